@@ -1,0 +1,24 @@
+//! # stackplan-geom
+//!
+//! The geometry kernel of stackplan: `f64` everywhere, lengths in millimetres, angles in radians.
+//!
+//! * [`predicates`]: the exact orientation predicates every combinatorial decision goes through;
+//! * [`tolerance`]: the one tolerance policy for computed quantities (touching vs penetrating);
+//! * [`polytope`]: convex polytopes with faces, edges and planes, and their validation;
+//! * [`hull`]: a robust 3-D convex hull (Quickhull with exact predicates and exact coplanar merging);
+//! * [`mass`]: volume, centre of gravity and inertia tensor;
+//! * [`part`]: rigid parts as unions of convex components, with boundary faces.
+
+pub mod hull;
+pub mod mass;
+pub mod part;
+pub mod polytope;
+pub mod predicates;
+pub mod tolerance;
+
+pub use glam::{DMat3, DVec2, DVec3};
+pub use hull::{ConvexHull, HullError, convex_hull};
+pub use mass::MassProperties;
+pub use part::{BoundaryFace, Part, PartError, PartOrigin};
+pub use polytope::{Containment, ConvexPolytope, Edge, Face, Plane, PolytopeError};
+pub use tolerance::Tolerance;

@@ -1,0 +1,613 @@
+//! Convex polytopes with a full boundary representation.
+//!
+//! A [`ConvexPolytope`] carries its vertices, its polygonal faces (outward, counter-clockwise seen from outside,
+//! exactly-coplanar facets already merged), its edges with the two faces that meet there, and a unit-normal plane per
+//! face (`n . x <= d` inside). Construction from an explicit face list costs O(V + E + F); [`ConvexPolytope::validate`]
+//! checks Euler's formula, that every vertex is on or inside every face plane, and strict convexity across every edge.
+
+use crate::predicates;
+use crate::tolerance::Tolerance;
+use glam::{DMat3, DVec3};
+use serde::{Deserialize, Serialize};
+use std::cmp::Ordering;
+use std::collections::HashMap;
+
+/// An oriented plane `normal . x = offset`; the inside half-space is `normal . x <= offset`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Plane {
+    /// Unit outward normal.
+    pub normal: DVec3,
+    /// Offset: `normal . x = offset` on the plane.
+    pub offset: f64,
+}
+
+impl Plane {
+    /// Signed distance of `p` (positive outside, i.e. on the normal's side).
+    #[inline]
+    pub fn signed_distance(&self, p: DVec3) -> f64 {
+        self.normal.dot(p) - self.offset
+    }
+}
+
+/// A polygonal face: vertex indices counter-clockwise seen from outside, and its plane.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Face {
+    /// Indices into [`ConvexPolytope::vertices`], counter-clockwise seen from outside.
+    pub vertices: Vec<usize>,
+    /// The face's plane with unit outward normal.
+    pub plane: Plane,
+}
+
+/// An edge between two vertices and the two faces that share it.
+///
+/// `faces[0]` traverses the edge as `vertices[0] -> vertices[1]` in its counter-clockwise order (the face on the
+/// left when walking from `vertices[0]` to `vertices[1]` seen from outside); `faces[1]` traverses it backwards.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Edge {
+    /// The edge's two end vertices.
+    pub vertices: [usize; 2],
+    /// The face traversing it forwards, then the face traversing it backwards.
+    pub faces: [usize; 2],
+}
+
+/// Why a face list is not the boundary of a convex polytope.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PolytopeError {
+    /// A face has fewer than three vertices.
+    #[error("face {face} has {count} vertices; a face needs at least 3")]
+    FaceTooSmall {
+        /// Face index.
+        face: usize,
+        /// Number of vertices it has.
+        count: usize,
+    },
+    /// A face refers to a vertex that does not exist.
+    #[error("face {face} refers to vertex {vertex}, but there are only {len} vertices")]
+    BadVertexIndex {
+        /// Face index.
+        face: usize,
+        /// The bad index.
+        vertex: usize,
+        /// Number of vertices.
+        len: usize,
+    },
+    /// A coordinate is NaN or infinite.
+    #[error("vertex {vertex} has a non-finite coordinate")]
+    NonFinite {
+        /// Vertex index.
+        vertex: usize,
+    },
+    /// The same directed edge appears in two faces, or an edge has only one face: not a closed 2-manifold.
+    #[error("edge {a}-{b} is not shared by exactly two consistently oriented faces")]
+    NotManifold {
+        /// First vertex.
+        a: usize,
+        /// Second vertex.
+        b: usize,
+    },
+    /// Euler's formula fails.
+    #[error("Euler characteristic V - E + F = {v} - {e} + {f} != 2")]
+    Euler {
+        /// Vertices.
+        v: usize,
+        /// Edges.
+        e: usize,
+        /// Faces.
+        f: usize,
+    },
+    /// A vertex lies outside a face plane.
+    #[error("vertex {vertex} lies outside the plane of face {face} by {distance}")]
+    VertexOutside {
+        /// Vertex index.
+        vertex: usize,
+        /// Face index.
+        face: usize,
+        /// Signed distance (positive = outside).
+        distance: f64,
+    },
+    /// A face's vertices are not coplanar.
+    #[error("face {face} is not planar: vertex {vertex} is off its plane by {distance}")]
+    NonPlanarFace {
+        /// Face index.
+        face: usize,
+        /// Vertex index.
+        vertex: usize,
+        /// Distance from the plane.
+        distance: f64,
+    },
+    /// Two faces sharing an edge are coplanar or bend the wrong way.
+    #[error("the polytope is not strictly convex across edge {a}-{b}")]
+    NotStrictlyConvex {
+        /// First vertex.
+        a: usize,
+        /// Second vertex.
+        b: usize,
+    },
+    /// A face has zero area (its normal is undefined).
+    #[error("face {face} is degenerate (zero area)")]
+    DegenerateFace {
+        /// Face index.
+        face: usize,
+    },
+}
+
+/// A convex polytope in boundary representation. See the module documentation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ConvexPolytope {
+    vertices: Vec<DVec3>,
+    faces: Vec<Face>,
+    edges: Vec<Edge>,
+    /// `face_edges[f][k]` is the edge from `faces[f].vertices[k]` to `faces[f].vertices[k + 1]`.
+    face_edges: Vec<Vec<usize>>,
+}
+
+/// Where a point is relative to a polytope, under a tolerance.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Containment {
+    /// Strictly inside every face plane by more than the tolerance.
+    Interior,
+    /// Within the tolerance of the boundary.
+    Boundary,
+    /// Outside some face plane by more than the tolerance.
+    Exterior,
+}
+
+/// Newell's normal of a polygon (twice its vector area); robust for nearly-degenerate polygons.
+pub fn newell_normal(points: impl Iterator<Item = DVec3> + Clone) -> DVec3 {
+    let mut n = DVec3::ZERO;
+    let first = points.clone().next();
+    let mut it = points.peekable();
+    while let Some(p) = it.next() {
+        let q = match it.peek() {
+            Some(q) => *q,
+            None => match first {
+                Some(f) => f,
+                None => break,
+            },
+        };
+        n.x += (p.y - q.y) * (p.z + q.z);
+        n.y += (p.z - q.z) * (p.x + q.x);
+        n.z += (p.x - q.x) * (p.y + q.y);
+    }
+    n
+}
+
+impl ConvexPolytope {
+    /// Builds a polytope from vertices and counter-clockwise (seen from outside) faces.
+    ///
+    /// Checks indices, finiteness and that the faces form a closed, consistently oriented 2-manifold; computes edges
+    /// and face planes (Newell normal, offset = the largest `n . v` over the face's vertices, so every face vertex
+    /// satisfies its own inequality). Convexity is checked by [`Self::validate`], not here.
+    pub fn new(vertices: Vec<DVec3>, faces: Vec<Vec<usize>>) -> Result<Self, PolytopeError> {
+        for (i, v) in vertices.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(PolytopeError::NonFinite { vertex: i });
+            }
+        }
+        let mut half: HashMap<(usize, usize), (usize, usize)> = HashMap::new();
+        for (f, face) in faces.iter().enumerate() {
+            if face.len() < 3 {
+                return Err(PolytopeError::FaceTooSmall {
+                    face: f,
+                    count: face.len(),
+                });
+            }
+            for (k, &a) in face.iter().enumerate() {
+                if a >= vertices.len() {
+                    return Err(PolytopeError::BadVertexIndex {
+                        face: f,
+                        vertex: a,
+                        len: vertices.len(),
+                    });
+                }
+                let b = face[(k + 1) % face.len()];
+                if half.insert((a, b), (f, k)).is_some() || a == b {
+                    return Err(PolytopeError::NotManifold { a, b });
+                }
+            }
+        }
+        let mut edges = Vec::with_capacity(half.len() / 2);
+        let mut face_edges: Vec<Vec<usize>> =
+            faces.iter().map(|f| vec![usize::MAX; f.len()]).collect();
+        for (f, face) in faces.iter().enumerate() {
+            for (k, &a) in face.iter().enumerate() {
+                let b = face[(k + 1) % face.len()];
+                if face_edges[f][k] != usize::MAX {
+                    continue;
+                }
+                let Some(&(g, j)) = half.get(&(b, a)) else {
+                    return Err(PolytopeError::NotManifold { a, b });
+                };
+                let e = edges.len();
+                edges.push(Edge {
+                    vertices: [a, b],
+                    faces: [f, g],
+                });
+                face_edges[f][k] = e;
+                face_edges[g][j] = e;
+            }
+        }
+        let mut out = Vec::with_capacity(faces.len());
+        for (f, face) in faces.into_iter().enumerate() {
+            let plane =
+                plane_of(&vertices, &face).ok_or(PolytopeError::DegenerateFace { face: f })?;
+            out.push(Face {
+                vertices: face,
+                plane,
+            });
+        }
+        Ok(Self {
+            vertices,
+            faces: out,
+            edges,
+            face_edges,
+        })
+    }
+
+    /// Builds a polytope whose face planes are given (for computed polytopes whose planes are known more accurately
+    /// than a fit to rounded vertices, e.g. Minkowski sums). Same checks as [`Self::new`]; the planes' normals must be
+    /// unit length.
+    pub fn with_planes(
+        vertices: Vec<DVec3>,
+        faces: Vec<Vec<usize>>,
+        planes: Vec<Plane>,
+    ) -> Result<Self, PolytopeError> {
+        let mut p = Self::new(vertices, faces)?;
+        for (face, plane) in p.faces.iter_mut().zip(planes) {
+            face.plane = plane;
+        }
+        Ok(p)
+    }
+
+    /// The vertices.
+    pub fn vertices(&self) -> &[DVec3] {
+        &self.vertices
+    }
+
+    /// The faces.
+    pub fn faces(&self) -> &[Face] {
+        &self.faces
+    }
+
+    /// The edges.
+    pub fn edges(&self) -> &[Edge] {
+        &self.edges
+    }
+
+    /// Edge indices of face `f`, aligned with its vertex cycle (`face_edges(f)[k]` joins vertex `k` and `k + 1`).
+    pub fn face_edges(&self, f: usize) -> &[usize] {
+        &self.face_edges[f]
+    }
+
+    /// The face planes, in face order.
+    pub fn planes(&self) -> impl ExactSizeIterator<Item = &Plane> + '_ {
+        self.faces.iter().map(|f| &f.plane)
+    }
+
+    /// Axis-aligned bounding box `(min, max)`.
+    pub fn aabb(&self) -> (DVec3, DVec3) {
+        let first = self.vertices[0];
+        self.vertices
+            .iter()
+            .fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
+    }
+
+    /// The policy tolerance for this polytope (scale = its bounding-box diagonal).
+    pub fn tolerance(&self) -> Tolerance {
+        Tolerance::for_points(&self.vertices)
+    }
+
+    /// Index of a vertex maximising `dir . v` (the support point).
+    pub fn support(&self, dir: DVec3) -> usize {
+        let mut best = 0;
+        let mut best_value = f64::NEG_INFINITY;
+        for (i, v) in self.vertices.iter().enumerate() {
+            let value = dir.dot(*v);
+            if value > best_value {
+                best_value = value;
+                best = i;
+            }
+        }
+        best
+    }
+
+    /// The image under `x -> rotation * x + translation` (same topology, planes transformed exactly as vectors).
+    pub fn transformed(&self, rotation: DMat3, translation: DVec3) -> Self {
+        let vertices = self
+            .vertices
+            .iter()
+            .map(|v| rotation * *v + translation)
+            .collect();
+        let faces = self
+            .faces
+            .iter()
+            .map(|f| {
+                let normal = (rotation * f.plane.normal).normalize();
+                // offset of the transformed plane: n' . (R x + t) = n . x + n' . t for a rotation R
+                let offset = f.plane.offset + normal.dot(translation);
+                Face {
+                    vertices: f.vertices.clone(),
+                    plane: Plane { normal, offset },
+                }
+            })
+            .collect();
+        Self {
+            vertices,
+            faces,
+            edges: self.edges.clone(),
+            face_edges: self.face_edges.clone(),
+        }
+    }
+
+    /// Classifies `p` against the face planes with the tolerance `tol`.
+    pub fn containment(&self, p: DVec3, tol: Tolerance) -> Containment {
+        let mut on_boundary = false;
+        for f in &self.faces {
+            match tol.sign(f.plane.signed_distance(p)) {
+                1 => return Containment::Exterior,
+                0 => on_boundary = true,
+                _ => {}
+            }
+        }
+        if on_boundary {
+            Containment::Boundary
+        } else {
+            Containment::Interior
+        }
+    }
+
+    /// Volume, by the divergence theorem over fan-triangulated faces. O(V + F).
+    pub fn volume(&self) -> f64 {
+        let c = self.vertex_centroid();
+        let mut v = 0.0;
+        for f in &self.faces {
+            let a = self.vertices[f.vertices[0]] - c;
+            for k in 1..f.vertices.len() - 1 {
+                let b = self.vertices[f.vertices[k]] - c;
+                let d = self.vertices[f.vertices[k + 1]] - c;
+                v += a.dot(b.cross(d));
+            }
+        }
+        v / 6.0
+    }
+
+    /// Mean of the vertices (an interior point of a full-dimensional polytope, not its centroid).
+    pub fn vertex_centroid(&self) -> DVec3 {
+        self.vertices.iter().copied().sum::<DVec3>() / self.vertices.len() as f64
+    }
+
+    /// Checks the polytope with the policy tolerance: Euler's formula, planarity of every face, every vertex on or
+    /// inside every face plane, strict convexity across every edge (the far vertices of the neighbouring face lie
+    /// strictly below the plane). Suited to computed polytopes whose coordinates carry rounding error.
+    pub fn validate(&self) -> Result<(), PolytopeError> {
+        self.validate_with(self.tolerance())
+    }
+
+    /// [`Self::validate`] with an explicit tolerance.
+    pub fn validate_with(&self, tol: Tolerance) -> Result<(), PolytopeError> {
+        self.check_euler()?;
+        for (fi, f) in self.faces.iter().enumerate() {
+            for &v in &f.vertices {
+                let d = f.plane.signed_distance(self.vertices[v]);
+                if d.abs() > tol.linear {
+                    return Err(PolytopeError::NonPlanarFace {
+                        face: fi,
+                        vertex: v,
+                        distance: d,
+                    });
+                }
+            }
+            for (vi, v) in self.vertices.iter().enumerate() {
+                let d = f.plane.signed_distance(*v);
+                if d > tol.linear {
+                    return Err(PolytopeError::VertexOutside {
+                        vertex: vi,
+                        face: fi,
+                        distance: d,
+                    });
+                }
+            }
+        }
+        for e in &self.edges {
+            let f = &self.faces[e.faces[0]];
+            let g = &self.faces[e.faces[1]];
+            let strictly_below = g
+                .vertices
+                .iter()
+                .filter(|v| !e.vertices.contains(v))
+                .any(|&v| f.plane.signed_distance(self.vertices[v]) < -tol.linear);
+            if !strictly_below {
+                return Err(PolytopeError::NotStrictlyConvex {
+                    a: e.vertices[0],
+                    b: e.vertices[1],
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The exact version of [`Self::validate`]: planarity, containment and strict convexity decided with exact
+    /// predicates on the vertex coordinates. For polytopes built from input points (hulls, input pieces).
+    pub fn validate_exact(&self) -> Result<(), PolytopeError> {
+        self.check_euler()?;
+        for (fi, f) in self.faces.iter().enumerate() {
+            let Some((a, b, c)) = self.face_frame(fi) else {
+                return Err(PolytopeError::DegenerateFace { face: fi });
+            };
+            for &v in &f.vertices {
+                if predicates::side(a, b, c, self.vertices[v]) != Ordering::Equal {
+                    let distance = f.plane.signed_distance(self.vertices[v]);
+                    return Err(PolytopeError::NonPlanarFace {
+                        face: fi,
+                        vertex: v,
+                        distance,
+                    });
+                }
+            }
+            for (vi, v) in self.vertices.iter().enumerate() {
+                if predicates::side(a, b, c, *v) == Ordering::Greater {
+                    let distance = f.plane.signed_distance(*v);
+                    return Err(PolytopeError::VertexOutside {
+                        vertex: vi,
+                        face: fi,
+                        distance,
+                    });
+                }
+            }
+        }
+        for e in &self.edges {
+            let Some((a, b, c)) = self.face_frame(e.faces[0]) else {
+                return Err(PolytopeError::DegenerateFace { face: e.faces[0] });
+            };
+            let g = &self.faces[e.faces[1]];
+            let strictly_below = g
+                .vertices
+                .iter()
+                .filter(|v| !e.vertices.contains(v))
+                .any(|&v| predicates::side(a, b, c, self.vertices[v]) == Ordering::Less);
+            if !strictly_below {
+                return Err(PolytopeError::NotStrictlyConvex {
+                    a: e.vertices[0],
+                    b: e.vertices[1],
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Three vertices of face `f` that are not collinear, in the face's counter-clockwise order (so that
+    /// [`predicates::side`] on them is positive outside). `None` if all the face's vertices are collinear.
+    pub fn face_frame(&self, f: usize) -> Option<(DVec3, DVec3, DVec3)> {
+        let idx = &self.faces[f].vertices;
+        let n = idx.len();
+        // A convex polygon: any three consecutive non-collinear vertices have the face's orientation.
+        for k in 0..n {
+            let a = self.vertices[idx[k]];
+            let b = self.vertices[idx[(k + 1) % n]];
+            let c = self.vertices[idx[(k + 2) % n]];
+            if !predicates::collinear(a, b, c) {
+                return Some((a, b, c));
+            }
+        }
+        None
+    }
+
+    fn check_euler(&self) -> Result<(), PolytopeError> {
+        let (v, e, f) = (self.vertices.len(), self.edges.len(), self.faces.len());
+        // every vertex must be used, otherwise V is overcounted
+        if v + f != e + 2 {
+            return Err(PolytopeError::Euler { v, e, f });
+        }
+        Ok(())
+    }
+}
+
+fn plane_of(vertices: &[DVec3], face: &[usize]) -> Option<Plane> {
+    let n = newell_normal(face.iter().map(|&i| vertices[i]));
+    let len = n.length();
+    if !(len > 0.0) || !len.is_finite() {
+        return None;
+    }
+    let normal = n / len;
+    let offset = face
+        .iter()
+        .map(|&i| normal.dot(vertices[i]))
+        .fold(f64::NEG_INFINITY, f64::max);
+    Some(Plane { normal, offset })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    pub(crate) fn unit_cube() -> ConvexPolytope {
+        let v: Vec<DVec3> = (0..8)
+            .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
+            .collect();
+        let faces = vec![
+            vec![0, 2, 3, 1], // z = 0, normal -z
+            vec![4, 5, 7, 6], // z = 1
+            vec![0, 1, 5, 4], // y = 0
+            vec![2, 6, 7, 3], // y = 1
+            vec![0, 4, 6, 2], // x = 0
+            vec![1, 3, 7, 5], // x = 1
+        ];
+        ConvexPolytope::new(v, faces).expect("cube")
+    }
+
+    #[test]
+    fn cube_is_valid() {
+        let c = unit_cube();
+        assert_eq!(c.edges().len(), 12);
+        c.validate().expect("valid");
+        c.validate_exact().expect("valid exact");
+        assert!((c.volume() - 1.0).abs() < 1e-15);
+        assert_eq!(c.faces()[0].plane.normal, -DVec3::Z);
+        assert_eq!(
+            c.containment(DVec3::splat(0.5), c.tolerance()),
+            Containment::Interior
+        );
+        assert_eq!(
+            c.containment(DVec3::new(0.5, 0.5, 1.0), c.tolerance()),
+            Containment::Boundary
+        );
+        assert_eq!(
+            c.containment(DVec3::new(0.5, 0.5, 1.1), c.tolerance()),
+            Containment::Exterior
+        );
+        for (ei, e) in c.edges().iter().enumerate() {
+            for (side, &f) in e.faces.iter().enumerate() {
+                let k = c
+                    .face_edges(f)
+                    .iter()
+                    .position(|&x| x == ei)
+                    .expect("edge in face");
+                let fv = &c.faces()[f].vertices;
+                let (a, b) = (fv[k], fv[(k + 1) % fv.len()]);
+                if side == 0 {
+                    assert_eq!([a, b], e.vertices);
+                } else {
+                    assert_eq!([b, a], e.vertices);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn rejects_bad_face_lists() {
+        let c = unit_cube();
+        let v = c.vertices().to_vec();
+        let mut faces: Vec<Vec<usize>> = c.faces().iter().map(|f| f.vertices.clone()).collect();
+        faces.pop();
+        assert!(matches!(
+            ConvexPolytope::new(v.clone(), faces.clone()),
+            Err(PolytopeError::NotManifold { .. })
+        ));
+        faces.push(vec![1, 3]);
+        assert!(matches!(
+            ConvexPolytope::new(v.clone(), faces),
+            Err(PolytopeError::FaceTooSmall { .. })
+        ));
+        let mut bad = v.clone();
+        bad[3].x = f64::NAN;
+        let faces: Vec<Vec<usize>> = c.faces().iter().map(|f| f.vertices.clone()).collect();
+        assert!(matches!(
+            ConvexPolytope::new(bad, faces.clone()),
+            Err(PolytopeError::NonFinite { vertex: 3 })
+        ));
+        // a dented cube: vertex 7 pushed inwards makes the polytope non-convex
+        let mut dented = v;
+        dented[7] = DVec3::splat(0.6);
+        let p = ConvexPolytope::new(dented, faces).expect("manifold");
+        assert!(p.validate_exact().is_err());
+    }
+
+    #[test]
+    fn transform_keeps_validity() {
+        let c = unit_cube();
+        let r = DMat3::from_rotation_z(0.3) * DMat3::from_rotation_x(1.1);
+        let t = c.transformed(r, DVec3::new(5.0, -2.0, 1.0));
+        t.validate().expect("valid");
+        assert!((t.volume() - 1.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,7 @@
+//! # stackplan
+//!
+//! Interference-free stacking of polyhedral sheet-metal parts (Ayyadevara, Bourne, Shimada, Sturges, IEEE T-RA 2002)
+//! and assembly contact states (Pan, Schimmels, ICRA 2004). This crate is a thin facade: each module re-exports one
+//! focused crate, so library users can depend on `stackplan` alone or on the single crates they need.
+
+pub use stackplan_geom as geom;
