@@ -14,6 +14,7 @@ pub mod mass;
 pub mod part;
 pub mod polytope;
 pub mod predicates;
+pub mod sheet_metal;
 pub mod tolerance;
 
 pub use glam::{DMat3, DVec2, DVec3};
