@@ -89,11 +89,7 @@ pub fn convex_hull(points: &[DVec3]) -> Result<ConvexHull, HullError> {
 fn initial_simplex(p: &[DVec3]) -> Result<[u32; 4], HullError> {
     // i0: lexicographically smallest point (an extreme point).
     let i0 = (0..p.len())
-        .min_by(|&a, &b| {
-            p[a].to_array()
-                .partial_cmp(&p[b].to_array())
-                .unwrap_or(Ordering::Equal)
-        })
+        .min_by(|&a, &b| p[a].to_array().partial_cmp(&p[b].to_array()).unwrap_or(Ordering::Equal))
         .unwrap_or(0);
     // i1: farthest from i0 (float choice, exact meaning: any point different from i0).
     let i1 = argmax(p.len(), |i| (p[i] - p[i0]).length_squared()).filter(|&i| p[i] != p[i0]);
@@ -103,17 +99,13 @@ fn initial_simplex(p: &[DVec3]) -> Result<[u32; 4], HullError> {
     let dir = p[i1] - p[i0];
     let i2 = argmax(p.len(), |i| (p[i] - p[i0]).cross(dir).length_squared())
         .filter(|&i| !predicates::collinear(p[i0], p[i1], p[i]));
-    let Some(i2) =
-        i2.or_else(|| (0..p.len()).find(|&i| !predicates::collinear(p[i0], p[i1], p[i])))
-    else {
+    let Some(i2) = i2.or_else(|| (0..p.len()).find(|&i| !predicates::collinear(p[i0], p[i1], p[i]))) else {
         return Err(HullError::Collinear);
     };
     let n = (p[i1] - p[i0]).cross(p[i2] - p[i0]);
-    let i3 = argmax(p.len(), |i| n.dot(p[i] - p[i0]).abs())
-        .filter(|&i| side(p[i0], p[i1], p[i2], p[i]) != Ordering::Equal);
-    let Some(i3) =
-        i3.or_else(|| (0..p.len()).find(|&i| side(p[i0], p[i1], p[i2], p[i]) != Ordering::Equal))
-    else {
+    let i3 =
+        argmax(p.len(), |i| n.dot(p[i] - p[i0]).abs()).filter(|&i| side(p[i0], p[i1], p[i2], p[i]) != Ordering::Equal);
+    let Some(i3) = i3.or_else(|| (0..p.len()).find(|&i| side(p[i0], p[i1], p[i2], p[i]) != Ordering::Equal)) else {
         return Err(HullError::Coplanar);
     };
     Ok([i0 as u32, i1 as u32, i2 as u32, i3 as u32])
@@ -134,33 +126,21 @@ fn argmax(n: usize, f: impl Fn(usize) -> f64) -> Option<usize> {
 
 fn make_tri(p: &[DVec3], v: [u32; 3]) -> Tri {
     let (a, b, c) = (p[v[0] as usize], p[v[1] as usize], p[v[2] as usize]);
-    Tri {
-        v,
-        nbr: [NONE; 3],
-        normal: (b - a).cross(c - a),
-        outside: Vec::new(),
-        alive: true,
-    }
+    Tri { v, nbr: [NONE; 3], normal: (b - a).cross(c - a), outside: Vec::new(), alive: true }
 }
 
 fn above(p: &[DVec3], t: &Tri, q: u32) -> bool {
-    side(
-        p[t.v[0] as usize],
-        p[t.v[1] as usize],
-        p[t.v[2] as usize],
-        p[q as usize],
-    ) == Ordering::Greater
+    side(p[t.v[0] as usize], p[t.v[1] as usize], p[t.v[2] as usize], p[q as usize]) == Ordering::Greater
 }
 
 fn build_simplex(p: &[DVec3], s: [u32; 4], tris: &mut Vec<Tri>) {
     let [a, b, c, d] = s;
     // orient (a, b, c) so that d is below it
-    let (b, c) =
-        if side(p[a as usize], p[b as usize], p[c as usize], p[d as usize]) == Ordering::Greater {
-            (c, b)
-        } else {
-            (b, c)
-        };
+    let (b, c) = if side(p[a as usize], p[b as usize], p[c as usize], p[d as usize]) == Ordering::Greater {
+        (c, b)
+    } else {
+        (b, c)
+    };
     let faces = [[a, b, c], [a, d, b], [b, d, c], [c, d, a]];
     for f in faces {
         tris.push(make_tri(p, f));
@@ -203,9 +183,7 @@ fn assign_initial_outside(p: &[DVec3], s: [u32; 4], tris: &mut [Tri]) {
 }
 
 fn expand(p: &[DVec3], tris: &mut Vec<Tri>) {
-    let mut stack: Vec<u32> = (0..tris.len() as u32)
-        .filter(|&t| !tris[t as usize].outside.is_empty())
-        .collect();
+    let mut stack: Vec<u32> = (0..tris.len() as u32).filter(|&t| !tris[t as usize].outside.is_empty()).collect();
     let mut visible: Vec<u32> = Vec::new();
     let mut horizon: Vec<(u32, u32, u32)> = Vec::new(); // (a, b, invisible neighbour) with a -> b in visible tri
     let mut bfs: Vec<u32> = Vec::new();
@@ -223,9 +201,7 @@ fn expand(p: &[DVec3], tris: &mut Vec<Tri>) {
             .outside
             .iter()
             .max_by(|&&x, &&y| {
-                n0.dot(p[x as usize] - a0)
-                    .partial_cmp(&n0.dot(p[y as usize] - a0))
-                    .unwrap_or(Ordering::Equal)
+                n0.dot(p[x as usize] - a0).partial_cmp(&n0.dot(p[y as usize] - a0)).unwrap_or(Ordering::Equal)
             })
             .unwrap_or(&tris[t0u].outside[0]);
         // visible set by BFS from t0 (the visible region is connected)
@@ -266,8 +242,7 @@ fn expand(p: &[DVec3], tris: &mut Vec<Tri>) {
         let hn = horizon.len();
         let mut ordered = Vec::with_capacity(hn);
         {
-            let mut next_of: std::collections::HashMap<u32, usize> =
-                std::collections::HashMap::with_capacity(hn);
+            let mut next_of: std::collections::HashMap<u32, usize> = std::collections::HashMap::with_capacity(hn);
             for (i, h) in horizon.iter().enumerate() {
                 next_of.insert(h.0, i);
             }
@@ -343,18 +318,8 @@ fn merge(p: &[DVec3], tris: &[Tri]) -> Result<ConvexHull, HullError> {
             }
             // the vertex of the neighbour opposite the shared edge
             let nt = &tris[j];
-            let far =
-                nt.v.iter()
-                    .copied()
-                    .find(|v| !t.v.contains(v))
-                    .unwrap_or(nt.v[0]);
-            if side(
-                p[t.v[0] as usize],
-                p[t.v[1] as usize],
-                p[t.v[2] as usize],
-                p[far as usize],
-            ) == Ordering::Equal
-            {
+            let far = nt.v.iter().copied().find(|v| !t.v.contains(v)).unwrap_or(nt.v[0]);
+            if side(p[t.v[0] as usize], p[t.v[1] as usize], p[t.v[2] as usize], p[far as usize]) == Ordering::Equal {
                 let (a, b) = (find(&mut parent, i as u32), find(&mut parent, j as u32));
                 if a != b {
                     parent[a as usize] = b;
@@ -390,8 +355,7 @@ fn merge(p: &[DVec3], tris: &[Tri]) -> Result<ConvexHull, HullError> {
         }
     }
     // boundary half-edges of each group, chained into a cycle
-    let mut boundary: Vec<std::collections::HashMap<u32, u32>> =
-        vec![Default::default(); group_count as usize];
+    let mut boundary: Vec<std::collections::HashMap<u32, u32>> = vec![Default::default(); group_count as usize];
     for (i, t) in tris.iter().enumerate() {
         if !t.alive {
             continue;
@@ -465,27 +429,15 @@ mod tests {
         assert_eq!(convex_hull(&[DVec3::ONE; 5]), Err(HullError::Coincident));
         let line: Vec<DVec3> = (0..5).map(|i| DVec3::splat(i as f64)).collect();
         assert_eq!(convex_hull(&line), Err(HullError::Collinear));
-        let plane: Vec<DVec3> = (0..9)
-            .map(|i| DVec3::new((i % 3) as f64, (i / 3) as f64, 2.0))
-            .collect();
+        let plane: Vec<DVec3> = (0..9).map(|i| DVec3::new((i % 3) as f64, (i / 3) as f64, 2.0)).collect();
         assert_eq!(convex_hull(&plane), Err(HullError::Coplanar));
-        assert_eq!(
-            convex_hull(&[DVec3::ZERO, DVec3::new(f64::NAN, 0.0, 0.0)]),
-            Err(HullError::NonFinite { index: 1 })
-        );
+        assert_eq!(convex_hull(&[DVec3::ZERO, DVec3::new(f64::NAN, 0.0, 0.0)]), Err(HullError::NonFinite { index: 1 }));
     }
 
     #[test]
     fn prism_with_duplicates_and_collinear_runs() {
         // an extruded hexagon (dyadic corners, so the edge samples are exactly collinear), every point twice
-        let corners = [
-            (2.0, 0.0),
-            (1.0, 2.0),
-            (-1.0, 2.0),
-            (-2.0, 0.0),
-            (-1.0, -2.0),
-            (1.0, -2.0),
-        ];
+        let corners = [(2.0, 0.0), (1.0, 2.0), (-1.0, 2.0), (-2.0, 0.0), (-1.0, -2.0), (1.0, -2.0)];
         let mut pts = Vec::new();
         for layer in [0.0, 2.0] {
             for k in 0..6 {

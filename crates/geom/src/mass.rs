@@ -38,11 +38,7 @@ pub struct Moments {
 impl Default for Moments {
     fn default() -> Self {
         // not derived: glam's `DMat3::default()` is the identity, not zero
-        Self {
-            volume: 0.0,
-            first: DVec3::ZERO,
-            second: DMat3::ZERO,
-        }
+        Self { volume: 0.0, first: DVec3::ZERO, second: DMat3::ZERO }
     }
 }
 
@@ -96,12 +92,7 @@ impl Moments {
         let cov_cg = (self.second - outer * self.volume) * density;
         let trace = cov_cg.x_axis.x + cov_cg.y_axis.y + cov_cg.z_axis.z;
         let inertia = DMat3::from_diagonal(DVec3::splat(trace)) - cov_cg;
-        Some(MassProperties {
-            volume: self.volume,
-            mass: self.volume * density,
-            center_of_gravity: cg,
-            inertia,
-        })
+        Some(MassProperties { volume: self.volume, mass: self.volume * density, center_of_gravity: cg, inertia })
     }
 }
 
@@ -131,10 +122,7 @@ mod tests {
     #[test]
     fn box_against_closed_form() {
         let (a, b, c) = (2.0, 3.0, 5.0);
-        let p = cuboid(
-            DVec3::new(1.0, -1.0, 4.0),
-            DVec3::new(1.0 + a, -1.0 + b, 4.0 + c),
-        );
+        let p = cuboid(DVec3::new(1.0, -1.0, 4.0), DVec3::new(1.0 + a, -1.0 + b, 4.0 + c));
         let m = polytope_mass_properties(&p, 7.8).expect("props");
         let mass = 7.8 * a * b * c;
         assert!((m.volume - a * b * c).abs() < 1e-12);
@@ -142,26 +130,15 @@ mod tests {
         assert!((m.center_of_gravity - DVec3::new(2.0, 0.5, 6.5)).length() < 1e-12);
         let expect = DVec3::new(b * b + c * c, a * a + c * c, a * a + b * b) * (mass / 12.0);
         let got = DVec3::new(m.inertia.x_axis.x, m.inertia.y_axis.y, m.inertia.z_axis.z);
-        assert!(
-            (got - expect).length() < 1e-9 * expect.length(),
-            "{got} vs {expect}"
-        );
-        assert!(
-            m.inertia.x_axis.y.abs() < 1e-9
-                && m.inertia.x_axis.z.abs() < 1e-9
-                && m.inertia.y_axis.z.abs() < 1e-9
-        );
+        assert!((got - expect).length() < 1e-9 * expect.length(), "{got} vs {expect}");
+        assert!(m.inertia.x_axis.y.abs() < 1e-9 && m.inertia.x_axis.z.abs() < 1e-9 && m.inertia.y_axis.z.abs() < 1e-9);
     }
 
     #[test]
     fn triangular_prism_against_closed_form() {
         // right triangle legs (a, b) in xy, extruded by h along z: cg at (a/3, b/3, h/2)
         let (a, b, h) = (3.0, 6.0, 2.0);
-        let base = [
-            DVec3::ZERO,
-            DVec3::new(a, 0.0, 0.0),
-            DVec3::new(0.0, b, 0.0),
-        ];
+        let base = [DVec3::ZERO, DVec3::new(a, 0.0, 0.0), DVec3::new(0.0, b, 0.0)];
         let pts: Vec<DVec3> = base.iter().flat_map(|&p| [p, p + DVec3::Z * h]).collect();
         let p = convex_hull(&pts).expect("prism").polytope;
         let m = polytope_mass_properties(&p, 1.0).expect("props");

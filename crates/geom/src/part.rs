@@ -96,14 +96,7 @@ impl Part {
         }
         let mass = total.properties(density).ok_or(PartError::ZeroVolume(0))?;
         let boundary = boundary_faces(&components);
-        Ok(Self {
-            name: name.into(),
-            components,
-            boundary,
-            mass,
-            density,
-            origin,
-        })
+        Ok(Self { name: name.into(), components, boundary, mass, density, origin })
     }
 
     /// Axis-aligned bounding box of the part `(min, max)`.
@@ -120,9 +113,7 @@ impl Part {
 
     /// All component vertices (with repetitions across components).
     pub fn all_vertices(&self) -> impl Iterator<Item = DVec3> + '_ {
-        self.components
-            .iter()
-            .flat_map(|c| c.vertices().iter().copied())
+        self.components.iter().flat_map(|c| c.vertices().iter().copied())
     }
 
     /// The policy tolerance for this part (scale = bounding-box diagonal).
@@ -145,9 +136,7 @@ impl Part {
 pub fn boundary_faces(components: &[ConvexPolytope]) -> Vec<BoundaryFace> {
     type Key = Vec<[u64; 3]>;
     fn key(points: impl Iterator<Item = DVec3>) -> Key {
-        let mut k: Key = points
-            .map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
-            .collect();
+        let mut k: Key = points.map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]).collect();
         // canonical rotation: start at the smallest coordinate triple
         if let Some(m) = (0..k.len()).min_by_key(|&i| k[i]) {
             k.rotate_left(m);
@@ -157,9 +146,7 @@ pub fn boundary_faces(components: &[ConvexPolytope]) -> Vec<BoundaryFace> {
     let mut count: HashMap<Key, usize> = HashMap::new();
     for c in components {
         for f in c.faces() {
-            *count
-                .entry(key(f.vertices.iter().map(|&v| c.vertices()[v])))
-                .or_default() += 1;
+            *count.entry(key(f.vertices.iter().map(|&v| c.vertices()[v]))).or_default() += 1;
         }
     }
     let mut out = Vec::new();
@@ -202,8 +189,7 @@ mod tests {
     fn two_boxes_share_a_face() {
         let a = cuboid(DVec3::ZERO, DVec3::new(1.0, 1.0, 1.0));
         let b = cuboid(DVec3::new(1.0, 0.0, 0.0), DVec3::new(3.0, 1.0, 1.0));
-        let p =
-            Part::from_components("two", vec![a, b], 2.0, PartOrigin::ConvexPieces).expect("part");
+        let p = Part::from_components("two", vec![a, b], 2.0, PartOrigin::ConvexPieces).expect("part");
         assert_eq!(p.boundary.len(), 10);
         assert!((p.mass.volume - 3.0).abs() < 1e-12);
         assert!((p.mass.mass - 6.0).abs() < 1e-12);
@@ -213,10 +199,7 @@ mod tests {
 
     #[test]
     fn bad_parts() {
-        assert_eq!(
-            Part::from_components("e", vec![], 1.0, PartOrigin::ConvexPieces),
-            Err(PartError::Empty)
-        );
+        assert_eq!(Part::from_components("e", vec![], 1.0, PartOrigin::ConvexPieces), Err(PartError::Empty));
         let a = cuboid(DVec3::ZERO, DVec3::ONE);
         let r = Part::from_components("d", vec![a.clone()], -1.0, PartOrigin::ConvexPieces);
         assert_eq!(r, Err(PartError::BadDensity(-1.0)));

@@ -187,18 +187,11 @@ impl ConvexPolytope {
         let mut half: HashMap<(usize, usize), (usize, usize)> = HashMap::new();
         for (f, face) in faces.iter().enumerate() {
             if face.len() < 3 {
-                return Err(PolytopeError::FaceTooSmall {
-                    face: f,
-                    count: face.len(),
-                });
+                return Err(PolytopeError::FaceTooSmall { face: f, count: face.len() });
             }
             for (k, &a) in face.iter().enumerate() {
                 if a >= vertices.len() {
-                    return Err(PolytopeError::BadVertexIndex {
-                        face: f,
-                        vertex: a,
-                        len: vertices.len(),
-                    });
+                    return Err(PolytopeError::BadVertexIndex { face: f, vertex: a, len: vertices.len() });
                 }
                 let b = face[(k + 1) % face.len()];
                 if half.insert((a, b), (f, k)).is_some() || a == b {
@@ -207,8 +200,7 @@ impl ConvexPolytope {
             }
         }
         let mut edges = Vec::with_capacity(half.len() / 2);
-        let mut face_edges: Vec<Vec<usize>> =
-            faces.iter().map(|f| vec![usize::MAX; f.len()]).collect();
+        let mut face_edges: Vec<Vec<usize>> = faces.iter().map(|f| vec![usize::MAX; f.len()]).collect();
         for (f, face) in faces.iter().enumerate() {
             for (k, &a) in face.iter().enumerate() {
                 let b = face[(k + 1) % face.len()];
@@ -219,29 +211,17 @@ impl ConvexPolytope {
                     return Err(PolytopeError::NotManifold { a, b });
                 };
                 let e = edges.len();
-                edges.push(Edge {
-                    vertices: [a, b],
-                    faces: [f, g],
-                });
+                edges.push(Edge { vertices: [a, b], faces: [f, g] });
                 face_edges[f][k] = e;
                 face_edges[g][j] = e;
             }
         }
         let mut out = Vec::with_capacity(faces.len());
         for (f, face) in faces.into_iter().enumerate() {
-            let plane =
-                plane_of(&vertices, &face).ok_or(PolytopeError::DegenerateFace { face: f })?;
-            out.push(Face {
-                vertices: face,
-                plane,
-            });
+            let plane = plane_of(&vertices, &face).ok_or(PolytopeError::DegenerateFace { face: f })?;
+            out.push(Face { vertices: face, plane });
         }
-        Ok(Self {
-            vertices,
-            faces: out,
-            edges,
-            face_edges,
-        })
+        Ok(Self { vertices, faces: out, edges, face_edges })
     }
 
     /// Builds a polytope whose face planes are given (for computed polytopes whose planes are known more accurately
@@ -287,9 +267,7 @@ impl ConvexPolytope {
     /// Axis-aligned bounding box `(min, max)`.
     pub fn aabb(&self) -> (DVec3, DVec3) {
         let first = self.vertices[0];
-        self.vertices
-            .iter()
-            .fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
+        self.vertices.iter().fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
     }
 
     /// The policy tolerance for this polytope (scale = its bounding-box diagonal).
@@ -313,11 +291,7 @@ impl ConvexPolytope {
 
     /// The image under `x -> rotation * x + translation` (same topology, planes transformed exactly as vectors).
     pub fn transformed(&self, rotation: DMat3, translation: DVec3) -> Self {
-        let vertices = self
-            .vertices
-            .iter()
-            .map(|v| rotation * *v + translation)
-            .collect();
+        let vertices = self.vertices.iter().map(|v| rotation * *v + translation).collect();
         let faces = self
             .faces
             .iter()
@@ -325,18 +299,10 @@ impl ConvexPolytope {
                 let normal = (rotation * f.plane.normal).normalize();
                 // offset of the transformed plane: n' . (R x + t) = n . x + n' . t for a rotation R
                 let offset = f.plane.offset + normal.dot(translation);
-                Face {
-                    vertices: f.vertices.clone(),
-                    plane: Plane { normal, offset },
-                }
+                Face { vertices: f.vertices.clone(), plane: Plane { normal, offset } }
             })
             .collect();
-        Self {
-            vertices,
-            faces,
-            edges: self.edges.clone(),
-            face_edges: self.face_edges.clone(),
-        }
+        Self { vertices, faces, edges: self.edges.clone(), face_edges: self.face_edges.clone() }
     }
 
     /// Classifies `p` against the face planes with the tolerance `tol`.
@@ -349,11 +315,7 @@ impl ConvexPolytope {
                 _ => {}
             }
         }
-        if on_boundary {
-            Containment::Boundary
-        } else {
-            Containment::Interior
-        }
+        if on_boundary { Containment::Boundary } else { Containment::Interior }
     }
 
     /// Volume, by the divergence theorem over fan-triangulated faces. O(V + F).
@@ -390,21 +352,13 @@ impl ConvexPolytope {
             for &v in &f.vertices {
                 let d = f.plane.signed_distance(self.vertices[v]);
                 if d.abs() > tol.linear {
-                    return Err(PolytopeError::NonPlanarFace {
-                        face: fi,
-                        vertex: v,
-                        distance: d,
-                    });
+                    return Err(PolytopeError::NonPlanarFace { face: fi, vertex: v, distance: d });
                 }
             }
             for (vi, v) in self.vertices.iter().enumerate() {
                 let d = f.plane.signed_distance(*v);
                 if d > tol.linear {
-                    return Err(PolytopeError::VertexOutside {
-                        vertex: vi,
-                        face: fi,
-                        distance: d,
-                    });
+                    return Err(PolytopeError::VertexOutside { vertex: vi, face: fi, distance: d });
                 }
             }
         }
@@ -417,10 +371,7 @@ impl ConvexPolytope {
                 .filter(|v| !e.vertices.contains(v))
                 .any(|&v| f.plane.signed_distance(self.vertices[v]) < -tol.linear);
             if !strictly_below {
-                return Err(PolytopeError::NotStrictlyConvex {
-                    a: e.vertices[0],
-                    b: e.vertices[1],
-                });
+                return Err(PolytopeError::NotStrictlyConvex { a: e.vertices[0], b: e.vertices[1] });
             }
         }
         Ok(())
@@ -437,21 +388,13 @@ impl ConvexPolytope {
             for &v in &f.vertices {
                 if predicates::side(a, b, c, self.vertices[v]) != Ordering::Equal {
                     let distance = f.plane.signed_distance(self.vertices[v]);
-                    return Err(PolytopeError::NonPlanarFace {
-                        face: fi,
-                        vertex: v,
-                        distance,
-                    });
+                    return Err(PolytopeError::NonPlanarFace { face: fi, vertex: v, distance });
                 }
             }
             for (vi, v) in self.vertices.iter().enumerate() {
                 if predicates::side(a, b, c, *v) == Ordering::Greater {
                     let distance = f.plane.signed_distance(*v);
-                    return Err(PolytopeError::VertexOutside {
-                        vertex: vi,
-                        face: fi,
-                        distance,
-                    });
+                    return Err(PolytopeError::VertexOutside { vertex: vi, face: fi, distance });
                 }
             }
         }
@@ -466,10 +409,7 @@ impl ConvexPolytope {
                 .filter(|v| !e.vertices.contains(v))
                 .any(|&v| predicates::side(a, b, c, self.vertices[v]) == Ordering::Less);
             if !strictly_below {
-                return Err(PolytopeError::NotStrictlyConvex {
-                    a: e.vertices[0],
-                    b: e.vertices[1],
-                });
+                return Err(PolytopeError::NotStrictlyConvex { a: e.vertices[0], b: e.vertices[1] });
             }
         }
         Ok(())
@@ -509,10 +449,7 @@ fn plane_of(vertices: &[DVec3], face: &[usize]) -> Option<Plane> {
         return None;
     }
     let normal = n / len;
-    let offset = face
-        .iter()
-        .map(|&i| normal.dot(vertices[i]))
-        .fold(f64::NEG_INFINITY, f64::max);
+    let offset = face.iter().map(|&i| normal.dot(vertices[i])).fold(f64::NEG_INFINITY, f64::max);
     Some(Plane { normal, offset })
 }
 
@@ -521,9 +458,8 @@ mod tests {
     use super::*;
 
     pub(crate) fn unit_cube() -> ConvexPolytope {
-        let v: Vec<DVec3> = (0..8)
-            .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
-            .collect();
+        let v: Vec<DVec3> =
+            (0..8).map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64)).collect();
         let faces = vec![
             vec![0, 2, 3, 1], // z = 0, normal -z
             vec![4, 5, 7, 6], // z = 1
@@ -543,25 +479,12 @@ mod tests {
         c.validate_exact().expect("valid exact");
         assert!((c.volume() - 1.0).abs() < 1e-15);
         assert_eq!(c.faces()[0].plane.normal, -DVec3::Z);
-        assert_eq!(
-            c.containment(DVec3::splat(0.5), c.tolerance()),
-            Containment::Interior
-        );
-        assert_eq!(
-            c.containment(DVec3::new(0.5, 0.5, 1.0), c.tolerance()),
-            Containment::Boundary
-        );
-        assert_eq!(
-            c.containment(DVec3::new(0.5, 0.5, 1.1), c.tolerance()),
-            Containment::Exterior
-        );
+        assert_eq!(c.containment(DVec3::splat(0.5), c.tolerance()), Containment::Interior);
+        assert_eq!(c.containment(DVec3::new(0.5, 0.5, 1.0), c.tolerance()), Containment::Boundary);
+        assert_eq!(c.containment(DVec3::new(0.5, 0.5, 1.1), c.tolerance()), Containment::Exterior);
         for (ei, e) in c.edges().iter().enumerate() {
             for (side, &f) in e.faces.iter().enumerate() {
-                let k = c
-                    .face_edges(f)
-                    .iter()
-                    .position(|&x| x == ei)
-                    .expect("edge in face");
+                let k = c.face_edges(f).iter().position(|&x| x == ei).expect("edge in face");
                 let fv = &c.faces()[f].vertices;
                 let (a, b) = (fv[k], fv[(k + 1) % fv.len()]);
                 if side == 0 {
@@ -579,22 +502,13 @@ mod tests {
         let v = c.vertices().to_vec();
         let mut faces: Vec<Vec<usize>> = c.faces().iter().map(|f| f.vertices.clone()).collect();
         faces.pop();
-        assert!(matches!(
-            ConvexPolytope::new(v.clone(), faces.clone()),
-            Err(PolytopeError::NotManifold { .. })
-        ));
+        assert!(matches!(ConvexPolytope::new(v.clone(), faces.clone()), Err(PolytopeError::NotManifold { .. })));
         faces.push(vec![1, 3]);
-        assert!(matches!(
-            ConvexPolytope::new(v.clone(), faces),
-            Err(PolytopeError::FaceTooSmall { .. })
-        ));
+        assert!(matches!(ConvexPolytope::new(v.clone(), faces), Err(PolytopeError::FaceTooSmall { .. })));
         let mut bad = v.clone();
         bad[3].x = f64::NAN;
         let faces: Vec<Vec<usize>> = c.faces().iter().map(|f| f.vertices.clone()).collect();
-        assert!(matches!(
-            ConvexPolytope::new(bad, faces.clone()),
-            Err(PolytopeError::NonFinite { vertex: 3 })
-        ));
+        assert!(matches!(ConvexPolytope::new(bad, faces.clone()), Err(PolytopeError::NonFinite { vertex: 3 })));
         // a dented cube: vertex 7 pushed inwards makes the polytope non-convex
         let mut dented = v;
         dented[7] = DVec3::splat(0.6);

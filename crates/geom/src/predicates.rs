@@ -15,11 +15,7 @@ use glam::{DVec2, DVec3};
 use std::cmp::Ordering;
 
 fn c3(p: DVec3) -> robust::Coord3D<f64> {
-    robust::Coord3D {
-        x: p.x,
-        y: p.y,
-        z: p.z,
-    }
+    robust::Coord3D { x: p.x, y: p.y, z: p.z }
 }
 
 fn c2(x: f64, y: f64) -> robust::Coord<f64> {

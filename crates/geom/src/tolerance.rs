@@ -33,14 +33,8 @@ pub struct Tolerance {
 impl Tolerance {
     /// The policy's tolerance for a problem whose characteristic length is `scale` (millimetres).
     pub fn for_scale(scale: f64) -> Self {
-        let scale = if scale.is_finite() {
-            scale.max(MIN_SCALE)
-        } else {
-            MIN_SCALE
-        };
-        Self {
-            linear: RELATIVE * scale,
-        }
+        let scale = if scale.is_finite() { scale.max(MIN_SCALE) } else { MIN_SCALE };
+        Self { linear: RELATIVE * scale }
     }
 
     /// The policy's tolerance for a set of points: scale = the diagonal of their bounding box.
@@ -72,9 +66,7 @@ pub fn bounding_diagonal(points: &[DVec3]) -> f64 {
     let Some(first) = points.first() else {
         return 0.0;
     };
-    let (lo, hi) = points
-        .iter()
-        .fold((*first, *first), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    let (lo, hi) = points.iter().fold((*first, *first), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
     (hi - lo).length()
 }
 
