@@ -64,8 +64,11 @@ struct Tri {
     v: [u32; 3],
     /// `nbr[k]` is the triangle across the edge `v[k] -> v[(k + 1) % 3]`.
     nbr: [u32; 3],
-    /// Float normal `(b - a) x (c - a)`, only used to pick the farthest point (a heuristic, never a decision).
+    /// Float normal `(b - a) x (c - a)`: picks the farthest point, and filters the exact test (see [`above`]).
     normal: DVec3,
+    /// Static error bound of `normal . (q - a)` over the input's bounding box: a float value beyond it has the sign
+    /// of the exact determinant.
+    filter: f64,
     outside: Vec<u32>,
     alive: bool,
 }
@@ -79,10 +82,12 @@ pub fn convex_hull(points: &[DVec3]) -> Result<ConvexHull, HullError> {
         return Err(HullError::NonFinite { index });
     }
     let simplex = initial_simplex(points)?;
+    // a slight overestimate of the largest |q - a| keeps the static filter safe
+    let diameter = crate::tolerance::bounding_diagonal(points) * (1.0 + 1e-9);
     let mut tris = Vec::with_capacity(64);
-    build_simplex(points, simplex, &mut tris);
+    build_simplex(points, simplex, &mut tris, diameter);
     assign_initial_outside(points, simplex, &mut tris);
-    expand(points, &mut tris);
+    expand(points, &mut tris, diameter);
     merge(points, &tris)
 }
 
@@ -124,16 +129,32 @@ fn argmax(n: usize, f: impl Fn(usize) -> f64) -> Option<usize> {
     best
 }
 
-fn make_tri(p: &[DVec3], v: [u32; 3]) -> Tri {
+/// Relative size of the static filter. The rounding error of `fl((b - a) x (c - a)) . fl(q - a)` is below
+/// `12 eps |b - a| |c - a| |q - a|` (eps = 2^-53, about 1.1e-16); 1e-12 leaves a margin of more than 700x.
+const FILTER: f64 = 1e-12;
+
+fn make_tri(p: &[DVec3], v: [u32; 3], diameter: f64) -> Tri {
     let (a, b, c) = (p[v[0] as usize], p[v[1] as usize], p[v[2] as usize]);
-    Tri { v, nbr: [NONE; 3], normal: (b - a).cross(c - a), outside: Vec::new(), alive: true }
+    let filter = FILTER * (b - a).length() * (c - a).length() * diameter;
+    Tri { v, nbr: [NONE; 3], normal: (b - a).cross(c - a), filter, outside: Vec::new(), alive: true }
 }
 
+/// Exactly whether `q` is strictly above the triangle's plane: a float evaluation decides when it is farther from
+/// zero than its error bound, Shewchuk's adaptive `orient3d` otherwise.
+#[inline]
 fn above(p: &[DVec3], t: &Tri, q: u32) -> bool {
-    side(p[t.v[0] as usize], p[t.v[1] as usize], p[t.v[2] as usize], p[q as usize]) == Ordering::Greater
+    let a = p[t.v[0] as usize];
+    let d = t.normal.dot(p[q as usize] - a);
+    if d > t.filter {
+        return true;
+    }
+    if d < -t.filter {
+        return false;
+    }
+    side(a, p[t.v[1] as usize], p[t.v[2] as usize], p[q as usize]) == Ordering::Greater
 }
 
-fn build_simplex(p: &[DVec3], s: [u32; 4], tris: &mut Vec<Tri>) {
+fn build_simplex(p: &[DVec3], s: [u32; 4], tris: &mut Vec<Tri>, diameter: f64) {
     let [a, b, c, d] = s;
     // orient (a, b, c) so that d is below it
     let (b, c) = if side(p[a as usize], p[b as usize], p[c as usize], p[d as usize]) == Ordering::Greater {
@@ -143,7 +164,7 @@ fn build_simplex(p: &[DVec3], s: [u32; 4], tris: &mut Vec<Tri>) {
     };
     let faces = [[a, b, c], [a, d, b], [b, d, c], [c, d, a]];
     for f in faces {
-        tris.push(make_tri(p, f));
+        tris.push(make_tri(p, f, diameter));
     }
     link_all(tris);
 }
@@ -182,13 +203,15 @@ fn assign_initial_outside(p: &[DVec3], s: [u32; 4], tris: &mut [Tri]) {
     }
 }
 
-fn expand(p: &[DVec3], tris: &mut Vec<Tri>) {
+fn expand(p: &[DVec3], tris: &mut Vec<Tri>, diameter: f64) {
     let mut stack: Vec<u32> = (0..tris.len() as u32).filter(|&t| !tris[t as usize].outside.is_empty()).collect();
     let mut visible: Vec<u32> = Vec::new();
     let mut horizon: Vec<(u32, u32, u32)> = Vec::new(); // (a, b, invisible neighbour) with a -> b in visible tri
     let mut bfs: Vec<u32> = Vec::new();
     let mut mark: Vec<u32> = vec![0; tris.len()];
     let mut epoch = 0u32;
+    // next_of[v] = position in `horizon` of the horizon edge starting at v (only valid for horizon vertices)
+    let mut next_of: Vec<u32> = vec![NONE; p.len()];
     while let Some(t0) = stack.pop() {
         let t0u = t0 as usize;
         if !tris[t0u].alive || tris[t0u].outside.is_empty() {
@@ -242,20 +265,19 @@ fn expand(p: &[DVec3], tris: &mut Vec<Tri>) {
         let hn = horizon.len();
         let mut ordered = Vec::with_capacity(hn);
         {
-            let mut next_of: std::collections::HashMap<u32, usize> = std::collections::HashMap::with_capacity(hn);
             for (i, h) in horizon.iter().enumerate() {
-                next_of.insert(h.0, i);
+                next_of[h.0 as usize] = i as u32;
             }
             let mut i = 0usize;
             for _ in 0..hn {
                 ordered.push(horizon[i]);
-                i = next_of[&horizon[i].1];
+                i = next_of[horizon[i].1 as usize] as usize;
             }
         }
         // new cone of triangles (a, b, apex)
         let first_new = tris.len() as u32;
         for (i, &(a, b, nb)) in ordered.iter().enumerate() {
-            let mut t = make_tri(p, [a, b, apex]);
+            let mut t = make_tri(p, [a, b, apex], diameter);
             let id = first_new + i as u32;
             t.nbr[0] = nb;
             t.nbr[1] = first_new + ((i + 1) % hn) as u32;
@@ -329,63 +351,68 @@ fn merge(p: &[DVec3], tris: &[Tri]) -> Result<ConvexHull, HullError> {
     }
     // group ids
     let mut group_of = vec![u32::MAX; n];
+    let mut group_of_root = vec![u32::MAX; n];
     let mut group_count = 0u32;
-    let mut root_group: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
     for i in 0..n {
         if tris[i].alive {
-            let r = find(&mut parent, i as u32);
-            let g = *root_group.entry(r).or_insert_with(|| {
+            let r = find(&mut parent, i as u32) as usize;
+            if group_of_root[r] == u32::MAX {
+                group_of_root[r] = group_count;
                 group_count += 1;
-                group_count - 1
-            });
-            group_of[i] = g;
+            }
+            group_of[i] = group_of_root[r];
         }
     }
-    // distinct groups per vertex (a vertex is extreme iff >= 3)
-    let mut vgroups: std::collections::HashMap<u32, Vec<u32>> = std::collections::HashMap::new();
+    // distinct groups per vertex, counted up to 3 (a vertex is extreme iff at least 3 faces meet there)
+    let mut vgroups: Vec<[u32; 3]> = vec![[u32::MAX; 3]; p.len()];
+    let mut vcount: Vec<u8> = vec![0; p.len()];
     for (i, t) in tris.iter().enumerate() {
         if !t.alive {
             continue;
         }
+        let g = group_of[i];
         for &v in &t.v {
-            let e = vgroups.entry(v).or_default();
-            if !e.contains(&group_of[i]) {
-                e.push(group_of[i]);
+            let (slots, count) = (&mut vgroups[v as usize], &mut vcount[v as usize]);
+            if (*count as usize) < 3 && !slots[..*count as usize].contains(&g) {
+                slots[*count as usize] = g;
+                *count += 1;
             }
         }
     }
     // boundary half-edges of each group, chained into a cycle
-    let mut boundary: Vec<std::collections::HashMap<u32, u32>> = vec![Default::default(); group_count as usize];
+    let mut boundary: Vec<Vec<(u32, u32)>> = vec![Vec::new(); group_count as usize];
     for (i, t) in tris.iter().enumerate() {
         if !t.alive {
             continue;
         }
         for k in 0..3 {
             if group_of[t.nbr[k] as usize] != group_of[i] {
-                boundary[group_of[i] as usize].insert(t.v[k], t.v[(k + 1) % 3]);
+                boundary[group_of[i] as usize].push((t.v[k], t.v[(k + 1) % 3]));
             }
         }
     }
-    let mut new_index: std::collections::HashMap<u32, usize> = std::collections::HashMap::new();
+    let mut next: Vec<u32> = vec![NONE; p.len()];
+    let mut new_index: Vec<u32> = vec![NONE; p.len()];
     let mut vertices = Vec::new();
     let mut source = Vec::new();
     let mut faces = Vec::with_capacity(group_count as usize);
     for b in &boundary {
-        let Some((&start, _)) = b.iter().min_by_key(|(k, _)| **k) else {
-            continue;
-        };
+        let Some(&(start, _)) = b.iter().min_by_key(|e| e.0) else { continue };
+        for &(a, c) in b {
+            next[a as usize] = c;
+        }
         let mut cycle = Vec::with_capacity(b.len());
         let mut v = start;
         for _ in 0..b.len() {
-            if vgroups.get(&v).map_or(0, Vec::len) >= 3 {
-                let idx = *new_index.entry(v).or_insert_with(|| {
+            if vcount[v as usize] >= 3 {
+                if new_index[v as usize] == NONE {
+                    new_index[v as usize] = vertices.len() as u32;
                     vertices.push(p[v as usize]);
                     source.push(v as usize);
-                    vertices.len() - 1
-                });
-                cycle.push(idx);
+                }
+                cycle.push(new_index[v as usize] as usize);
             }
-            v = b[&v];
+            v = next[v as usize];
         }
         faces.push(cycle);
     }

@@ -10,7 +10,6 @@ use crate::tolerance::Tolerance;
 use glam::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
 use std::cmp::Ordering;
-use std::collections::HashMap;
 
 /// An oriented plane `normal . x = offset`; the inside half-space is `normal . x <= offset`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -184,7 +183,9 @@ impl ConvexPolytope {
                 return Err(PolytopeError::NonFinite { vertex: i });
             }
         }
-        let mut half: HashMap<(usize, usize), (usize, usize)> = HashMap::new();
+        // half-edges (a, b, face, position), grouped by undirected edge by sorting: each group must be exactly one
+        // a -> b and one b -> a (closed, consistently oriented 2-manifold). O(H log H) for H half-edges, no hashing.
+        let mut half: Vec<(usize, usize, usize, usize)> = Vec::with_capacity(faces.iter().map(Vec::len).sum());
         for (f, face) in faces.iter().enumerate() {
             if face.len() < 3 {
                 return Err(PolytopeError::FaceTooSmall { face: f, count: face.len() });
@@ -194,27 +195,31 @@ impl ConvexPolytope {
                     return Err(PolytopeError::BadVertexIndex { face: f, vertex: a, len: vertices.len() });
                 }
                 let b = face[(k + 1) % face.len()];
-                if half.insert((a, b), (f, k)).is_some() || a == b {
+                if a == b {
                     return Err(PolytopeError::NotManifold { a, b });
                 }
+                half.push((a, b, f, k));
             }
         }
+        half.sort_unstable_by_key(|&(a, b, _, _)| (a.min(b), a.max(b), a > b));
         let mut edges = Vec::with_capacity(half.len() / 2);
         let mut face_edges: Vec<Vec<usize>> = faces.iter().map(|f| vec![usize::MAX; f.len()]).collect();
-        for (f, face) in faces.iter().enumerate() {
-            for (k, &a) in face.iter().enumerate() {
-                let b = face[(k + 1) % face.len()];
-                if face_edges[f][k] != usize::MAX {
-                    continue;
-                }
-                let Some(&(g, j)) = half.get(&(b, a)) else {
-                    return Err(PolytopeError::NotManifold { a, b });
-                };
-                let e = edges.len();
-                edges.push(Edge { vertices: [a, b], faces: [f, g] });
-                face_edges[f][k] = e;
-                face_edges[g][j] = e;
+        let mut i = 0;
+        while i < half.len() {
+            let (a, b, f, k) = half[i];
+            let Some(&(c, d, g, j)) = half.get(i + 1) else {
+                return Err(PolytopeError::NotManifold { a, b });
+            };
+            // the pair must be a -> b and b -> a, and no third half-edge on the same vertices
+            let third = half.get(i + 2).is_some_and(|&(x, y, _, _)| x.min(y) == a.min(b) && x.max(y) == a.max(b));
+            if c != b || d != a || third {
+                return Err(PolytopeError::NotManifold { a, b });
             }
+            let e = edges.len();
+            edges.push(Edge { vertices: [a, b], faces: [f, g] });
+            face_edges[f][k] = e;
+            face_edges[g][j] = e;
+            i += 2;
         }
         let mut out = Vec::with_capacity(faces.len());
         for (f, face) in faces.into_iter().enumerate() {
