@@ -9,17 +9,22 @@
 //! * [`mass`]: volume, centre of gravity and inertia tensor;
 //! * [`part`]: rigid parts as unions of convex components, with boundary faces.
 
+pub mod convex_merge;
+pub mod examples;
 pub mod hull;
 pub mod mass;
 pub mod part;
+pub mod polygon;
 pub mod polytope;
 pub mod predicates;
 pub mod sheet_metal;
 pub mod tolerance;
+pub mod triangulate;
 
 pub use glam::{DMat3, DVec2, DVec3};
 pub use hull::{ConvexHull, HullError, convex_hull};
 pub use mass::MassProperties;
 pub use part::{BoundaryFace, Part, PartError, PartOrigin};
 pub use polytope::{Containment, ConvexPolytope, Edge, Face, Plane, PolytopeError};
+pub use sheet_metal::{Decomposition, SheetFace, SheetMetal, SheetMetalError};
 pub use tolerance::Tolerance;

@@ -4,8 +4,15 @@
 //! `thickness / 2` to each side) into convex prisms: a convex face without holes gives one prism; a concave face or a
 //! face with holes is first decomposed into convex polygons (see [`Decomposition`]).
 
-use glam::DVec3;
+use crate::convex_merge::merge_convex;
+use crate::part::{Part, PartError, PartOrigin};
+use crate::polygon::{FacePlane, RingDefect, check_rings, drop_collinear, is_convex_ccw, ring_orientation};
+use crate::polytope::{ConvexPolytope, PolytopeError, newell_normal};
+use crate::predicates::orient2d;
+use crate::triangulate::{TriangulationError, triangulate};
+use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
+use std::cmp::Ordering;
 
 /// A zero-thickness sheet-metal model: planar faces with holes, and the sheet thickness.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -35,4 +42,366 @@ pub enum Decomposition {
     ConvexMerge,
     /// The plain triangulation of [A]: reproduces the seed's component counts (Channel 3, Triangle 6, Complex 79).
     Triangulation,
+}
+
+/// Which ring of a face an error refers to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Ring {
+    /// The outer boundary.
+    Outline,
+    /// Hole `k` (index into [`SheetFace::holes`]).
+    Hole(usize),
+}
+
+impl std::fmt::Display for Ring {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Ring::Outline => write!(f, "outline"),
+            Ring::Hole(k) => write!(f, "hole {k}"),
+        }
+    }
+}
+
+impl Ring {
+    fn from_index(r: usize) -> Self {
+        if r == 0 { Ring::Outline } else { Ring::Hole(r - 1) }
+    }
+}
+
+/// Why a sheet-metal model cannot be turned into a part. Face, ring and vertex indices refer to the input (vertex
+/// indices count the ring's points as given, before consecutive duplicates are removed).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SheetMetalError {
+    /// The thickness is not a positive finite number.
+    #[error("sheet thickness must be positive and finite, got {0}")]
+    BadThickness(f64),
+    /// There are no faces.
+    #[error("the sheet-metal model has no faces")]
+    NoFaces,
+    /// A coordinate is NaN or infinite.
+    #[error("face {face}, {ring}, vertex {vertex}: coordinate is not finite")]
+    NonFinite {
+        /// Face index.
+        face: usize,
+        /// Ring.
+        ring: Ring,
+        /// Vertex index in the ring.
+        vertex: usize,
+    },
+    /// A ring has fewer than three distinct vertices.
+    #[error("face {face}, {ring}: only {count} distinct vertices, a polygon needs at least 3")]
+    TooFewVertices {
+        /// Face index.
+        face: usize,
+        /// Ring.
+        ring: Ring,
+        /// Distinct vertices (after removing consecutive duplicates).
+        count: usize,
+    },
+    /// A ring has zero area (all its vertices are collinear, or its area cancels out).
+    #[error("face {face}, {ring}: zero area")]
+    ZeroArea {
+        /// Face index.
+        face: usize,
+        /// Ring.
+        ring: Ring,
+    },
+    /// A vertex is farther from the face's fitted plane than the planarity tolerance.
+    #[error(
+        "face {face} is not planar: {ring} vertex {vertex} is {distance:e} mm from the fitted plane (tolerance {tolerance:e} mm)"
+    )]
+    NonPlanar {
+        /// Face index.
+        face: usize,
+        /// Ring.
+        ring: Ring,
+        /// Vertex index in the ring.
+        vertex: usize,
+        /// Distance from the plane (mm).
+        distance: f64,
+        /// The planarity tolerance used (mm).
+        tolerance: f64,
+    },
+    /// A ring intersects itself (edge `k` joins vertex `k` and the next distinct vertex).
+    #[error("face {face}, {ring}: edges {edge_a} and {edge_b} intersect (the polygon is not simple)")]
+    SelfIntersecting {
+        /// Face index.
+        face: usize,
+        /// Ring.
+        ring: Ring,
+        /// First edge (index of its start vertex in the input ring).
+        edge_a: usize,
+        /// Second edge.
+        edge_b: usize,
+    },
+    /// A hole touches, crosses or lies outside the outline.
+    #[error("face {face}: hole {hole} is not strictly inside the outline")]
+    HoleNotInside {
+        /// Face index.
+        face: usize,
+        /// Hole index.
+        hole: usize,
+    },
+    /// Two holes touch, cross or nest.
+    #[error("face {face}: holes {hole_a} and {hole_b} overlap or touch")]
+    HolesOverlap {
+        /// Face index.
+        face: usize,
+        /// First hole.
+        hole_a: usize,
+        /// Second hole.
+        hole_b: usize,
+    },
+    /// Triangulation failed (an internal error: validation should have caught the cause).
+    #[error("face {face}: triangulation failed: {source}")]
+    Triangulation {
+        /// Face index.
+        face: usize,
+        /// The cause.
+        source: TriangulationError,
+    },
+    /// An extruded piece is not a valid convex polytope (a sliver below the tolerance of the kernel).
+    #[error("face {face}, piece {piece}: extruded prism is invalid: {source}")]
+    Prism {
+        /// Face index.
+        face: usize,
+        /// Piece index within the face.
+        piece: usize,
+        /// The cause.
+        source: PolytopeError,
+    },
+    /// The components do not make a part.
+    #[error(transparent)]
+    Part(#[from] PartError),
+}
+
+/// A face after validation: its plane, its points in the exact 2-D projection, and its convex pieces.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FaceDecomposition {
+    /// The fitted plane and projection.
+    pub plane: FacePlane,
+    /// All distinct vertices of the face (outline first, then holes), projected exactly to 2-D.
+    pub points: Vec<DVec2>,
+    /// The same points on the fitted plane (lifted back from 2-D).
+    pub points_on_plane: Vec<DVec3>,
+    /// The outline, counter-clockwise in 2-D, as indices into `points`.
+    pub outline: Vec<usize>,
+    /// The holes, clockwise in 2-D.
+    pub holes: Vec<Vec<usize>>,
+    /// Strictly convex counter-clockwise (2-D) polygons tiling the face, straight vertices removed.
+    pub pieces: Vec<Vec<usize>>,
+}
+
+impl FaceDecomposition {
+    /// Area of the face in its plane (outline minus holes; mm^2).
+    pub fn area(&self) -> f64 {
+        let ring_area = |ring: &[usize]| {
+            let pts: Vec<DVec3> = ring.iter().map(|&i| self.points_on_plane[i]).collect();
+            newell_normal(pts.iter().copied()).length() / 2.0
+        };
+        ring_area(&self.outline) - self.holes.iter().map(|h| ring_area(h)).sum::<f64>()
+    }
+
+    /// The 3-D polygon of piece `k` on the mid-plane, counter-clockwise about the plane normal.
+    pub fn piece_polygon(&self, k: usize) -> Vec<DVec3> {
+        let mut cycle: Vec<DVec3> = self.pieces[k].iter().map(|&i| self.points_on_plane[i]).collect();
+        if !self.plane.projection_keeps_orientation() {
+            cycle.reverse();
+        }
+        cycle
+    }
+}
+
+impl SheetMetal {
+    /// Checks the whole model (thickness and every face) without building prisms. See [`SheetMetalError`].
+    pub fn validate(&self) -> Result<(), SheetMetalError> {
+        self.check_thickness()?;
+        for (i, face) in self.faces.iter().enumerate() {
+            prepare_face(i, face)?;
+        }
+        Ok(())
+    }
+
+    fn check_thickness(&self) -> Result<(), SheetMetalError> {
+        if !(self.thickness > 0.0 && self.thickness.is_finite()) {
+            return Err(SheetMetalError::BadThickness(self.thickness));
+        }
+        if self.faces.is_empty() {
+            return Err(SheetMetalError::NoFaces);
+        }
+        Ok(())
+    }
+
+    /// Validates face `face` and splits it into convex polygons (one when it is convex without holes).
+    pub fn decompose_face(
+        &self,
+        face: usize,
+        decomposition: Decomposition,
+    ) -> Result<FaceDecomposition, SheetMetalError> {
+        let Some(f) = self.faces.get(face) else {
+            return Err(SheetMetalError::NoFaces);
+        };
+        let mut prepared = prepare_face(face, f)?;
+        let outline_pts: Vec<DVec2> = prepared.outline.iter().map(|&i| prepared.points[i]).collect();
+        let raw_pieces = if prepared.holes.is_empty() && is_convex_ccw(&outline_pts) {
+            vec![prepared.outline.clone()]
+        } else {
+            let triangles = triangulate(&prepared.points, &prepared.outline, &prepared.holes)
+                .map_err(|source| SheetMetalError::Triangulation { face, source })?;
+            match decomposition {
+                Decomposition::Triangulation => triangles.iter().map(|t| t.to_vec()).collect(),
+                Decomposition::ConvexMerge => merge_convex(&prepared.points, &triangles),
+            }
+        };
+        prepared.pieces = raw_pieces.iter().map(|p| drop_collinear(p, &prepared.points)).collect();
+        tracing::debug!(face, pieces = prepared.pieces.len(), ?decomposition, "decomposed sheet-metal face");
+        Ok(prepared)
+    }
+
+    /// The convex prisms of every face, grouped by face: each convex polygon extruded by `thickness / 2` to both
+    /// sides of the face plane. Every prism passes [`ConvexPolytope::validate`].
+    pub fn decompose(&self, decomposition: Decomposition) -> Result<Vec<Vec<ConvexPolytope>>, SheetMetalError> {
+        self.check_thickness()?;
+        (0..self.faces.len())
+            .map(|face| {
+                let d = self.decompose_face(face, decomposition)?;
+                extrude(face, &d, self.thickness)
+            })
+            .collect()
+    }
+
+    /// Builds the rigid part: validation, decomposition, extrusion, mass properties and boundary faces.
+    pub fn build_part(&self, name: &str, density: f64, decomposition: Decomposition) -> Result<Part, SheetMetalError> {
+        let components: Vec<ConvexPolytope> = self.decompose(decomposition)?.into_iter().flatten().collect();
+        let part =
+            Part::from_components(name, components, density, PartOrigin::SheetMetal { thickness: self.thickness })?;
+        tracing::debug!(name, components = part.components.len(), volume = part.mass.volume, "built sheet-metal part");
+        Ok(part)
+    }
+}
+
+/// Extrudes the pieces of one face: `q -/+ n t/2` for every point `q` on the plane, shared by all pieces (so pieces
+/// that share a cut have bit-identical side faces).
+fn extrude(face: usize, d: &FaceDecomposition, thickness: f64) -> Result<Vec<ConvexPolytope>, SheetMetalError> {
+    let half = d.plane.normal * (thickness / 2.0);
+    let below: Vec<DVec3> = d.points_on_plane.iter().map(|q| *q - half).collect();
+    let above: Vec<DVec3> = d.points_on_plane.iter().map(|q| *q + half).collect();
+    let keep = d.plane.projection_keeps_orientation();
+    d.pieces
+        .iter()
+        .enumerate()
+        .map(|(piece, cycle)| {
+            let mut cycle = cycle.clone();
+            if !keep {
+                cycle.reverse();
+            }
+            let prism = prism(&cycle, &below, &above)
+                .and_then(|p| p.validate().map(|()| p))
+                .map_err(|source| SheetMetalError::Prism { face, piece, source })?;
+            Ok(prism)
+        })
+        .collect()
+}
+
+/// The prism over a convex cycle (counter-clockwise about the extrusion direction `above - below`).
+fn prism(cycle: &[usize], below: &[DVec3], above: &[DVec3]) -> Result<ConvexPolytope, PolytopeError> {
+    let m = cycle.len();
+    let mut vertices: Vec<DVec3> = cycle.iter().map(|&i| below[i]).collect();
+    vertices.extend(cycle.iter().map(|&i| above[i]));
+    let mut faces: Vec<Vec<usize>> = Vec::with_capacity(m + 2);
+    faces.push((m..2 * m).collect());
+    faces.push((0..m).rev().collect());
+    for i in 0..m {
+        let j = (i + 1) % m;
+        faces.push(vec![i, j, m + j, m + i]);
+    }
+    ConvexPolytope::new(vertices, faces)
+}
+
+/// Validates a face and returns it projected, oriented, with no pieces yet.
+fn prepare_face(face: usize, f: &SheetFace) -> Result<FaceDecomposition, SheetMetalError> {
+    // rings as given: 0 = outline, k + 1 = hole k
+    let rings: Vec<&[DVec3]> =
+        std::iter::once(f.outline.as_slice()).chain(f.holes.iter().map(|h| h.as_slice())).collect();
+    for (r, ring) in rings.iter().enumerate() {
+        if let Some(vertex) = ring.iter().position(|p| !p.is_finite()) {
+            return Err(SheetMetalError::NonFinite { face, ring: Ring::from_index(r), vertex });
+        }
+    }
+    // consecutive duplicates removed; keep the input index of every kept vertex
+    let mut cleaned: Vec<Vec<(usize, DVec3)>> = Vec::with_capacity(rings.len());
+    for (r, ring) in rings.iter().enumerate() {
+        let mut kept: Vec<(usize, DVec3)> = Vec::with_capacity(ring.len());
+        for (i, p) in ring.iter().enumerate() {
+            if kept.last().is_none_or(|(_, q)| q != p) {
+                kept.push((i, *p));
+            }
+        }
+        while kept.len() > 1 && kept.first().map(|x| x.1) == kept.last().map(|x| x.1) {
+            kept.pop();
+        }
+        if kept.len() < 3 {
+            return Err(SheetMetalError::TooFewVertices { face, ring: Ring::from_index(r), count: kept.len() });
+        }
+        cleaned.push(kept);
+    }
+    let outline3: Vec<DVec3> = cleaned[0].iter().map(|x| x.1).collect();
+    let all3: Vec<DVec3> = cleaned.iter().flatten().map(|x| x.1).collect();
+    let plane = FacePlane::fit(&outline3, &all3).ok_or(SheetMetalError::ZeroArea { face, ring: Ring::Outline })?;
+    let tolerance = FacePlane::planarity_tolerance(&all3);
+    for (r, ring) in cleaned.iter().enumerate() {
+        for &(vertex, p) in ring {
+            let distance = plane.distance(p);
+            if !(distance.abs() <= tolerance) {
+                return Err(SheetMetalError::NonPlanar {
+                    face,
+                    ring: Ring::from_index(r),
+                    vertex,
+                    distance,
+                    tolerance,
+                });
+            }
+        }
+    }
+    let rings2: Vec<Vec<DVec2>> =
+        cleaned.iter().map(|ring| ring.iter().map(|x| plane.project(x.1)).collect()).collect();
+    for (r, ring) in rings2.iter().enumerate() {
+        let all_collinear = (2..ring.len()).all(|k| orient2d(ring[0], ring[1], ring[k]) == Ordering::Equal);
+        if all_collinear {
+            return Err(SheetMetalError::ZeroArea { face, ring: Ring::from_index(r) });
+        }
+    }
+    check_rings(&rings2).map_err(|defect| match defect {
+        RingDefect::SelfIntersection { ring, edge_a, edge_b } => SheetMetalError::SelfIntersecting {
+            face,
+            ring: Ring::from_index(ring),
+            edge_a: cleaned[ring][edge_a].0,
+            edge_b: cleaned[ring][edge_b].0,
+        },
+        RingDefect::HoleNotInside { ring } => SheetMetalError::HoleNotInside { face, hole: ring - 1 },
+        RingDefect::HolesOverlap { ring_a, ring_b } => {
+            SheetMetalError::HolesOverlap { face, hole_a: ring_a - 1, hole_b: ring_b - 1 }
+        }
+    })?;
+    // orient: outline counter-clockwise, holes clockwise (in 2-D)
+    let mut points: Vec<DVec2> = Vec::with_capacity(all3.len());
+    let mut outline = Vec::new();
+    let mut holes = Vec::new();
+    for (r, ring) in rings2.iter().enumerate() {
+        let start = points.len();
+        points.extend_from_slice(ring);
+        let mut idx: Vec<usize> = (start..points.len()).collect();
+        let want = if r == 0 { Ordering::Greater } else { Ordering::Less };
+        if ring_orientation(ring) != want {
+            idx.reverse();
+        }
+        if r == 0 {
+            outline = idx;
+        } else {
+            holes.push(idx);
+        }
+    }
+    let points_on_plane = points.iter().map(|q| plane.lift(*q)).collect();
+    Ok(FaceDecomposition { plane, points, points_on_plane, outline, holes, pieces: Vec::new() })
 }
