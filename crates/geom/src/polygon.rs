@@ -49,20 +49,18 @@ pub struct FacePlane {
 }
 
 impl FacePlane {
-    /// Fits a plane to a polygon outline (Newell normal) and a set of further points (all enter the offset).
+    /// Fits a plane to a polygon outline: Newell normal, offset = mean of `normal . p` over the outline (so a
+    /// lifted hole is reported as off the plane rather than dragging the plane away from the outline).
     ///
     /// Returns `None` when the outline has zero vector area (collinear or cancelling), or the normal is not finite.
-    pub fn fit(outline: &[DVec3], all_points: &[DVec3]) -> Option<Self> {
+    pub fn fit(outline: &[DVec3]) -> Option<Self> {
         let n = newell_normal(outline.iter().copied());
         let len = n.length();
-        if !(len > 0.0 && len.is_finite()) {
+        if !(len > 0.0 && len.is_finite()) || outline.is_empty() {
             return None;
         }
         let normal = n / len;
-        if all_points.is_empty() {
-            return None;
-        }
-        let offset = all_points.iter().map(|p| normal.dot(*p)).sum::<f64>() / all_points.len() as f64;
+        let offset = outline.iter().map(|p| normal.dot(*p)).sum::<f64>() / outline.len() as f64;
         let a = normal.abs();
         let drop_axis = if a.x >= a.y && a.x >= a.z {
             0
@@ -383,7 +381,7 @@ mod tests {
     fn fit_picks_dominant_axis_and_orientation() {
         let pts: Vec<DVec3> = square().iter().map(|p| DVec3::new(p.x, 7.0, p.y)).collect();
         // (x, z) in order (0,0),(4,0),(4,4),(0,4): counter-clockwise about -y, i.e. normal -y
-        let plane = FacePlane::fit(&pts, &pts).expect("plane");
+        let plane = FacePlane::fit(&pts).expect("plane");
         assert_eq!(plane.drop_axis, 1);
         assert!((plane.normal - DVec3::new(0.0, -1.0, 0.0)).length() < 1e-15);
         assert!((plane.offset + 7.0).abs() < 1e-15);
@@ -391,7 +389,7 @@ mod tests {
         let ccw = ring_orientation(&proj) == Ordering::Greater;
         assert_eq!(ccw, plane.projection_keeps_orientation());
         let collinear = vec![DVec3::ZERO, DVec3::X, DVec3::X * 2.0];
-        assert!(FacePlane::fit(&collinear, &collinear).is_none());
+        assert!(FacePlane::fit(&collinear).is_none());
     }
 
     #[test]

@@ -9,7 +9,8 @@ use crate::part::{Part, PartError, PartOrigin};
 use crate::polygon::{FacePlane, RingDefect, check_rings, drop_collinear, is_convex_ccw, ring_orientation};
 use crate::polytope::{ConvexPolytope, PolytopeError, newell_normal};
 use crate::predicates::orient2d;
-use crate::triangulate::{TriangulationError, triangulate};
+use crate::tolerance::Tolerance;
+use crate::triangulate::{TriangulationError, triangulate_avoiding_slivers};
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 use std::cmp::Ordering;
@@ -247,7 +248,8 @@ impl SheetMetal {
         let raw_pieces = if prepared.holes.is_empty() && is_convex_ccw(&outline_pts) {
             vec![prepared.outline.clone()]
         } else {
-            let triangles = triangulate(&prepared.points, &prepared.outline, &prepared.holes)
+            let sliver = SLIVER_FACTOR * Tolerance::for_points(&prepared.points_on_plane).linear;
+            let triangles = triangulate_avoiding_slivers(&prepared.points, &prepared.outline, &prepared.holes, sliver)
                 .map_err(|source| SheetMetalError::Triangulation { face, source })?;
             match decomposition {
                 Decomposition::Triangulation => triangles.iter().map(|t| t.to_vec()).collect(),
@@ -281,27 +283,62 @@ impl SheetMetal {
     }
 }
 
+/// Multiple of the policy tolerance below which a vertex counts as nearly straight (see [`flat_vertex`]).
+const SLIVER_FACTOR: f64 = 4.0;
+
 /// Extrudes the pieces of one face: `q -/+ n t/2` for every point `q` on the plane, shared by all pieces (so pieces
 /// that share a cut have bit-identical side faces).
+///
+/// Pieces are strictly convex in exact arithmetic, but input that is only nearly collinear (a collinear run after a
+/// rotation) leaves vertices whose turn is below the kernel's tolerance, and [`ConvexPolytope::validate`] would
+/// reject the prism as not strictly convex. Such vertices are removed (moving the piece's boundary by less than
+/// `SLIVER_FACTOR` policy tolerances), and a piece that is a needle below the tolerance is dropped (its volume is
+/// below `SLIVER_FACTOR * tolerance * length * thickness`).
 fn extrude(face: usize, d: &FaceDecomposition, thickness: f64) -> Result<Vec<ConvexPolytope>, SheetMetalError> {
     let half = d.plane.normal * (thickness / 2.0);
     let below: Vec<DVec3> = d.points_on_plane.iter().map(|q| *q - half).collect();
     let above: Vec<DVec3> = d.points_on_plane.iter().map(|q| *q + half).collect();
     let keep = d.plane.projection_keeps_orientation();
-    d.pieces
-        .iter()
-        .enumerate()
-        .map(|(piece, cycle)| {
-            let mut cycle = cycle.clone();
-            if !keep {
-                cycle.reverse();
-            }
-            let prism = prism(&cycle, &below, &above)
-                .and_then(|p| p.validate().map(|()| p))
-                .map_err(|source| SheetMetalError::Prism { face, piece, source })?;
-            Ok(prism)
-        })
-        .collect()
+    let mut prisms = Vec::with_capacity(d.pieces.len());
+    for (piece, cycle) in d.pieces.iter().enumerate() {
+        let mut cycle = cycle.clone();
+        if !keep {
+            cycle.reverse();
+        }
+        let corners: Vec<DVec3> = cycle.iter().flat_map(|&i| [below[i], above[i]]).collect();
+        let flat = SLIVER_FACTOR * Tolerance::for_points(&corners).linear;
+        while cycle.len() >= 3 {
+            let m = cycle.len();
+            let Some(k) = (0..m).find(|&k| {
+                let (u, v, w) = (cycle[(k + m - 1) % m], cycle[k], cycle[(k + 1) % m]);
+                flat_vertex(d.points_on_plane[u], d.points_on_plane[v], d.points_on_plane[w], flat)
+            }) else {
+                break;
+            };
+            cycle.remove(k);
+        }
+        if cycle.len() < 3 {
+            tracing::debug!(face, piece, "dropped a needle piece thinner than the tolerance");
+            continue;
+        }
+        let prism = prism(&cycle, &below, &above)
+            .and_then(|p| p.validate().map(|()| p))
+            .map_err(|source| SheetMetalError::Prism { face, piece, source })?;
+        prisms.push(prism);
+    }
+    Ok(prisms)
+}
+
+/// Whether the turn `u -> v -> w` is too small for a strictly convex prism under the tolerance `flat`: one
+/// neighbour lies within `flat` of the line through `v` and the other (the distances `validate` tests across the
+/// side edge at `v`).
+fn flat_vertex(u: DVec3, v: DVec3, w: DVec3, flat: f64) -> bool {
+    let distance = |p: DVec3, a: DVec3, b: DVec3| {
+        let dir = b - a;
+        let len = dir.length();
+        if len > 0.0 { (p - a).cross(dir).length() / len } else { (p - a).length() }
+    };
+    distance(w, u, v) <= flat || distance(u, v, w) <= flat
 }
 
 /// The prism over a convex cycle (counter-clockwise about the extrusion direction `above - below`).
@@ -348,12 +385,12 @@ fn prepare_face(face: usize, f: &SheetFace) -> Result<FaceDecomposition, SheetMe
     }
     let outline3: Vec<DVec3> = cleaned[0].iter().map(|x| x.1).collect();
     let all3: Vec<DVec3> = cleaned.iter().flatten().map(|x| x.1).collect();
-    let plane = FacePlane::fit(&outline3, &all3).ok_or(SheetMetalError::ZeroArea { face, ring: Ring::Outline })?;
+    let plane = FacePlane::fit(&outline3).ok_or(SheetMetalError::ZeroArea { face, ring: Ring::Outline })?;
     let tolerance = FacePlane::planarity_tolerance(&all3);
     for (r, ring) in cleaned.iter().enumerate() {
         for &(vertex, p) in ring {
             let distance = plane.distance(p);
-            if !(distance.abs() <= tolerance) {
+            if distance.abs() > tolerance || distance.is_nan() {
                 return Err(SheetMetalError::NonPlanar {
                     face,
                     ring: Ring::from_index(r),

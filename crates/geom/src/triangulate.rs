@@ -54,11 +54,23 @@ pub enum TriangulationError {
 
 /// Triangulates the polygon `outline` (counter-clockwise) with `holes` (clockwise), given as indices into
 /// `points`. Returns counter-clockwise triangles of point indices: exactly `n + 2h - 2` of them for `n` vertices in
-/// all rings and `h` holes.
+/// all rings and `h` holes. Same as [`triangulate_avoiding_slivers`] with `sliver = 0`.
 pub fn triangulate(
     points: &[DVec2],
     outline: &[usize],
     holes: &[Vec<usize>],
+) -> Result<Vec<[usize; 3]>, TriangulationError> {
+    triangulate_avoiding_slivers(points, outline, holes, 0.0)
+}
+
+/// [`triangulate`], preferring ears whose tip is farther than `sliver` from the line through its neighbours (see
+/// [`clip_ears`]): for input that is only nearly collinear (rotated collinear runs), this avoids needle triangles
+/// whenever another valid ear exists.
+pub fn triangulate_avoiding_slivers(
+    points: &[DVec2],
+    outline: &[usize],
+    holes: &[Vec<usize>],
+    sliver: f64,
 ) -> Result<Vec<[usize; 3]>, TriangulationError> {
     for (r, ring) in std::iter::once(outline).chain(holes.iter().map(|h| h.as_slice())).enumerate() {
         if ring.len() < 3 || ring.iter().any(|&i| i >= points.len()) {
@@ -66,7 +78,7 @@ pub fn triangulate(
         }
     }
     let polygon = bridge_holes(points, outline, holes)?;
-    clip_ears(points, &polygon)
+    clip_ears(points, &polygon, sliver)
 }
 
 /// Joins every hole to the outer polygon by a bridge; returns the weakly simple polygon (with repeated indices).
@@ -155,36 +167,45 @@ fn strictly_inside_angle(prev: DVec2, v: DVec2, next: DVec2, x: DVec2) -> bool {
 }
 
 /// Ear clipping of a weakly simple counter-clockwise polygon (indices may repeat where holes were bridged).
-pub fn clip_ears(points: &[DVec2], polygon: &[usize]) -> Result<Vec<[usize; 3]>, TriangulationError> {
+///
+/// `sliver` is a length: ears whose tip lies within `sliver` of the line through its neighbours (nearly straight
+/// tips, which give needle triangles) are taken only when no other ear exists. The validity of an ear is always
+/// decided exactly; `sliver` only orders the choice. Pass 0 to take the first exact ear.
+pub fn clip_ears(points: &[DVec2], polygon: &[usize], sliver: f64) -> Result<Vec<[usize; 3]>, TriangulationError> {
     let n = polygon.len();
     if n < 3 {
         return Err(TriangulationError::NoEar { remaining: n });
     }
     let mut prev: Vec<usize> = (0..n).map(|i| (i + n - 1) % n).collect();
     let mut next: Vec<usize> = (0..n).map(|i| (i + 1) % n).collect();
-    let mut alive = vec![true; n];
     let mut triangles = Vec::with_capacity(n - 2);
     let mut remaining = n;
     let mut current = 0;
-    let mut failures = 0;
+    let robust = |a: usize, b: usize, c: usize| {
+        let (pa, pb, pc) = (points[polygon[a]], points[polygon[b]], points[polygon[c]]);
+        (pb - pa).perp_dot(pc - pa) > sliver * (pc - pa).length()
+    };
     while remaining > 3 {
-        if is_ear(points, polygon, &prev, &next, &alive, current) {
-            let (a, c) = (prev[current], next[current]);
-            triangles.push([polygon[a], polygon[current], polygon[c]]);
-            next[a] = c;
-            prev[c] = a;
-            alive[current] = false;
-            remaining -= 1;
-            failures = 0;
-            // the neighbours' ear status changed: look at the previous one first
-            current = a;
-        } else {
-            failures += 1;
-            if failures > remaining {
-                return Err(TriangulationError::NoEar { remaining });
+        let scan = |want_robust: bool| {
+            let mut k = current;
+            for _ in 0..remaining {
+                if (!want_robust || robust(prev[k], k, next[k])) && is_ear(points, polygon, &prev, &next, k) {
+                    return Some(k);
+                }
+                k = next[k];
             }
-            current = next[current];
-        }
+            None
+        };
+        let Some(ear) = scan(true).or_else(|| scan(false)) else {
+            return Err(TriangulationError::NoEar { remaining });
+        };
+        let (a, c) = (prev[ear], next[ear]);
+        triangles.push([polygon[a], polygon[ear], polygon[c]]);
+        next[a] = c;
+        prev[c] = a;
+        remaining -= 1;
+        // the neighbours' ear status changed: look at the previous one first
+        current = a;
     }
     let (a, c) = (prev[current], next[current]);
     let last = [polygon[a], polygon[current], polygon[c]];
@@ -195,7 +216,7 @@ pub fn clip_ears(points: &[DVec2], polygon: &[usize]) -> Result<Vec<[usize; 3]>,
     Ok(triangles)
 }
 
-fn is_ear(points: &[DVec2], polygon: &[usize], prev: &[usize], next: &[usize], alive: &[bool], b: usize) -> bool {
+fn is_ear(points: &[DVec2], polygon: &[usize], prev: &[usize], next: &[usize], b: usize) -> bool {
     let a = prev[b];
     let c = next[b];
     let (pa, pb, pc) = (points[polygon[a]], points[polygon[b]], points[polygon[c]]);
@@ -209,7 +230,6 @@ fn is_ear(points: &[DVec2], polygon: &[usize], prev: &[usize], next: &[usize], a
     }
     let mut k = next[c];
     while k != a {
-        debug_assert!(alive[k]);
         let p = points[polygon[k]];
         if p != pa
             && p != pb
