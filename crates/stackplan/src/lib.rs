@@ -5,3 +5,4 @@
 //! focused crate, so library users can depend on `stackplan` alone or on the single crates they need.
 
 pub use stackplan_geom as geom;
+pub use stackplan_freespace as freespace;

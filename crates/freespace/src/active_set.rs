@@ -1,0 +1,589 @@
+//! Exact primal active-set solver for tiny convex problems: at most four variables, any number of inequalities.
+//!
+//! Solves the lexicographic problem
+//!
+//! ```text
+//! lex-min ( f(p), p[tie[0]], p[tie[1]], ... )   subject to   a_j . p <= b_j  (j = 1..m)
+//! f(p) = 1/2 sum_i h_i p_i^2 + g . p,  h_i >= 0
+//! ```
+//!
+//! i.e. minimise the separable convex quadratic `f` (an LP when `h = 0`) and break ties among its minimisers by the
+//! lowest coordinate in the order `tie`. This is the hot path of [A] VI-A-1/VI-A-4 (Ayyadevara et al. 2002: "use a
+//! closed-form method to compute the optimal position for each convex component") and, with `h = 0` and one more
+//! variable, the LP behind the Chebyshev centre, emptiness, redundancy and touching tests of a cell.
+//!
+//! Method (Nocedal & Wright, *Numerical Optimization*, 2nd ed., Alg. 16.3, extended to a positive *semi*-definite
+//! diagonal Hessian and a lexicographic objective): keep a feasible point `p` and a working set `W` of linearly
+//! independent tight constraints. In the null space `N` of `A_W` split off the flat subspace
+//! `F = N ∩ {d : d_i = 0 for h_i > 0}` (where `f` is linear) from its complement `C` (where `f` is strictly convex):
+//!
+//! 1. if `f` decreases along `F` (`P_F grad f != 0`) move along the ray `-P_F grad f`;
+//! 2. else take the Newton step in `C` (`M_C t = -C^T grad f`, `M_C = C^T H C` positive definite, Cholesky);
+//! 3. else (the point minimises `f` on the affine subspace) follow the tie-break: the first `e_tie[k]` with a
+//!    non-zero projection on `F` gives the ray `-P_F e_tie[k]` (on `F`, `f` is constant);
+//! 4. each move stops at the first blocking constraint (ratio test), which joins `W`; an unblocked ray means the
+//!    problem is unbounded (reported, never looped on);
+//! 5. at a stationary point, compute lexicographic multipliers (`f` stage, then each tie stage: the perturbation
+//!    `f + e1 p[tie0] + e2 p[tie1] + ...` with `e1 >> e2 >> ... > 0` infinitesimal gives the multiplier
+//!    `lambda_0 + e1 mu_1 + ...`, compared lexicographically with 0). If one is lexicographically negative, drop that
+//!    constraint; otherwise `p` is optimal.
+//!
+//! Anti-cycling: after `4 m + 20` iterations both choices switch to Bland's rule (lowest index); a hard iteration
+//! limit returns an error instead of looping. Cost per iteration O(m) (the ratio test) plus O(1) linear algebra on
+//! at most 4x4 matrices; in three variables the number of iterations is usually at most 4-8.
+
+/// Largest number of variables.
+pub(crate) const MAX_N: usize = 4;
+
+/// A vector in up to four variables; unused components are zero.
+pub(crate) type V4 = [f64; MAX_N];
+
+/// Relative size below which a vector is linearly dependent on a working set (Gram-Schmidt residual).
+const RANK_TOL: f64 = 1e-12;
+/// A constraint blocks a move only if its normal has at least this component along the unit move direction.
+/// Larger than [`RANK_TOL`], so a blocking constraint is always independent of the working set.
+const BLOCK_TOL: f64 = 1e-11;
+/// A direction of the null space whose curved components are below this is flat (curvature below 1e-16 relative).
+const FLAT_TOL: f64 = 1e-8;
+/// A tie-break direction is followed only if its projection on the flat subspace exceeds this.
+const TIE_TOL: f64 = 1e-9;
+/// Relative tolerance of multipliers.
+const MULT_TOL: f64 = 1e-10;
+
+#[inline]
+pub(crate) fn dot4(a: &V4, b: &V4) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]
+}
+
+#[inline]
+fn norm4(a: &V4) -> f64 {
+    dot4(a, a).sqrt()
+}
+
+#[inline]
+fn unit(i: usize) -> V4 {
+    let mut e = [0.0; MAX_N];
+    e[i] = 1.0;
+    e
+}
+
+#[inline]
+fn axpy(y: &mut V4, alpha: f64, x: &V4) {
+    for i in 0..MAX_N {
+        y[i] += alpha * x[i];
+    }
+}
+
+/// An orthonormal set of at most four vectors.
+#[derive(Debug, Clone, Copy)]
+struct Basis {
+    v: [V4; MAX_N],
+    len: usize,
+}
+
+impl Basis {
+    fn new() -> Self {
+        Self { v: [[0.0; MAX_N]; MAX_N], len: 0 }
+    }
+
+    fn vectors(&self) -> &[V4] {
+        &self.v[..self.len]
+    }
+
+    /// The part of `x` orthogonal to the basis (two Gram-Schmidt passes).
+    fn residual(&self, x: &V4) -> V4 {
+        let mut w = *x;
+        for _ in 0..2 {
+            for q in self.vectors() {
+                let c = dot4(&w, q);
+                axpy(&mut w, -c, q);
+            }
+        }
+        w
+    }
+
+    /// Adds the normalised residual of `x` if it is at least `rel_tol |x|`; returns whether it was added.
+    fn try_add(&mut self, x: &V4, rel_tol: f64) -> bool {
+        let n0 = norm4(x);
+        if n0.is_nan() || n0 <= 0.0 || self.len == MAX_N {
+            return false;
+        }
+        let w = self.residual(x);
+        let nw = norm4(&w);
+        if nw > rel_tol * n0 {
+            self.v[self.len] = w.map(|c| c / nw);
+            self.len += 1;
+            true
+        } else {
+            false
+        }
+    }
+
+    /// An orthonormal basis of the orthogonal complement of `self` in `R^n` (greedy: most independent unit vector).
+    fn complement(&self, n: usize) -> Basis {
+        let mut all = *self;
+        let mut out = Basis::new();
+        while all.len < n {
+            let mut best = (-1.0, [0.0; MAX_N]);
+            for i in 0..n {
+                let w = all.residual(&unit(i));
+                let r = norm4(&w);
+                if r > best.0 {
+                    best = (r, w);
+                }
+            }
+            // the residual of the best unit vector is at least sqrt((n - len) / n) > 0.5
+            let w = best.1.map(|c| c / best.0);
+            all.v[all.len] = w;
+            all.len += 1;
+            out.v[out.len] = w;
+            out.len += 1;
+        }
+        out
+    }
+}
+
+/// Cholesky factorisation of a symmetric positive (semi)definite matrix of order `k <= 4`, in place (lower).
+/// Pivots that rounding made non-positive are floored at a tiny positive value (the step then becomes long and the
+/// ratio test cuts it).
+fn cholesky(a: &mut [[f64; MAX_N]; MAX_N], k: usize) {
+    for j in 0..k {
+        let mut d = a[j][j];
+        for l in 0..j {
+            d -= a[j][l] * a[j][l];
+        }
+        let d = if d > 1e-280 { d.sqrt() } else { 1e-140 };
+        a[j][j] = d;
+        for i in j + 1..k {
+            let mut s = a[i][j];
+            for l in 0..j {
+                s -= a[i][l] * a[j][l];
+            }
+            a[i][j] = s / d;
+        }
+    }
+}
+
+/// Solves `L L^T x = b` for the factor of [`cholesky`].
+fn cholesky_solve(l: &[[f64; MAX_N]; MAX_N], k: usize, b: &V4) -> V4 {
+    let mut y = [0.0; MAX_N];
+    for i in 0..k {
+        let mut s = b[i];
+        for j in 0..i {
+            s -= l[i][j] * y[j];
+        }
+        y[i] = s / l[i][i];
+    }
+    let mut x = [0.0; MAX_N];
+    for i in (0..k).rev() {
+        let mut s = y[i];
+        for j in i + 1..k {
+            s -= l[j][i] * x[j];
+        }
+        x[i] = s / l[i][i];
+    }
+    x
+}
+
+/// The working set: indices of constraints, in the order they joined.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct WorkSet {
+    idx: [usize; MAX_N],
+    len: usize,
+}
+
+impl WorkSet {
+    pub(crate) fn as_slice(&self) -> &[usize] {
+        &self.idx[..self.len]
+    }
+    fn contains(&self, j: usize) -> bool {
+        self.as_slice().contains(&j)
+    }
+    fn push(&mut self, j: usize) {
+        if self.len < MAX_N {
+            self.idx[self.len] = j;
+            self.len += 1;
+        }
+    }
+    fn remove_at(&mut self, k: usize) {
+        for i in k..self.len - 1 {
+            self.idx[i] = self.idx[i + 1];
+        }
+        self.len -= 1;
+    }
+}
+
+/// A problem instance. Rows are constraint normals in the first `n` components (the rest zero).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Problem<'a> {
+    /// Number of variables (1..=4).
+    pub n: usize,
+    /// Constraint normals.
+    pub rows: &'a [V4],
+    /// Constraint offsets: `rows[j] . p <= offsets[j]`.
+    pub offsets: &'a [f64],
+    /// Constraints with `mask[j] == false` are ignored.
+    pub mask: Option<&'a [bool]>,
+    /// Diagonal of the Hessian (>= 0).
+    pub h: V4,
+    /// Linear term.
+    pub g: V4,
+    /// Tie-break order of the coordinates (first `n` entries used).
+    pub tie: [usize; MAX_N],
+    /// Characteristic length of the problem (>= 1): thresholds of step lengths are relative to it.
+    pub length_scale: f64,
+}
+
+/// How a solve ended.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Outcome {
+    /// The lexicographic optimum with its working set and the `f`-stage multipliers (in working-set order).
+    Optimal { point: V4, working: WorkSet, multipliers: V4 },
+    /// A ray along which the objective (stage 0) or a tie-break coordinate (stage k >= 1) decreases without bound.
+    Unbounded { point: V4, stage: usize },
+}
+
+/// The solver gave up.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum ActiveSetError {
+    /// The iteration limit was reached (cycling or a numerical breakdown).
+    #[error("active-set iteration limit {limit} reached")]
+    IterationLimit {
+        /// The limit.
+        limit: usize,
+    },
+}
+
+/// The null space of the working set, split into flat and curved parts.
+struct Subspace {
+    flat: Basis,
+    curved: Basis,
+    /// Cholesky factor of `M_C = C^T H C`.
+    chol: [[f64; MAX_N]; MAX_N],
+}
+
+impl Subspace {
+    fn new(prob: &Problem<'_>, w: &WorkSet) -> Self {
+        let n = prob.n;
+        let mut rows = Basis::new();
+        for &j in w.as_slice() {
+            rows.try_add(&prob.rows[j], RANK_TOL);
+        }
+        let null = rows.complement(n);
+        let r = null.len;
+        // rows of the null-space basis matrix restricted to the curved coordinates, in t-space
+        let mut curved_t = Basis::new();
+        for i in 0..n {
+            if prob.h[i] > 0.0 {
+                let mut b = [0.0; MAX_N];
+                for (k, v) in null.vectors().iter().enumerate() {
+                    b[k] = v[i];
+                }
+                if norm4(&b) > FLAT_TOL {
+                    curved_t.try_add(&b, FLAT_TOL);
+                }
+            }
+        }
+        let flat_t = curved_t.complement(r);
+        let lift = |t: &V4| {
+            let mut x = [0.0; MAX_N];
+            for (k, v) in null.vectors().iter().enumerate() {
+                axpy(&mut x, t[k], v);
+            }
+            x
+        };
+        let mut flat = Basis::new();
+        for t in flat_t.vectors() {
+            flat.v[flat.len] = lift(t);
+            flat.len += 1;
+        }
+        let mut curved = Basis::new();
+        for t in curved_t.vectors() {
+            curved.v[curved.len] = lift(t);
+            curved.len += 1;
+        }
+        let mut chol = [[0.0; MAX_N]; MAX_N];
+        for a in 0..curved.len {
+            for b in 0..=a {
+                let mut s = 0.0;
+                for i in 0..n {
+                    s += prob.h[i] * curved.v[a][i] * curved.v[b][i];
+                }
+                chol[a][b] = s;
+            }
+        }
+        cholesky(&mut chol, curved.len);
+        Self { flat, curved, chol }
+    }
+
+    /// `-P_F x`: minus the projection on the flat subspace.
+    fn flat_descent(&self, x: &V4) -> V4 {
+        let mut d = [0.0; MAX_N];
+        for f in self.flat.vectors() {
+            axpy(&mut d, -dot4(x, f), f);
+        }
+        d
+    }
+
+    /// The Newton step `-C M_C^{-1} C^T x` of a gradient `x`.
+    fn newton(&self, x: &V4) -> V4 {
+        let k = self.curved.len;
+        let mut rhs = [0.0; MAX_N];
+        for (a, c) in self.curved.vectors().iter().enumerate() {
+            rhs[a] = -dot4(x, c);
+        }
+        let t = cholesky_solve(&self.chol, k, &rhs);
+        let mut s = [0.0; MAX_N];
+        for (a, c) in self.curved.vectors().iter().enumerate() {
+            axpy(&mut s, t[a], c);
+        }
+        s
+    }
+}
+
+enum Step {
+    Move { dir: V4, bounded: bool, stage: usize },
+    Stationary,
+}
+
+impl Problem<'_> {
+    #[inline]
+    fn enabled(&self, j: usize) -> bool {
+        self.mask.is_none_or(|m| m[j])
+    }
+
+    fn gradient(&self, p: &V4) -> V4 {
+        let mut gr = [0.0; MAX_N];
+        for i in 0..self.n {
+            gr[i] = self.h[i] * p[i] + self.g[i];
+        }
+        gr
+    }
+
+    /// Typical size of the gradient over the problem's region (for relative thresholds).
+    fn gradient_scale(&self) -> f64 {
+        let mut s: f64 = 0.0;
+        for i in 0..self.n {
+            s = s.max(self.h[i] * self.length_scale + self.g[i].abs());
+        }
+        s.max(f64::MIN_POSITIVE)
+    }
+
+    fn step(&self, sub: &Subspace, p: &V4) -> Step {
+        let grad = self.gradient(p);
+        let ray = sub.flat_descent(&grad);
+        if norm4(&ray) > 1e-10 * self.gradient_scale() {
+            return Step::Move { dir: ray, bounded: false, stage: 0 };
+        }
+        let s = sub.newton(&grad);
+        if norm4(&s) > 1e-12 * self.length_scale {
+            return Step::Move { dir: s, bounded: true, stage: 0 };
+        }
+        for k in 0..self.n {
+            let ray = sub.flat_descent(&unit(self.tie[k]));
+            if norm4(&ray) > TIE_TOL {
+                return Step::Move { dir: ray, bounded: false, stage: k + 1 };
+            }
+        }
+        Step::Stationary
+    }
+
+    /// Lexicographic multipliers of the working set: `mult[stage][k]` for the k-th working constraint.
+    /// Returns the index (into the working set) of the constraint to drop, if any, and the stage-0 multipliers.
+    fn drop_choice(&self, sub: &Subspace, w: &WorkSet, p: &V4, bland: bool) -> (Option<usize>, V4) {
+        let k = w.len;
+        let mut lambda0 = [0.0; MAX_N];
+        if k == 0 {
+            return (None, lambda0);
+        }
+        let mut gram = [[0.0; MAX_N]; MAX_N];
+        for a in 0..k {
+            for b in 0..=a {
+                gram[a][b] = dot4(&self.rows[w.idx[a]], &self.rows[w.idx[b]]);
+            }
+        }
+        cholesky(&mut gram, k);
+        let mut undecided = [true; MAX_N];
+        for stage in 0..=self.n {
+            let gvec = if stage == 0 { self.gradient(p) } else { unit(self.tie[stage - 1]) };
+            let sc = sub.newton(&gvec);
+            let mut r = gvec;
+            for i in 0..self.n {
+                r[i] += self.h[i] * sc[i];
+            }
+            let mut rhs = [0.0; MAX_N];
+            for a in 0..k {
+                rhs[a] = -dot4(&self.rows[w.idx[a]], &r);
+            }
+            let mu = cholesky_solve(&gram, k, &rhs);
+            if stage == 0 {
+                lambda0 = mu;
+            }
+            let tol = MULT_TOL * if stage == 0 { self.gradient_scale() } else { 1.0 };
+            let mut choice: Option<usize> = None;
+            for a in 0..k {
+                if undecided[a] && mu[a] < -tol {
+                    choice = match choice {
+                        None => Some(a),
+                        Some(c) => {
+                            let better = if bland { w.idx[a] < w.idx[c] } else { mu[a] < mu[c] };
+                            Some(if better { a } else { c })
+                        }
+                    };
+                }
+            }
+            if choice.is_some() {
+                return (choice, lambda0);
+            }
+            let mut any = false;
+            for a in 0..k {
+                if undecided[a] && mu[a].abs() > tol {
+                    undecided[a] = false;
+                }
+                any |= undecided[a];
+            }
+            if !any {
+                break;
+            }
+        }
+        (None, lambda0)
+    }
+
+    /// Runs the active-set method from `start` (feasible, or infeasible only by rounding).
+    pub(crate) fn solve(&self, start: V4) -> Result<Outcome, ActiveSetError> {
+        let m = self.rows.len();
+        let bland_after = 4 * m + 20;
+        let limit = 40 * (m + 5);
+        let mut p = start;
+        let mut w = WorkSet::default();
+        for iter in 0..limit {
+            let sub = Subspace::new(self, &w);
+            match self.step(&sub, &p) {
+                Step::Move { dir, bounded, stage } => {
+                    let len = norm4(&dir);
+                    let mut alpha = if bounded { 1.0 } else { f64::INFINITY };
+                    let mut blocking = None;
+                    for j in 0..m {
+                        if !self.enabled(j) || w.contains(j) {
+                            continue;
+                        }
+                        let a = &self.rows[j];
+                        let ad = dot4(a, &dir);
+                        if ad > BLOCK_TOL * len {
+                            let slack = (self.offsets[j] - dot4(a, &p)).max(0.0);
+                            let t = slack / ad;
+                            if t < alpha {
+                                alpha = t;
+                                blocking = Some(j);
+                            }
+                        }
+                    }
+                    match blocking {
+                        None if !bounded => return Ok(Outcome::Unbounded { point: p, stage }),
+                        _ => {}
+                    }
+                    axpy(&mut p, alpha, &dir);
+                    if let Some(j) = blocking {
+                        w.push(j);
+                    }
+                }
+                Step::Stationary => {
+                    let (drop, multipliers) = self.drop_choice(&sub, &w, &p, iter >= bland_after);
+                    match drop {
+                        Some(k) => w.remove_at(k),
+                        None => return Ok(Outcome::Optimal { point: p, working: w, multipliers }),
+                    }
+                }
+            }
+        }
+        Err(ActiveSetError::IterationLimit { limit })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rows3(v: &[[f64; 3]]) -> Vec<V4> {
+        v.iter().map(|r| [r[0], r[1], r[2], 0.0]).collect()
+    }
+
+    fn unit_box() -> (Vec<V4>, Vec<f64>) {
+        let rows = rows3(&[[1., 0., 0.], [-1., 0., 0.], [0., 1., 0.], [0., -1., 0.], [0., 0., 1.], [0., 0., -1.]]);
+        (rows, vec![1.0, 0.0, 1.0, 0.0, 1.0, 0.0])
+    }
+
+    fn problem<'a>(rows: &'a [V4], b: &'a [f64], h: V4, g: V4) -> Problem<'a> {
+        Problem { n: 3, rows, offsets: b, mask: None, h, g, tie: [2, 1, 0, 3], length_scale: 1.0 }
+    }
+
+    fn optimal(o: Outcome) -> (V4, Vec<usize>) {
+        match o {
+            Outcome::Optimal { point, working, .. } => {
+                let mut w = working.as_slice().to_vec();
+                w.sort_unstable();
+                (point, w)
+            }
+            Outcome::Unbounded { .. } => panic!("unexpectedly unbounded"),
+        }
+    }
+
+    #[test]
+    fn projection_onto_a_box_corner() {
+        let (rows, b) = unit_box();
+        // f = |p - (2, 2, -1)|^2 / 2 * 2
+        let prob = problem(&rows, &b, [2.0, 2.0, 2.0, 0.0], [-4.0, -4.0, 2.0, 0.0]);
+        let (p, w) = optimal(prob.solve([0.5, 0.5, 0.5, 0.0]).expect("solve"));
+        assert!((p[0] - 1.0).abs() < 1e-14 && (p[1] - 1.0).abs() < 1e-14 && p[2].abs() < 1e-14);
+        assert_eq!(w, vec![0, 2, 5]);
+    }
+
+    #[test]
+    fn interior_optimum_has_empty_working_set() {
+        let (rows, b) = unit_box();
+        let prob = problem(&rows, &b, [1.0, 1.0, 1.0, 0.0], [-0.3, -0.4, -0.5, 0.0]);
+        let (p, w) = optimal(prob.solve([0.9, 0.1, 0.2, 0.0]).expect("solve"));
+        assert!((p[0] - 0.3).abs() < 1e-14 && (p[1] - 0.4).abs() < 1e-14 && (p[2] - 0.5).abs() < 1e-14);
+        assert!(w.is_empty());
+    }
+
+    #[test]
+    fn singular_hessian_takes_lowest_z_then_y_then_x() {
+        let (rows, b) = unit_box();
+        // only x is curved, optimum x = 0.25; y and z free: tie-break lowest z (0) then lowest y (0)
+        let prob = problem(&rows, &b, [1.0, 0.0, 0.0, 0.0], [-0.25, 0.0, 0.0, 0.0]);
+        let (p, w) = optimal(prob.solve([0.5, 0.5, 0.5, 0.0]).expect("solve"));
+        assert!((p[0] - 0.25).abs() < 1e-14 && p[1].abs() < 1e-14 && p[2].abs() < 1e-14, "{p:?}");
+        assert_eq!(w, vec![3, 5]);
+        // zero objective: the lowest z, then y, then x of the box
+        let prob = problem(&rows, &b, [0.0; 4], [0.0; 4]);
+        let (p, _) = optimal(prob.solve([0.5, 0.5, 0.5, 0.0]).expect("solve"));
+        assert!(p[0].abs() < 1e-14 && p[1].abs() < 1e-14 && p[2].abs() < 1e-14, "{p:?}");
+    }
+
+    #[test]
+    fn lp_and_unbounded_ray() {
+        let rows = rows3(&[[0., 0., -1.]]);
+        let b = [0.0];
+        // minimise z over z >= 0: z = 0 and then the tie-break on y runs away
+        let prob = problem(&rows, &b, [0.0; 4], [0.0, 0.0, 1.0, 0.0]);
+        match prob.solve([0.0, 0.0, 3.0, 0.0]).expect("solve") {
+            Outcome::Unbounded { point, stage, .. } => {
+                assert_eq!(stage, 2);
+                assert!(point[2].abs() < 1e-14);
+            }
+            Outcome::Optimal { .. } => panic!("must be unbounded"),
+        }
+    }
+
+    #[test]
+    fn flat_cell_two_opposite_constraints() {
+        let (mut rows, mut b) = unit_box();
+        rows.extend(rows3(&[[1.0, 1.0, 0.0], [-1.0, -1.0, 0.0]]));
+        b.extend([1.0, -1.0]);
+        let prob = problem(&rows, &b, [2.0, 2.0, 2.0, 0.0], [0.0; 4]);
+        let (p, w) = optimal(prob.solve([0.5, 0.5, 0.5, 0.0]).expect("solve"));
+        assert!((p[0] - 0.5).abs() < 1e-12 && (p[1] - 0.5).abs() < 1e-12 && p[2].abs() < 1e-14, "{p:?}");
+        assert!(w.contains(&6) ^ w.contains(&7));
+    }
+}

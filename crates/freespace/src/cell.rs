@@ -1,0 +1,506 @@
+//! Convex free-space cells: H-polytopes `{p : a_j . p <= b_j}` in 2 or 3 variables with provenance tags.
+//!
+//! [A] VI-A-1 (Ayyadevara et al. 2002, section 6.1.1): "each convex component of free space is represented as a set
+//! of linear inequalities that describe the bounding faces of the component". A [`Cell`] stores its inequalities with
+//! unit normals, a [`Tag`] per inequality (so the planner can map an active constraint back to an obstacle face or a
+//! side of the floor volume), the problem's [`Tolerance`], and its [`CellShape`], computed once at construction from
+//! the Chebyshev LP
+//!
+//! ```text
+//! max r   s.t.   a_j . c + r <= b_j  (|a_j| = 1),   r <= cap
+//! ```
+//!
+//! (ties broken by the lowest centre z, then y, then x, so the centre is deterministic). `r* < -tol`: empty;
+//! `|r*| <= tol`: flat (a face, an edge or a point, within the tolerance); `r* > tol`: solid with centre `c*` and
+//! inradius `r*`. The LP is solved by the exact active-set method of [`crate::active_set`] (one extra variable):
+//! O(m) per iteration, a handful of iterations.
+//!
+//! **Boundedness.** Every non-empty cell is bounded: [`Cell::new`] checks it (2D LPs `max +-p_i`) and returns
+//! [`CellError::Unbounded`] otherwise. Cells derived from a bounded cell (Omega, subtraction pieces, intersections)
+//! are subsets of it and skip the check. So the QP on a cell always has a minimiser and every tie-break terminates.
+//!
+//! Redundancy removal costs one LP per inequality (O(m) iterations of O(m) each); membership is O(m).
+
+use crate::active_set::{ActiveSetError, MAX_N, Outcome, Problem, V4, dot4};
+use geom::{Containment, Tolerance};
+use serde::{Deserialize, Serialize};
+use stackplan_geom as geom;
+
+/// Where an inequality of a cell comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Tag {
+    /// Side `side` (from vertex `side` to `side + 1`) of the floor polygon: the part touches that wall.
+    FloorSide {
+        /// Index of the polygon edge.
+        side: u32,
+    },
+    /// The floor `z >= 0`: the part rests on the floor.
+    Floor,
+    /// The maximum stack height `z <= H`.
+    Ceiling,
+    /// The position is outside a c-space obstacle across its face `face` (`n . p >= d`): when active, the part
+    /// touches the obstacle with the contact that face describes.
+    ObstacleFace {
+        /// Caller's identifier of the obstacle.
+        obstacle: u64,
+        /// Face index within the obstacle.
+        face: u32,
+    },
+    /// A cut made by the decomposition of a subtraction (`n . p <= d` of an obstacle face, extended): not a
+    /// contact by itself.
+    ObstacleCut {
+        /// Caller's identifier of the obstacle.
+        obstacle: u64,
+        /// Face index within the obstacle.
+        face: u32,
+    },
+    /// Anything else, labelled by the caller.
+    User(u64),
+}
+
+/// One inequality `normal . p <= offset`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Halfspace<const D: usize> {
+    /// Outward normal (unit length once inside a cell).
+    pub normal: [f64; D],
+    /// Offset.
+    pub offset: f64,
+    /// Provenance.
+    pub tag: Tag,
+}
+
+impl<const D: usize> Halfspace<D> {
+    /// A half-space `normal . p <= offset`.
+    pub fn new(normal: [f64; D], offset: f64, tag: Tag) -> Self {
+        Self { normal, offset, tag }
+    }
+
+    /// Signed distance-like slack `normal . p - offset` (a distance when the normal is unit).
+    #[inline]
+    pub fn excess(&self, p: &[f64; D]) -> f64 {
+        let mut s = -self.offset;
+        for i in 0..D {
+            s += self.normal[i] * p[i];
+        }
+        s
+    }
+
+    /// The complementary closed half-space `normal . p >= offset`, i.e. `-normal . p <= -offset`.
+    pub fn flipped(&self, tag: Tag) -> Self {
+        Self { normal: self.normal.map(|c| -c), offset: -self.offset, tag }
+    }
+}
+
+/// The shape of a cell, from its Chebyshev LP.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum CellShape<const D: usize> {
+    /// No point satisfies all inequalities (by more than the tolerance).
+    Empty,
+    /// Lower-dimensional within the tolerance (a face, an edge or a point); `point` is in the cell within tolerance.
+    Flat {
+        /// A point of the cell.
+        point: [f64; D],
+    },
+    /// Full-dimensional: the centre and radius of the largest inscribed ball.
+    Solid {
+        /// Chebyshev centre.
+        centre: [f64; D],
+        /// Inradius (> tolerance).
+        radius: f64,
+    },
+}
+
+/// Why a cell cannot be built or analysed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CellError {
+    /// An inequality has a NaN or infinite coefficient.
+    #[error("inequality {index} has a non-finite coefficient")]
+    NonFinite {
+        /// Index of the inequality.
+        index: usize,
+    },
+    /// The cell is non-empty and unbounded (cells must be bounded, e.g. by Omega).
+    #[error("the cell is unbounded; intersect it with Omega (or another bounded cell) first")]
+    Unbounded,
+    /// The LP solver gave up.
+    #[error("LP for {purpose} failed: {source}")]
+    Solver {
+        /// What the LP was for.
+        purpose: &'static str,
+        /// The solver's error.
+        source: ActiveSetError,
+    },
+}
+
+/// A convex cell in `D` (2 or 3) variables. See the module documentation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cell<const D: usize> {
+    halfspaces: Vec<Halfspace<D>>,
+    rows: Vec<V4>,
+    offsets: Vec<f64>,
+    tolerance: Tolerance,
+    shape: CellShape<D>,
+}
+
+/// The default tie-break order: lowest z, then y, then x (D = 3); lowest y then x (D = 2).
+pub(crate) fn default_tie(d: usize) -> [usize; MAX_N] {
+    if d == 3 { [2, 1, 0, 3] } else { [1, 0, 2, 3] }
+}
+
+/// Result of a linear programme over a cell.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum LpResult<const D: usize> {
+    /// Lexicographic optimum (objective, then lowest z, y, x).
+    Optimal { point: [f64; D], value: f64 },
+    /// The objective is unbounded below.
+    Unbounded,
+}
+
+impl<const D: usize> Cell<D> {
+    const DIM_OK: () = assert!(D == 2 || D == 3, "cells have 2 or 3 variables");
+
+    /// A cell from inequalities under the tolerance policy `tolerance`; checks finiteness and boundedness.
+    ///
+    /// Normals are scaled to unit length (with their offsets). An inequality with a zero normal is dropped when it
+    /// holds (`0 <= offset + tol`) and makes the cell empty when it does not.
+    pub fn new(halfspaces: Vec<Halfspace<D>>, tolerance: Tolerance) -> Result<Self, CellError> {
+        Self::build(halfspaces, tolerance, true)
+    }
+
+    /// Builds without the boundedness check: only for subsets of a bounded cell.
+    pub(crate) fn build(
+        halfspaces: Vec<Halfspace<D>>,
+        tolerance: Tolerance,
+        check_bounded: bool,
+    ) -> Result<Self, CellError> {
+        let () = Self::DIM_OK;
+        let mut kept = Vec::with_capacity(halfspaces.len());
+        let mut trivially_empty = false;
+        for (index, h) in halfspaces.into_iter().enumerate() {
+            if !h.offset.is_finite() || h.normal.iter().any(|c| !c.is_finite()) {
+                return Err(CellError::NonFinite { index });
+            }
+            let len = h.normal.iter().map(|c| c * c).sum::<f64>().sqrt();
+            if len > 0.0 {
+                kept.push(Halfspace { normal: h.normal.map(|c| c / len), offset: h.offset / len, tag: h.tag });
+            } else if h.offset < -tolerance.linear {
+                trivially_empty = true;
+                kept.push(h);
+            }
+        }
+        let rows: Vec<V4> = kept.iter().map(|h| to_v4(&h.normal)).collect();
+        let offsets: Vec<f64> = kept.iter().map(|h| h.offset).collect();
+        let mut cell = Self { halfspaces: kept, rows, offsets, tolerance, shape: CellShape::Empty };
+        if !trivially_empty {
+            cell.shape = cell.chebyshev()?;
+            if check_bounded && cell.shape != CellShape::Empty {
+                cell.check_bounded()?;
+            }
+        }
+        Ok(cell)
+    }
+
+    /// The inequalities (unit normals), in order; active-constraint indices refer to this list.
+    pub fn halfspaces(&self) -> &[Halfspace<D>] {
+        &self.halfspaces
+    }
+
+    /// Number of inequalities.
+    pub fn len(&self) -> usize {
+        self.halfspaces.len()
+    }
+
+    /// Whether the cell has no inequalities (never true for a bounded cell).
+    pub fn is_empty_list(&self) -> bool {
+        self.halfspaces.is_empty()
+    }
+
+    /// The tolerance policy of the cell.
+    pub fn tolerance(&self) -> Tolerance {
+        self.tolerance
+    }
+
+    /// Empty, flat or solid.
+    pub fn shape(&self) -> CellShape<D> {
+        self.shape
+    }
+
+    /// Whether no point satisfies the inequalities.
+    pub fn is_empty(&self) -> bool {
+        self.shape == CellShape::Empty
+    }
+
+    /// Whether the cell is full-dimensional (inradius above the tolerance).
+    pub fn is_solid(&self) -> bool {
+        matches!(self.shape, CellShape::Solid { .. })
+    }
+
+    /// Chebyshev centre and inradius (`None` for empty and flat cells).
+    pub fn chebyshev_centre(&self) -> Option<([f64; D], f64)> {
+        match self.shape {
+            CellShape::Solid { centre, radius } => Some((centre, radius)),
+            _ => None,
+        }
+    }
+
+    /// A point of the cell (the Chebyshev centre of a solid cell), `None` when empty.
+    pub fn interior_point(&self) -> Option<[f64; D]> {
+        match self.shape {
+            CellShape::Empty => None,
+            CellShape::Flat { point } => Some(point),
+            CellShape::Solid { centre, .. } => Some(centre),
+        }
+    }
+
+    /// Where `p` is, under the cell's tolerance: interior (every slack > tol), boundary, or exterior.
+    pub fn contains(&self, p: &[f64; D]) -> Containment {
+        let mut worst = f64::NEG_INFINITY;
+        for h in &self.halfspaces {
+            worst = worst.max(h.excess(p));
+        }
+        if worst > self.tolerance.linear {
+            Containment::Exterior
+        } else if worst < -self.tolerance.linear {
+            Containment::Interior
+        } else {
+            Containment::Boundary
+        }
+    }
+
+    /// A cell with `extra` inequalities added (a subset of this one, so no boundedness check).
+    pub fn with_halfspaces(&self, extra: impl IntoIterator<Item = Halfspace<D>>) -> Result<Self, CellError> {
+        let mut hs = self.halfspaces.clone();
+        hs.extend(extra);
+        Self::build(hs, self.tolerance, false)
+    }
+
+    /// The intersection of two cells (inequalities of `self`, then of `other`); tolerance of `self`.
+    pub fn intersection(&self, other: &Self) -> Result<Self, CellError> {
+        self.with_halfspaces(other.halfspaces.iter().copied())
+    }
+
+    /// The same set without redundant inequalities.
+    ///
+    /// Inequality `j` is redundant when `max a_j . p` over the cell without `j` is at most `b_j + tol`; inequalities
+    /// are tested in order and removed at once, so of two identical inequalities the later one is kept. One LP per
+    /// inequality. An empty cell is returned unchanged.
+    pub fn without_redundant(&self) -> Result<Self, CellError> {
+        if self.is_empty() {
+            return Ok(self.clone());
+        }
+        let m = self.halfspaces.len();
+        let mut mask = vec![true; m];
+        for j in 0..m {
+            mask[j] = false;
+            let objective = self.halfspaces[j].normal.map(|c| -c);
+            let redundant = match self.lp_masked(&objective, Some(&mask), "redundancy test")? {
+                LpResult::Optimal { value, .. } => -value <= self.halfspaces[j].offset + self.tolerance.linear,
+                LpResult::Unbounded => false,
+            };
+            mask[j] = !redundant;
+        }
+        let hs: Vec<Halfspace<D>> =
+            self.halfspaces.iter().zip(&mask).filter(|(_, keep)| **keep).map(|(h, _)| *h).collect();
+        let rows: Vec<V4> = hs.iter().map(|h| to_v4(&h.normal)).collect();
+        let offsets: Vec<f64> = hs.iter().map(|h| h.offset).collect();
+        Ok(Self { halfspaces: hs, rows, offsets, tolerance: self.tolerance, shape: self.shape })
+    }
+
+    /// Maximum of `direction . p` over the cell with a maximiser (lowest z, y, x among maximisers); `None` if empty.
+    pub fn support(&self, direction: &[f64; D]) -> Result<Option<(f64, [f64; D])>, CellError> {
+        if self.is_empty() {
+            return Ok(None);
+        }
+        match self.lp_masked(&direction.map(|c| -c), None, "support")? {
+            LpResult::Optimal { point, value } => Ok(Some((-value, point))),
+            LpResult::Unbounded => Err(CellError::Unbounded),
+        }
+    }
+
+    pub(crate) fn rows(&self) -> &[V4] {
+        &self.rows
+    }
+
+    pub(crate) fn offsets(&self) -> &[f64] {
+        &self.offsets
+    }
+
+    /// The characteristic length used for relative thresholds of the solvers.
+    pub(crate) fn length_scale(&self) -> f64 {
+        (self.tolerance.linear / geom::tolerance::RELATIVE).max(1.0)
+    }
+
+    /// min `objective . p` over the (masked) cell, from the cell's interior point.
+    pub(crate) fn lp_masked(
+        &self,
+        objective: &[f64; D],
+        mask: Option<&[bool]>,
+        purpose: &'static str,
+    ) -> Result<LpResult<D>, CellError> {
+        let Some(start) = self.interior_point() else {
+            return Ok(LpResult::Unbounded);
+        };
+        let prob = Problem {
+            n: D,
+            rows: &self.rows,
+            offsets: &self.offsets,
+            mask,
+            h: [0.0; MAX_N],
+            g: to_v4(objective),
+            tie: default_tie(D),
+            length_scale: self.length_scale(),
+        };
+        match prob.solve(to_v4(&start)).map_err(|source| CellError::Solver { purpose, source })? {
+            Outcome::Optimal { point, .. } => {
+                let p = from_v4::<D>(&point);
+                let value = (0..D).map(|i| objective[i] * p[i]).sum();
+                Ok(LpResult::Optimal { point: p, value })
+            }
+            Outcome::Unbounded { .. } => Ok(LpResult::Unbounded),
+        }
+    }
+
+    fn chebyshev(&self) -> Result<CellShape<D>, CellError> {
+        let tol = self.tolerance.linear;
+        let cap = 1e6 * self.length_scale();
+        let mut rows = Vec::with_capacity(self.rows.len() + 1);
+        let mut offsets = Vec::with_capacity(self.rows.len() + 1);
+        let mut r0 = cap;
+        for (row, &b) in self.rows.iter().zip(&self.offsets) {
+            let mut r = *row;
+            r[D] = 1.0;
+            rows.push(r);
+            offsets.push(b);
+            r0 = r0.min(b);
+        }
+        let mut capr = [0.0; MAX_N];
+        capr[D] = 1.0;
+        rows.push(capr);
+        offsets.push(cap);
+        let mut g = [0.0; MAX_N];
+        g[D] = -1.0;
+        let prob = Problem {
+            n: D + 1,
+            rows: &rows,
+            offsets: &offsets,
+            mask: None,
+            h: [0.0; MAX_N],
+            g,
+            tie: default_tie(D),
+            length_scale: self.length_scale(),
+        };
+        let mut start = [0.0; MAX_N];
+        start[D] = r0;
+        let out = prob.solve(start).map_err(|source| CellError::Solver { purpose: "Chebyshev centre", source })?;
+        let (point, bounded) = match out {
+            Outcome::Optimal { point, .. } => (point, true),
+            Outcome::Unbounded { point, .. } => (point, false),
+        };
+        let radius = point[D];
+        if radius < -tol {
+            return Ok(CellShape::Empty);
+        }
+        if !bounded || radius >= cap * (1.0 - 1e-9) {
+            return Err(CellError::Unbounded);
+        }
+        let p = from_v4::<D>(&point);
+        if radius <= tol { Ok(CellShape::Flat { point: p }) } else { Ok(CellShape::Solid { centre: p, radius }) }
+    }
+
+    fn check_bounded(&self) -> Result<(), CellError> {
+        for i in 0..D {
+            for sign in [1.0, -1.0] {
+                let mut dir = [0.0; D];
+                dir[i] = sign;
+                if self.lp_masked(&dir, None, "boundedness test")? == LpResult::Unbounded {
+                    return Err(CellError::Unbounded);
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+#[inline]
+pub(crate) fn to_v4<const D: usize>(x: &[f64; D]) -> V4 {
+    let mut v = [0.0; MAX_N];
+    v[..D].copy_from_slice(x);
+    v
+}
+
+#[inline]
+pub(crate) fn from_v4<const D: usize>(x: &V4) -> [f64; D] {
+    let mut v = [0.0; D];
+    v.copy_from_slice(&x[..D]);
+    v
+}
+
+/// `a . b` of two D-vectors through the 4-vector kernel.
+#[inline]
+pub(crate) fn dot<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
+    dot4(&to_v4(a), &to_v4(b))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    pub(crate) fn boxed(lo: [f64; 3], hi: [f64; 3]) -> Vec<Halfspace<3>> {
+        let mut hs = Vec::new();
+        for i in 0..3 {
+            let mut n = [0.0; 3];
+            n[i] = 1.0;
+            hs.push(Halfspace::new(n, hi[i], Tag::User(2 * i as u64)));
+            n[i] = -1.0;
+            hs.push(Halfspace::new(n, -lo[i], Tag::User(2 * i as u64 + 1)));
+        }
+        hs
+    }
+
+    #[test]
+    fn chebyshev_of_a_box() {
+        let c = Cell::new(boxed([0.0, 0.0, 0.0], [4.0, 2.0, 6.0]), Tolerance::for_scale(10.0)).expect("cell");
+        let (centre, r) = c.chebyshev_centre().expect("solid");
+        assert!((r - 1.0).abs() < 1e-12);
+        // centre (x, 1, z) with x in [1, 3], z in [1, 5]: lowest z, then x
+        assert!((centre[1] - 1.0).abs() < 1e-12 && (centre[2] - 1.0).abs() < 1e-12 && (centre[0] - 1.0).abs() < 1e-12);
+        assert_eq!(c.contains(&[2.0, 1.0, 3.0]), Containment::Interior);
+        assert_eq!(c.contains(&[4.0, 1.0, 3.0]), Containment::Boundary);
+        assert_eq!(c.contains(&[4.1, 1.0, 3.0]), Containment::Exterior);
+    }
+
+    #[test]
+    fn empty_flat_unbounded() {
+        let tol = Tolerance::for_scale(10.0);
+        let mut hs = boxed([0.0; 3], [1.0; 3]);
+        hs.push(Halfspace::new([1.0, 1.0, 1.0], -0.5, Tag::User(9)));
+        assert!(Cell::new(hs, tol).expect("cell").is_empty());
+        let mut hs = boxed([0.0; 3], [1.0; 3]);
+        hs.push(Halfspace::new([2.0, 0.0, 0.0], 0.0, Tag::User(9)));
+        let c = Cell::new(hs, tol).expect("cell");
+        assert!(matches!(c.shape(), CellShape::Flat { .. }), "{:?}", c.shape());
+        let mut hs = boxed([0.0; 3], [1.0; 3]);
+        hs.remove(4);
+        assert_eq!(Cell::new(hs.clone(), tol), Err(CellError::Unbounded));
+        hs.push(Halfspace::new([0.0; 3], -1.0, Tag::User(3)));
+        assert!(Cell::new(hs, tol).expect("empty").is_empty());
+        let nan = vec![Halfspace::new([f64::NAN, 0.0, 0.0], 1.0, Tag::Floor)];
+        assert_eq!(Cell::new(nan, tol), Err(CellError::NonFinite { index: 0 }));
+    }
+
+    #[test]
+    fn redundancy_removal_keeps_the_set() {
+        let tol = Tolerance::for_scale(10.0);
+        let mut hs = boxed([0.0; 3], [1.0; 3]);
+        hs.push(Halfspace::new([1.0, 1.0, 0.0], 5.0, Tag::User(20)));
+        hs.push(Halfspace::new([1.0, 0.0, 0.0], 1.0, Tag::User(21))); // duplicate of the first
+        hs.push(Halfspace::new([1.0, 1.0, 1.0], 2.5, Tag::User(22))); // cuts a corner
+        let c = Cell::new(hs, tol).expect("cell");
+        let r = c.without_redundant().expect("lp");
+        let tags: Vec<Tag> = r.halfspaces().iter().map(|h| h.tag).collect();
+        assert_eq!(r.len(), 7, "{tags:?}");
+        assert!(tags.contains(&Tag::User(21)) && !tags.contains(&Tag::User(0)) && !tags.contains(&Tag::User(20)));
+        assert!(tags.contains(&Tag::User(22)));
+    }
+}

@@ -1,0 +1,280 @@
+//! The placement QP: minimum of a separable convex quadratic over a cell, with the active inequalities.
+//!
+//! [A] VI-A-1 and VI-A-4 (Ayyadevara et al. 2002, sections 6.1.1, 6.1.4): the optimum of the convex quadratic cost
+//! per convex free-space component; its active inequalities name the contacts (obstacle faces) or the walls of the
+//! floor volume.
+//!
+//! Two solvers:
+//! * [`minimize`]: the exact primal active-set method of [`crate::active_set`] started at the cell's interior point
+//!   (O(m) per iteration, a handful of iterations in 2-3 variables). When the Hessian is singular (`w = 1` leaves z
+//!   free, `w = 0` leaves x and y free) the minimiser set is not a point; the solver returns its lexicographic
+//!   minimum: lowest z, then lowest y, then lowest x (lowest y then x in 2-D). Before returning, the KKT conditions
+//!   are verified from scratch (see [`verify_kkt`]); a failed check is an error, never a silent wrong answer.
+//! * [`minimize_clarabel`]: clarabel's interior-point QP (general path and cross-check; statuses other than
+//!   `Solved` are errors). Its point is some minimiser (no tie-break); its `active` list is the tight inequalities.
+
+use crate::active_set::{ActiveSetError, MAX_N, Outcome, Problem};
+use crate::cell::{Cell, default_tie, from_v4, to_v4};
+use crate::cost::SeparableQuadratic;
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus};
+
+/// An optimum over a cell.
+#[derive(Debug, Clone, PartialEq)]
+pub struct QpSolution<const D: usize> {
+    /// The minimiser (the lexicographic one for the exact solver).
+    pub point: [f64; D],
+    /// The cost there.
+    pub cost: f64,
+    /// Indices (into [`Cell::halfspaces`]) of the working set at the optimum: linearly independent active
+    /// inequalities (at most D), sorted. For the clarabel path: the tight inequalities.
+    pub active: Vec<usize>,
+    /// Lagrange multipliers of `active` (same order; >= 0). Empty for the clarabel path.
+    pub multipliers: Vec<f64>,
+    /// All inequalities within the cell's tolerance of equality at `point`, sorted.
+    pub tight: Vec<usize>,
+}
+
+/// Why a QP has no answer.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum QpError {
+    /// The cell is empty.
+    #[error("the cell is empty")]
+    EmptyCell,
+    /// The cost has invalid coefficients (negative Hessian entry or non-finite values).
+    #[error("cost coefficient {index} is invalid")]
+    BadCost {
+        /// Variable index.
+        index: usize,
+    },
+    /// The cost decreases without bound over the cell (impossible for bounded cells).
+    #[error("the cost is unbounded below over the cell")]
+    Unbounded,
+    /// The active-set solver gave up.
+    #[error(transparent)]
+    Solver(#[from] ActiveSetError),
+    /// The KKT check after the solve failed.
+    #[error("KKT check failed: {what} (value {value:e}, allowed {allowed:e})")]
+    Kkt {
+        /// Which condition.
+        what: &'static str,
+        /// The offending value.
+        value: f64,
+        /// The allowed bound.
+        allowed: f64,
+    },
+    /// clarabel did not report `Solved`.
+    #[error("clarabel status {0}")]
+    Clarabel(String),
+}
+
+fn check_cost<const D: usize>(cost: &impl SeparableQuadratic<D>) -> Result<([f64; D], [f64; D]), QpError> {
+    let h = cost.hessian_diagonal();
+    let g = cost.linear();
+    for i in 0..D {
+        if !(h[i] >= 0.0 && h[i].is_finite() && g[i].is_finite()) {
+            return Err(QpError::BadCost { index: i });
+        }
+    }
+    Ok((h, g))
+}
+
+fn tight_set<const D: usize>(cell: &Cell<D>, p: &[f64; D]) -> Vec<usize> {
+    let tol = cell.tolerance().linear;
+    (0..cell.len()).filter(|&j| cell.halfspaces()[j].excess(p).abs() <= tol).collect()
+}
+
+/// Exact minimum of `cost` over `cell`: see the module documentation.
+pub fn minimize<const D: usize>(cell: &Cell<D>, cost: &impl SeparableQuadratic<D>) -> Result<QpSolution<D>, QpError> {
+    let (h, g) = check_cost(cost)?;
+    let start = cell.interior_point().ok_or(QpError::EmptyCell)?;
+    let prob = Problem {
+        n: D,
+        rows: cell.rows(),
+        offsets: cell.offsets(),
+        mask: None,
+        h: to_v4(&h),
+        g: to_v4(&g),
+        tie: default_tie(D),
+        length_scale: cell.length_scale(),
+    };
+    match prob.solve(to_v4(&start))? {
+        Outcome::Optimal { point, working, multipliers } => {
+            let p: [f64; D] = from_v4(&point);
+            let mut pairs: Vec<(usize, f64)> =
+                working.as_slice().iter().copied().zip(multipliers.iter().copied()).collect();
+            pairs.sort_unstable_by_key(|x| x.0);
+            let sol = QpSolution {
+                point: p,
+                cost: cost.evaluate(&p),
+                active: pairs.iter().map(|x| x.0).collect(),
+                multipliers: pairs.iter().map(|x| x.1).collect(),
+                tight: tight_set(cell, &p),
+            };
+            verify_kkt(cell, cost, &sol)?;
+            Ok(sol)
+        }
+        Outcome::Unbounded { stage, .. } => {
+            tracing::debug!(stage, "QP unbounded (stage 0: the cost, k > 0: the k-th tie-break coordinate)");
+            Err(QpError::Unbounded)
+        }
+    }
+}
+
+/// Verifies the first-order (KKT) conditions of a solution of [`minimize`], which for a convex problem prove global
+/// optimality:
+///
+/// * primal feasibility: `a_j . p - b_j <= tol` for every `j` (the cell's tolerance);
+/// * complementarity: every `j` in `active` is tight, `|a_j . p - b_j| <= tol`;
+/// * dual feasibility: `lambda_j >= -eps`;
+/// * stationarity: `|grad f(p) + sum_j lambda_j a_j| <= eps`,
+///
+/// with `eps = 1e-8 * G`, `G = max_i (h_i L + |g_i|)` the gradient scale over the cell's length scale `L`.
+pub fn verify_kkt<const D: usize>(
+    cell: &Cell<D>,
+    cost: &impl SeparableQuadratic<D>,
+    sol: &QpSolution<D>,
+) -> Result<(), QpError> {
+    let tol = cell.tolerance().linear;
+    let hs = cell.halfspaces();
+    let mut worst = f64::NEG_INFINITY;
+    for h in hs {
+        worst = worst.max(h.excess(&sol.point));
+    }
+    if worst > tol {
+        return Err(QpError::Kkt { what: "primal feasibility", value: worst, allowed: tol });
+    }
+    let (h, g) = check_cost(cost)?;
+    let scale = cell.length_scale();
+    let gs = (0..D).map(|i| h[i] * scale + g[i].abs()).fold(f64::MIN_POSITIVE, f64::max);
+    let eps = 1e-8 * gs;
+    let mut residual = cost.gradient(&sol.point);
+    for (&j, &l) in sol.active.iter().zip(&sol.multipliers) {
+        let e = hs[j].excess(&sol.point).abs();
+        if e > tol {
+            return Err(QpError::Kkt { what: "complementarity", value: e, allowed: tol });
+        }
+        if l < -eps {
+            return Err(QpError::Kkt { what: "dual feasibility", value: l, allowed: -eps });
+        }
+        for i in 0..D {
+            residual[i] += l * hs[j].normal[i];
+        }
+    }
+    let r = residual.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if r > eps {
+        return Err(QpError::Kkt { what: "stationarity", value: r, allowed: eps });
+    }
+    Ok(())
+}
+
+/// Minimum of `cost` over `cell` by clarabel (interior point). The general path and the tests' cross-check.
+pub fn minimize_clarabel<const D: usize>(
+    cell: &Cell<D>,
+    cost: &impl SeparableQuadratic<D>,
+) -> Result<QpSolution<D>, QpError> {
+    let (h, g) = check_cost(cost)?;
+    if cell.is_empty() {
+        return Err(QpError::EmptyCell);
+    }
+    let x = clarabel_qp::<D>(&h, &g, cell.rows(), cell.offsets())?;
+    let mut p = [0.0; D];
+    p.copy_from_slice(&x[..D]);
+    let tight = tight_set(cell, &p);
+    Ok(QpSolution { point: p, cost: cost.evaluate(&p), active: tight.clone(), multipliers: Vec::new(), tight })
+}
+
+/// `min 1/2 sum h_i x_i^2 + g . x  s.t.  rows_j . x <= b_j` with clarabel; `Solved` only.
+pub(crate) fn clarabel_qp<const D: usize>(
+    h: &[f64; D],
+    g: &[f64; D],
+    rows: &[[f64; MAX_N]],
+    b: &[f64],
+) -> Result<Vec<f64>, QpError> {
+    let m = rows.len();
+    // P: diagonal, upper triangle, explicit zeros dropped
+    let mut colptr = vec![0usize];
+    let mut rowval = Vec::new();
+    let mut nzval = Vec::new();
+    for i in 0..D {
+        if h[i] != 0.0 {
+            rowval.push(i);
+            nzval.push(h[i]);
+        }
+        colptr.push(rowval.len());
+    }
+    let p = CscMatrix::new(D, D, colptr, rowval, nzval);
+    let mut colptr = vec![0usize];
+    let mut rowval = Vec::new();
+    let mut nzval = Vec::new();
+    for i in 0..D {
+        for (j, r) in rows.iter().enumerate() {
+            if r[i] != 0.0 {
+                rowval.push(j);
+                nzval.push(r[i]);
+            }
+        }
+        colptr.push(rowval.len());
+    }
+    let a = CscMatrix::new(m, D, colptr, rowval, nzval);
+    let settings = DefaultSettingsBuilder::default()
+        .verbose(false)
+        .tol_gap_abs(1e-11)
+        .tol_gap_rel(1e-11)
+        .tol_feas(1e-11)
+        .tol_ktratio(1e-9)
+        .max_iter(200)
+        .build()
+        .map_err(|e| QpError::Clarabel(format!("settings: {e}")))?;
+    let cones = [NonnegativeConeT(m)];
+    let mut solver =
+        DefaultSolver::new(&p, g, &a, b, &cones, settings).map_err(|e| QpError::Clarabel(format!("setup: {e}")))?;
+    solver.solve();
+    if solver.solution.status != SolverStatus::Solved {
+        return Err(QpError::Clarabel(format!("{:?}", solver.solution.status)));
+    }
+    Ok(solver.solution.x.clone())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cell::{Halfspace, Tag};
+    use crate::cost::SeparableCost;
+    use stackplan_geom::Tolerance;
+
+    fn unit_cube() -> Cell<3> {
+        let mut hs = Vec::new();
+        for i in 0..3 {
+            let mut n = [0.0; 3];
+            n[i] = 1.0;
+            hs.push(Halfspace::new(n, 1.0, Tag::User(2 * i as u64)));
+            n[i] = -1.0;
+            hs.push(Halfspace::new(n, 0.0, Tag::User(2 * i as u64 + 1)));
+        }
+        Cell::new(hs, Tolerance::for_scale(1.0)).expect("cube")
+    }
+
+    #[test]
+    fn golden_corner_and_clarabel_agree() {
+        let c = unit_cube();
+        let f = SeparableCost::new([2.0, 4.0, 6.0], [-6.0, 2.0, -3.0], 1.0).expect("cost");
+        // unconstrained optimum (3, -0.5, 0.5) -> clamp to (1, 0, 0.5)
+        let s = minimize(&c, &f).expect("exact");
+        assert!((s.point[0] - 1.0).abs() < 1e-14 && s.point[1].abs() < 1e-14 && (s.point[2] - 0.5).abs() < 1e-14);
+        assert_eq!(s.active, vec![0, 3]);
+        assert!((s.multipliers[0] - 4.0).abs() < 1e-12 && (s.multipliers[1] - 2.0).abs() < 1e-12);
+        let k = minimize_clarabel(&c, &f).expect("clarabel");
+        assert!((k.cost - s.cost).abs() < 1e-8);
+    }
+
+    #[test]
+    fn rejects_bad_costs_and_empty_cells() {
+        let c = unit_cube();
+        let bad = SeparableCost::new([1.0; 3], [0.0; 3], 0.0).expect("ok");
+        assert!(minimize(&c, &bad).is_ok());
+        let empty = c.with_halfspaces([Halfspace::new([1.0, 0.0, 0.0], -1.0, Tag::User(7))]).expect("cell");
+        assert_eq!(minimize(&empty, &bad), Err(QpError::EmptyCell));
+        assert_eq!(minimize_clarabel(&empty, &bad), Err(QpError::EmptyCell));
+    }
+}
