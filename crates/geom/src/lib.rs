@@ -7,15 +7,19 @@
 //! * [`polytope`]: convex polytopes with faces, edges and planes, and their validation;
 //! * [`hull`]: a robust 3-D convex hull (Quickhull with exact predicates and exact coplanar merging);
 //! * [`mass`]: volume, centre of gravity and inertia tensor;
-//! * [`part`]: rigid parts as unions of convex components, with boundary faces.
+//! * [`part`]: rigid parts as unions of convex components, with boundary faces;
+//! * [`pose`]: rigid poses (rotation and position) of placed parts;
+//! * [`io`]: file formats (part JSON, STL, OBJ, glTF export, stack files) with located errors.
 
 pub mod convex_merge;
 pub mod examples;
 pub mod hull;
+pub mod io;
 pub mod mass;
 pub mod part;
 pub mod polygon;
 pub mod polytope;
+pub mod pose;
 pub mod predicates;
 pub mod sheet_metal;
 pub mod tolerance;
@@ -23,8 +27,10 @@ pub mod triangulate;
 
 pub use glam::{DMat3, DVec2, DVec3};
 pub use hull::{ConvexHull, HullError, convex_hull};
+pub use io::{IoError, ReadOptions, read_part, write_part};
 pub use mass::MassProperties;
 pub use part::{BoundaryFace, Part, PartError, PartOrigin};
 pub use polytope::{Containment, ConvexPolytope, Edge, Face, Plane, PolytopeError};
+pub use pose::{Pose, PoseError};
 pub use sheet_metal::{Decomposition, SheetFace, SheetMetal, SheetMetalError};
 pub use tolerance::Tolerance;

@@ -1,0 +1,123 @@
+//! Wavefront OBJ (the geometric subset; see `README-io.md`), hand-written so every error carries its line number.
+//!
+//! **Reading.** `v x y z [w]` defines a vertex (extra numbers such as vertex colours are allowed and ignored),
+//! `f i j k ...` a polygon with vertex references `i`, `i/t`, `i//n` or `i/t/n`; indices are 1-based, negative
+//! indices count back from the last vertex defined so far (`-1` is the latest). `o` and `g` start a new object/group;
+//! each non-empty object/group (faces before the first `o`/`g` form an unnamed one) is one convex piece and must bound
+//! a convex solid, checked exactly as for STL shells ([`super::mesh`]) unless decomposition is requested. `vt`,
+//! `vn`, `vp`, `s`, `usemtl`, `mtllib`, `l`, `p` and other statements are ignored; `#` starts a comment. Vertices are
+//! welded by exact coordinates. O(file size) parsing.
+//!
+//! **Writing.** One `o piece_<i>` per component with its vertices and polygonal faces (counter-clockwise seen from
+//! outside, 1-based absolute indices). Coordinates use Rust's shortest round-trip `f64` formatting, so a part read
+//! back is identical component by component.
+
+use super::mesh::{MeshPolygon, Shell, Welder, part_from_shells};
+use super::{IoError, Place, ReadOptions, check_coordinate, stem_name};
+use crate::part::Part;
+use glam::DVec3;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Reads an OBJ file.
+pub fn read_obj(path: impl AsRef<Path>, options: &ReadOptions) -> Result<Part, IoError> {
+    let path = path.as_ref();
+    let bytes = super::read_bytes(path)?;
+    parse_obj(&bytes, path, options)
+}
+
+/// Parses OBJ from memory; `file` is only used in error messages and as the part name.
+pub fn parse_obj(bytes: &[u8], file: &Path, options: &ReadOptions) -> Result<Part, IoError> {
+    let text = String::from_utf8_lossy(bytes);
+    let syntax =
+        |line: usize, message: String| IoError::Syntax { file: file.to_path_buf(), at: Place::Line(line), message };
+    let mut welder = Welder::default();
+    let mut vertex_ids: Vec<usize> = Vec::new(); // OBJ vertex k (0-based) -> welded index
+    let mut groups: Vec<Shell> = vec![Shell { name: None, polygons: Vec::new() }];
+    for (i, raw) in text.lines().enumerate() {
+        let line = i + 1;
+        let content = raw.split('#').next().unwrap_or("");
+        let mut words = content.split_whitespace();
+        let Some(keyword) = words.next() else { continue };
+        match keyword {
+            "v" => {
+                let numbers: Vec<&str> = words.collect();
+                if numbers.len() < 3 {
+                    return Err(syntax(line, format!("a vertex needs 3 coordinates, got {}", numbers.len())));
+                }
+                let mut p = [0.0; 3];
+                for (k, w) in numbers.iter().enumerate() {
+                    let value: f64 = w.parse().map_err(|_| syntax(line, format!("`{w}` is not a number")))?;
+                    if k < 3 {
+                        p[k] = check_coordinate(value, file, || Place::Line(line))?;
+                    }
+                }
+                vertex_ids.push(welder.index(DVec3::from_array(p)));
+            }
+            "f" => {
+                let mut vertices = Vec::new();
+                for w in words {
+                    let bad = || syntax(line, format!("`{w}` is not a vertex reference (i, i/t, i//n or i/t/n)"));
+                    let mut parts = w.split('/');
+                    let index: i64 = parts.next().unwrap_or("").parse().map_err(|_| bad())?;
+                    // texture and normal indices are ignored, but must be integers (or empty) when present
+                    let rest: Vec<&str> = parts.collect();
+                    if rest.len() > 2 || rest.iter().any(|r| !r.is_empty() && r.parse::<i64>().is_err()) {
+                        return Err(bad());
+                    }
+                    let count = vertex_ids.len();
+                    let resolved = match index {
+                        i if i > 0 && (i as u64) <= count as u64 => Some(i as usize - 1),
+                        i if i < 0 && i.unsigned_abs() <= count as u64 => Some(count - i.unsigned_abs() as usize),
+                        _ => None,
+                    };
+                    let Some(k) = resolved else {
+                        return Err(IoError::BadIndex { file: file.to_path_buf(), line, index, count });
+                    };
+                    vertices.push(vertex_ids[k]);
+                }
+                if vertices.len() < 3 {
+                    return Err(IoError::FaceTooSmall { file: file.to_path_buf(), line, count: vertices.len() });
+                }
+                let group = groups.last_mut().expect("groups starts non-empty and only grows");
+                group.polygons.push(MeshPolygon { vertices, place: Place::Line(line) });
+            }
+            "o" | "g" => {
+                let name: Vec<&str> = words.collect();
+                let name = if name.is_empty() { None } else { Some(name.join(" ")) };
+                groups.push(Shell { name, polygons: Vec::new() });
+            }
+            other => tracing::trace!(line, statement = other, "ignoring OBJ statement"),
+        }
+    }
+    let shells: Vec<(Shell, Option<usize>)> =
+        groups.into_iter().filter(|g| !g.polygons.is_empty()).map(|g| (g, None)).collect();
+    if shells.is_empty() {
+        return Err(IoError::Empty { file: file.to_path_buf(), at: Place::WholeFile, what: "the OBJ has no faces" });
+    }
+    part_from_shells(file, stem_name(file), &welder.points, shells, options)
+}
+
+/// The part as OBJ text.
+pub fn obj_string(part: &Part) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "# stackplan part {:?}: {} convex components", part.name, part.components.len());
+    let mut base = 1usize;
+    for (i, c) in part.components.iter().enumerate() {
+        let _ = writeln!(s, "o piece_{i}");
+        for v in c.vertices() {
+            let _ = writeln!(s, "v {:?} {:?} {:?}", v.x, v.y, v.z);
+        }
+        for f in c.faces() {
+            let idx: Vec<String> = f.vertices.iter().map(|&v| (v + base).to_string()).collect();
+            let _ = writeln!(s, "f {}", idx.join(" "));
+        }
+        base += c.vertices().len();
+    }
+    s
+}
+
+/// Writes the part as OBJ atomically.
+pub fn write_obj(path: impl AsRef<Path>, part: &Part) -> Result<(), IoError> {
+    super::atomic::write_atomic(path, obj_string(part).as_bytes())
+}

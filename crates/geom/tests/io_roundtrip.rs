@@ -1,0 +1,330 @@
+//! Round trips through every format, GLB parse-back, stack files and atomic writes.
+
+use proptest::prelude::*;
+use stackplan_geom::io::glb::{GlbItem, glb_bytes};
+use stackplan_geom::io::stack::{StackPart, read_stack, write_stack, write_stack_with_extras};
+use stackplan_geom::io::{self, IoError, ReadOptions, atomic};
+use stackplan_geom::{ConvexPolytope, DMat3, DVec3, Part, PartOrigin, Pose, convex_hull};
+use std::path::Path;
+
+const BRACKET: &str = r#"{
+  "name": "bracket",
+  "density": 7.85e-6,
+  "sheet_metal": {
+    "thickness": 1,
+    "faces": [
+      {"outline": [[0, 0, 0], [40, 0, 0], [40, 20, 0], [0, 20, 0]], "holes": [[[10, 5, 0], [14, 5, 0], [14, 9, 0], [10, 9, 0]]]},
+      {"outline": [[0, 0, 4], [0, 20, 4], [0, 20, 30], [0, 10, 38], [0, 0, 30]]}
+    ]
+  }
+}"#;
+
+fn bracket() -> Part {
+    io::parse_part_json(BRACKET.as_bytes(), Path::new("bracket.json"), &ReadOptions::default()).expect("bracket")
+}
+
+/// A component as its sorted vertex coordinates (bit patterns), which determine a convex polytope.
+fn key(c: &ConvexPolytope) -> Vec<[u64; 3]> {
+    let mut k: Vec<[u64; 3]> = c.vertices().iter().map(|v| (*v + DVec3::ZERO).to_array().map(f64::to_bits)).collect();
+    k.sort_unstable();
+    k
+}
+
+fn same_components(a: &Part, b: &Part) {
+    let mut ka: Vec<_> = a.components.iter().map(key).collect();
+    let mut kb: Vec<_> = b.components.iter().map(key).collect();
+    ka.sort();
+    kb.sort();
+    assert_eq!(ka, kb, "components differ");
+    for (x, y) in a.components.iter().zip(&b.components) {
+        assert_eq!(x.faces().len(), y.faces().len());
+    }
+    let (va, vb) = (a.mass.volume, b.mass.volume);
+    assert!((va - vb).abs() <= 1e-12 * va, "volume {va} vs {vb}");
+    assert!((a.mass.center_of_gravity - b.mass.center_of_gravity).length() <= 1e-9);
+}
+
+#[test]
+fn sheet_metal_json_builds_and_round_trips() {
+    let part = bracket();
+    assert_eq!(part.name, "bracket");
+    assert_eq!(part.density, 7.85e-6);
+    assert!(part.components.len() >= 3, "a face with a hole needs several convex pieces");
+    // volume: (40 x 20 - 4 x 4) x 1 + (pentagon area) x 1
+    let pentagon = 20.0 * 26.0 + 0.5 * 20.0 * 8.0;
+    let expected = 800.0 - 16.0 + pentagon;
+    assert!((part.mass.volume - expected).abs() < 1e-9 * expected, "{} vs {expected}", part.mass.volume);
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("b.json");
+    io::write_part_json(&path, &part).expect("write");
+    let back = io::read_part(&path, &ReadOptions::default()).expect("read back");
+    assert_eq!(back.origin, PartOrigin::ConvexPieces);
+    assert_eq!(back.name, "bracket");
+    assert_eq!(back.density, part.density);
+    same_components(&part, &back);
+    // the options' density wins over the file's
+    let heavy = io::read_part(&path, &ReadOptions { density: Some(2.0), ..Default::default() }).expect("read");
+    assert_eq!(heavy.density, 2.0);
+}
+
+#[test]
+fn triangulation_option_reaches_the_sheet_metal_builder() {
+    let merged = bracket();
+    let options = ReadOptions { decomposition: stackplan_geom::Decomposition::Triangulation, ..Default::default() };
+    let triangulated = io::parse_part_json(BRACKET.as_bytes(), Path::new("b.json"), &options).expect("bracket");
+    assert!(triangulated.components.len() > merged.components.len());
+    assert!((triangulated.mass.volume - merged.mass.volume).abs() < 1e-9 * merged.mass.volume);
+}
+
+#[test]
+fn obj_round_trip_is_exact() {
+    let part = bracket();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("bracket.obj");
+    io::write_obj(&path, &part).expect("write");
+    let back = io::read_part(&path, &ReadOptions::default()).expect("read");
+    assert_eq!(back.origin, PartOrigin::Mesh);
+    same_components(&part, &back);
+}
+
+#[test]
+fn stl_round_trips_separate_touching_components() {
+    // the bracket's prisms touch face to face: the shell splitter must still separate them
+    let part = bracket();
+    let dir = tempfile::tempdir().expect("tempdir");
+    for ascii in [true, false] {
+        let path = dir.path().join(if ascii { "a.stl" } else { "b.stl" });
+        if ascii {
+            io::write_stl_ascii(&path, &part).expect("write");
+        } else {
+            io::write_stl_binary(&path, &part).expect("write");
+        }
+        let back = io::read_part(&path, &ReadOptions::default()).expect("read");
+        assert_eq!(back.components.len(), part.components.len(), "ascii = {ascii}");
+        same_components(&part, &back); // coordinates are dyadic, so even f32 is exact
+    }
+}
+
+#[test]
+fn binary_stl_with_a_solid_header_is_binary() {
+    let part = bracket();
+    let mut bytes = io::stl_binary_bytes(&part);
+    bytes[..12].copy_from_slice(b"solid bracke");
+    let back = io::parse_stl(&bytes, Path::new("x.stl"), &ReadOptions::default()).expect("binary despite `solid`");
+    same_components(&part, &back);
+}
+
+#[test]
+fn two_cubes_sharing_a_face_are_two_shells_and_an_edge_touch_too() {
+    let cube = |o: DVec3| {
+        let pts: Vec<DVec3> =
+            (0..8).map(|i| o + DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64)).collect();
+        convex_hull(&pts).expect("cube").polytope
+    };
+    for offsets in [[DVec3::ZERO, DVec3::X], [DVec3::ZERO, DVec3::new(1.0, 1.0, 0.0)], [DVec3::ZERO, DVec3::ONE]] {
+        let part =
+            Part::from_components("two", offsets.iter().map(|&o| cube(o)).collect(), 1.0, PartOrigin::ConvexPieces)
+                .expect("part");
+        let text = io::stl_ascii_string(&part);
+        let back = io::parse_stl(text.as_bytes(), Path::new("two.stl"), &ReadOptions::default()).expect("read");
+        same_components(&part, &back);
+    }
+}
+
+#[test]
+fn glb_parses_back() {
+    let part = bracket();
+    let cube_pts: Vec<DVec3> =
+        (0..8).map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64) * 10.0).collect();
+    let cube =
+        Part::from_components("cube", vec![convex_hull(&cube_pts).expect("cube").polytope], 1.0, PartOrigin::Mesh)
+            .expect("cube");
+    let items = [
+        GlbItem::part(&part),
+        GlbItem {
+            part: &cube,
+            pose: Pose::from_z_rotation(0.3).compose(&Pose::from_translation(DVec3::Z)),
+            color: [1.0, 0.0, 0.0, 0.5],
+        },
+        GlbItem { part: &part, pose: Pose::from_translation(DVec3::new(0.0, 0.0, 5.0)), color: [0.0, 1.0, 0.0, 1.0] },
+    ];
+    let bytes = glb_bytes(&items);
+    let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes")) as usize;
+    assert_eq!(&bytes[0..4], b"glTF");
+    assert_eq!(word(4), 2);
+    assert_eq!(word(8), bytes.len());
+    let json_len = word(12);
+    assert_eq!(&bytes[16..20], b"JSON");
+    assert_eq!(json_len % 4, 0);
+    let json = &bytes[20..20 + json_len];
+    let bin_header = 20 + json_len;
+    let bin_len = word(bin_header);
+    assert_eq!(&bytes[bin_header + 4..bin_header + 8], b"BIN\0");
+    assert_eq!(bin_len % 4, 0);
+    assert_eq!(bin_header + 8 + bin_len, bytes.len());
+    let bin = &bytes[bin_header + 8..];
+
+    // typed parse and validation by gltf-json, an independent implementation of the schema
+    let root = gltf_json::Root::from_slice(json).expect("valid glTF JSON");
+    let mut problems = Vec::new();
+    gltf_json::validation::Validate::validate(&root, &root, gltf_json::Path::new, &mut |path, error| {
+        problems.push(format!("{}: {error:?}", path()))
+    });
+    assert!(problems.is_empty(), "{problems:?}");
+    assert_eq!(root.meshes.len(), 3);
+    assert_eq!(root.nodes.len(), 4);
+    assert!(root.buffers[0].byte_length.0 as usize <= bin_len);
+
+    let value: serde_json::Value = serde_json::from_slice(json).expect("json");
+    for (i, item) in items.iter().enumerate() {
+        let triangles: usize = item.part.components.iter().flat_map(|c| c.faces()).map(|f| f.vertices.len() - 2).sum();
+        let positions = &value["accessors"][2 * i];
+        let normals = &value["accessors"][2 * i + 1];
+        assert_eq!(positions["count"], 3 * triangles);
+        assert_eq!(normals["count"], 3 * triangles);
+        let (lo, hi) = item.part.aabb();
+        for k in 0..3 {
+            assert_eq!(positions["min"][k].as_f64(), Some(lo[k] as f32 as f64));
+            assert_eq!(positions["max"][k].as_f64(), Some(hi[k] as f32 as f64));
+        }
+        // the stored floats lie within min/max and the normals are unit
+        let view = &value["bufferViews"][positions["bufferView"].as_u64().expect("view") as usize];
+        let offset = view["byteOffset"].as_u64().expect("offset") as usize;
+        let floats: Vec<f32> = bin[offset..offset + 36 * triangles]
+            .chunks(4)
+            .map(|c| f32::from_le_bytes(c.try_into().expect("4 bytes")))
+            .collect();
+        for p in floats.chunks(3) {
+            for k in 0..3 {
+                assert!(p[k] >= lo[k] as f32 && p[k] <= hi[k] as f32);
+            }
+        }
+        let nview = &value["bufferViews"][normals["bufferView"].as_u64().expect("view") as usize];
+        let noffset = nview["byteOffset"].as_u64().expect("offset") as usize;
+        for n in bin[noffset..noffset + 36 * triangles].chunks(12) {
+            let n: Vec<f32> = n.chunks(4).map(|c| f32::from_le_bytes(c.try_into().expect("4"))).collect();
+            assert!(((n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() - 1.0).abs() < 1e-6);
+        }
+    }
+    // the node matrix of item 1 is its pose (column-major)
+    let m = &value["nodes"][2]["matrix"];
+    let pose = items[1].pose;
+    assert_eq!(m[12].as_f64(), Some(pose.position.x));
+    assert_eq!(m[1].as_f64(), Some(pose.rotation.x_axis.y));
+    // JSON padding is spaces
+    assert!(json.iter().rev().take_while(|&&b| b == b' ').count() < 4);
+    let dir = tempfile::tempdir().expect("tempdir");
+    io::write_part(dir.path().join("p.glb"), &part).expect("write glb");
+    assert!(dir.path().join("p.glb").exists());
+}
+
+#[test]
+fn stack_file_round_trip_and_row_convention() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let part = bracket();
+    io::write_part_json(dir.path().join("bracket.json"), &part).expect("part");
+    let poses = vec![
+        Pose::IDENTITY,
+        Pose::from_z_rotation(0.25).compose(&Pose::from_translation(DVec3::new(1.5, -2.0, 3.0))),
+        Pose::new(DMat3::from_rotation_x(std::f64::consts::FRAC_PI_2), DVec3::new(0.0, 0.0, 40.0)).expect("pose"),
+    ];
+    let stack = dir.path().join("stack.json");
+    write_stack(&stack, StackPart::Path(Path::new("bracket.json")), &poses).expect("write");
+    let read = read_stack(&stack).expect("read");
+    assert_eq!(read.placements, poses);
+    assert_eq!(read.part_path.as_deref(), Some(dir.path().join("bracket.json").as_path()));
+    same_components(&part, &read.part);
+
+    // inline part with extra keys per placement
+    let mut extra = serde_json::Map::new();
+    extra.insert("cost".into(), serde_json::json!(12.5));
+    extra.insert("theta_deg".into(), serde_json::json!(14));
+    let inline = dir.path().join("inline.json");
+    write_stack_with_extras(&inline, StackPart::Inline(&part), &poses, &[serde_json::Map::new(), extra.clone()])
+        .expect("write");
+    let read = read_stack(&inline).expect("read inline");
+    assert_eq!(read.part_path, None);
+    assert_eq!(read.placements, poses);
+    assert_eq!(read.extras[1], extra);
+    same_components(&part, &read.part);
+
+    // rows as written: rotation[i][j] is row i; world = R v + p
+    let text = r#"{"part": "bracket.json", "placements": [
+        {"position": [10, 20, 30], "rotation": [[0, -1, 0], [1, 0, 0], [0, 0, 1]], "note": "quarter turn"}]}"#;
+    let hand = dir.path().join("hand.json");
+    std::fs::write(&hand, text).expect("write");
+    let read = read_stack(&hand).expect("read");
+    assert_eq!(read.placements[0].apply(DVec3::X), DVec3::new(10.0, 21.0, 30.0));
+    assert_eq!(read.placements[0].apply(DVec3::Y), DVec3::new(9.0, 20.0, 30.0));
+    assert_eq!(read.extras[0]["note"], "quarter turn");
+}
+
+#[test]
+fn a_failing_write_leaves_no_file_and_keeps_the_old_one() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let target = dir.path().join("out.stl");
+    let failing = |w: &mut dyn std::io::Write| -> std::io::Result<()> {
+        w.write_all(&[1u8; 10_000])?;
+        Err(std::io::Error::other("disk full (simulated)"))
+    };
+    let e = atomic::write_atomic_with(&target, failing).expect_err("fails");
+    assert!(matches!(&e, IoError::Os { file, .. } if file == &target));
+    assert!(e.to_string().contains("out.stl") && e.to_string().contains("disk full"));
+    assert!(!target.exists());
+    assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 0, "no temporary file left behind");
+
+    atomic::write_atomic(&target, b"old").expect("write");
+    assert!(atomic::write_atomic_with(&target, failing).is_err());
+    assert_eq!(std::fs::read(&target).expect("read"), b"old");
+    assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 1);
+
+    let missing_dir = dir.path().join("no/such/dir/part.json");
+    let e = io::write_part_json(&missing_dir, &bracket()).expect_err("no directory");
+    assert!(matches!(e, IoError::Os { .. }) && e.to_string().contains("part.json"));
+    assert!(!missing_dir.exists());
+}
+
+#[test]
+fn unsupported_extensions() {
+    let e = io::read_part("part.step", &ReadOptions::default()).expect_err("step");
+    assert!(matches!(e, IoError::UnsupportedExtension { .. }) && e.to_string().contains("part.step"));
+    let e = io::write_part("part.txt", &bracket()).expect_err("txt");
+    assert!(matches!(e, IoError::UnsupportedExtension { .. }));
+}
+
+/// Random convex pieces on a dyadic grid, well separated so that they are distinct shells.
+fn random_part() -> impl Strategy<Value = Part> {
+    prop::collection::vec(prop::collection::vec(prop::array::uniform3(-16i32..16), 4..24), 1..4).prop_filter_map(
+        "flat pieces",
+        |pieces| {
+            let mut components = Vec::new();
+            for (i, piece) in pieces.iter().enumerate() {
+                let pts: Vec<DVec3> = piece
+                    .iter()
+                    .map(|p| DVec3::new(p[0] as f64 * 0.25 + 100.0 * i as f64, p[1] as f64 * 0.125, p[2] as f64 * 0.5))
+                    .collect();
+                components.push(convex_hull(&pts).ok()?.polytope);
+            }
+            Part::from_components("random", components, 1.0, PartOrigin::ConvexPieces).ok()
+        },
+    )
+}
+
+proptest! {
+    #[test]
+    fn random_parts_round_trip_through_every_format(part in random_part()) {
+        let opts = ReadOptions::default();
+        let json = io::part_json_string(&part);
+        let back = io::parse_part_json(json.as_bytes(), Path::new("r.json"), &opts).expect("json");
+        same_components(&part, &back);
+        let obj = io::obj_string(&part);
+        let back = io::parse_obj(obj.as_bytes(), Path::new("r.obj"), &opts).expect("obj");
+        same_components(&part, &back);
+        let stl = io::stl_ascii_string(&part);
+        let back = io::parse_stl(stl.as_bytes(), Path::new("r.stl"), &opts).expect("ascii stl");
+        same_components(&part, &back);
+        let stl = io::stl_binary_bytes(&part);
+        let back = io::parse_stl(&stl, Path::new("r.stl"), &opts).expect("binary stl");
+        same_components(&part, &back);
+    }
+}
