@@ -328,3 +328,116 @@ proptest! {
         same_components(&part, &back);
     }
 }
+
+#[test]
+fn every_good_seed_file_reads() {
+    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/good");
+    let opts = ReadOptions::default();
+    let two = io::read_part(dir.join("two_groups.obj"), &opts).expect("obj");
+    assert_eq!(two.components.len(), 2);
+    assert!((two.mass.volume - (1.0 / 6.0 + 8.0)).abs() < 1e-12);
+    let cube = io::read_part(dir.join("cube.stl"), &opts).expect("stl");
+    assert!((cube.mass.volume - 8.0).abs() < 1e-12);
+    let tetra = io::read_part(dir.join("tetra_binary.stl"), &opts).expect("binary stl with a solid header");
+    assert!((tetra.mass.volume - 1.0 / 6.0).abs() < 1e-12);
+    let pieces = io::read_part(dir.join("pieces.json"), &opts).expect("pieces");
+    assert_eq!(pieces.density, 2.5);
+    assert!((pieces.mass.mass - 2.5 * (1.0 / 6.0 + 8.0)).abs() < 1e-12);
+    let sheet = io::read_part(dir.join("sheet.json"), &opts).expect("sheet");
+    assert!((sheet.mass.volume - 1.5 * (600.0 - 25.0 + 20.0 * 23.0)).abs() < 1e-9);
+    let stack = read_stack(dir.join("stack.json")).expect("stack");
+    assert_eq!(stack.placements.len(), 2);
+    assert_eq!(stack.extras[1]["cost"], 1.5);
+}
+
+/// Independent oracle for a closed, consistently oriented triangle surface: it bounds a convex solid iff no vertex
+/// lies strictly above the plane of any triangle (exact orient3d) and the enclosed volume is positive.
+fn oracle_convex(points: &[DVec3], triangles: &[[usize; 3]]) -> bool {
+    let all_below = triangles.iter().all(|t| {
+        points.iter().all(|&p| {
+            stackplan_geom::predicates::side(points[t[0]], points[t[1]], points[t[2]], p) != std::cmp::Ordering::Greater
+        })
+    });
+    let volume: f64 = triangles.iter().map(|t| points[t[0]].dot(points[t[1]].cross(points[t[2]]))).sum::<f64>() / 6.0;
+    all_below && volume > 0.0
+}
+
+fn ascii_stl(points: &[DVec3], triangles: &[[usize; 3]]) -> String {
+    let mut s = String::from("solid t\n");
+    for t in triangles {
+        s.push_str("facet normal 0 0 0\nouter loop\n");
+        for &v in t {
+            s.push_str(&format!("vertex {:?} {:?} {:?}\n", points[v].x, points[v].y, points[v].z));
+        }
+        s.push_str("endloop\nendfacet\n");
+    }
+    s.push_str("endsolid t\n");
+    s
+}
+
+proptest! {
+    /// Fan-triangulate a random convex polytope, move one vertex to a random grid point (often making the surface
+    /// non-convex, sometimes not), and compare the exact convexity check with the independent oracle.
+    #[test]
+    fn convexity_check_agrees_with_an_independent_oracle(
+        pts in prop::collection::vec(prop::array::uniform3(-8i32..8), 5..16),
+        which in any::<prop::sample::Index>(),
+        target in prop::array::uniform3(-10i32..10),
+    ) {
+        let pts: Vec<DVec3> = pts.iter().map(|p| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64 * 0.5)).collect();
+        let Ok(hull) = convex_hull(&pts) else { return Ok(()) };
+        let poly = hull.polytope;
+        let mut points = poly.vertices().to_vec();
+        let mut triangles = Vec::new();
+        for f in poly.faces() {
+            for w in f.vertices[1..].windows(2) {
+                triangles.push([f.vertices[0], w[0], w[1]]);
+            }
+        }
+        let moved = which.index(points.len());
+        let new_point = DVec3::new(target[0] as f64, target[1] as f64, target[2] as f64 * 0.5);
+        prop_assume!(!points.contains(&new_point));
+        points[moved] = new_point;
+        // skip surfaces with a degenerate (collinear) triangle: both sides treat them specially
+        prop_assume!(triangles.iter().all(|t| !stackplan_geom::predicates::collinear(points[t[0]], points[t[1]], points[t[2]])));
+        let text = ascii_stl(&points, &triangles);
+        let result = io::parse_stl(text.as_bytes(), Path::new("moved.stl"), &ReadOptions::default());
+        let expected = oracle_convex(&points, &triangles);
+        match &result {
+            Ok(part) => {
+                prop_assert!(expected, "accepted a non-convex surface");
+                prop_assert_eq!(part.components.len(), 1);
+            }
+            Err(e) => {
+                prop_assert!(!expected, "rejected a convex surface: {}", e);
+                prop_assert!(matches!(e, IoError::NotConvex { .. } | IoError::DegeneratePiece { .. }), "{:?}", e);
+            }
+        }
+    }
+}
+
+#[test]
+fn a_large_convex_mesh_is_checked_quickly() {
+    // 4000 points on a sphere (a Fibonacci lattice): about 8000 hull triangles, each checked exactly
+    let n = 4000;
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let pts: Vec<DVec3> = (0..n)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+            let r = (1.0 - z * z).sqrt();
+            let t = golden * i as f64;
+            DVec3::new(r * t.cos(), r * t.sin(), z) * 50.0
+        })
+        .collect();
+    let ball = convex_hull(&pts).expect("ball").polytope;
+    let part = Part::from_components("ball", vec![ball], 1.0, PartOrigin::ConvexPieces).expect("part");
+    let start = std::time::Instant::now();
+    let back = io::parse_stl(io::stl_ascii_string(&part).as_bytes(), Path::new("ball.stl"), &ReadOptions::default())
+        .expect("convex");
+    same_components(&part, &back);
+    let back = io::parse_obj(io::obj_string(&part).as_bytes(), Path::new("ball.obj"), &ReadOptions::default())
+        .expect("convex");
+    same_components(&part, &back);
+    // generous bound (shared, loaded machine); the quadratic fallback would take minutes here
+    assert!(start.elapsed().as_secs_f64() < 20.0, "took {:?}", start.elapsed());
+}
