@@ -1,0 +1,305 @@
+//! Interference pairs between a moving part and placed parts ([A] eq. 6-8, section 5.1.3).
+//!
+//! A part is a union of convex components; two parts interfere iff some pair of components has overlapping interiors
+//! (touching is not interference, [A] App. A). The list `L` of such pairs at a configuration is what the planner builds
+//! obstacles for.
+//!
+//! * **Broad phase**: the world AABBs of all placed components in a parry3d-f64 [`Bvh`] (binned SAH build,
+//!   O(n log n)); the moving component's AABB, enlarged by the clearance and the tolerance, is queried against it.
+//! * **Narrow phase**: the separating-axis theorem for convex polytopes. The candidate axes are the face normals of both
+//!   and the cross products of their edge directions (deduplicated: a box has 3 normal axes and 3 edge directions, so
+//!   3 + 3 + 9 axes). For each axis `u` the signed gap `max(min_B - max_A, min_A - max_B)` of the two projections is a
+//!   lower bound on the distance; the largest gap over the complete axis set is positive iff the polytopes are
+//!   disjoint, and when it is negative its magnitude is the penetration depth (the minimum translation distance is
+//!   attained along one of these axes). With the tolerance `tol` of [`stackplan_geom::Tolerance`]:
+//!   `gap > tol` separated, `|gap| <= tol` touching, `gap < -tol` penetrating by `-gap`. O((FA + FB + EA EB)(VA + VB))
+//!   with early exit on the first separating axis.
+//! * **Clearance** `delta > 0`: pairs whose Euclidean distance is below `delta` are reported too. The SAT gap is only a
+//!   lower bound on the distance of separated polytopes, so candidates with `tol < gap < delta` get their exact
+//!   distance from parry3d-f64's GJK (`query::distance`) on the two polyhedra.
+
+use glam::{DMat3, DVec3};
+use parry3d_f64::bounding_volume::Aabb;
+use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
+use serde::{Deserialize, Serialize};
+use stackplan_geom::polytope::ConvexPolytope;
+use stackplan_geom::{Part, Tolerance};
+
+/// A convex component placed in the world, prepared for separating-axis tests.
+#[derive(Debug, Clone)]
+pub struct PlacedConvex {
+    /// World vertices.
+    pub vertices: Vec<DVec3>,
+    /// Unique face normal directions (up to sign), world frame, unit.
+    pub normal_axes: Vec<DVec3>,
+    /// Unique edge directions (up to sign), world frame, unit.
+    pub edge_directions: Vec<DVec3>,
+    /// World AABB `(min, max)`.
+    pub aabb: (DVec3, DVec3),
+}
+
+/// Adds `d` to `set` unless a parallel (or antiparallel) direction is already there.
+fn push_unique_direction(set: &mut Vec<DVec3>, d: DVec3) {
+    const PARALLEL: f64 = 1e-12;
+    if !set.iter().any(|s| s.cross(d).length_squared() <= PARALLEL) {
+        set.push(d);
+    }
+}
+
+impl PlacedConvex {
+    /// The polytope moved by `x -> rotation x + position`.
+    pub fn new(polytope: &ConvexPolytope, rotation: DMat3, position: DVec3) -> Self {
+        let vertices: Vec<DVec3> = polytope.vertices().iter().map(|v| rotation * *v + position).collect();
+        let mut normal_axes = Vec::with_capacity(polytope.faces().len());
+        for f in polytope.faces() {
+            push_unique_direction(&mut normal_axes, (rotation * f.plane.normal).normalize());
+        }
+        let mut edge_directions = Vec::with_capacity(polytope.edges().len());
+        for e in polytope.edges() {
+            let d = vertices[e.vertices[1]] - vertices[e.vertices[0]];
+            push_unique_direction(&mut edge_directions, d.normalize());
+        }
+        let first = vertices.first().copied().unwrap_or(DVec3::ZERO);
+        let aabb = vertices.iter().fold((first, first), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+        Self { vertices, normal_axes, edge_directions, aabb }
+    }
+}
+
+/// How two convex components relate.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "contact", rename_all = "snake_case")]
+pub enum PairContact {
+    /// Interiors overlap: the minimum translation distance is `depth > tol`.
+    Penetrating {
+        /// Penetration depth (mm).
+        depth: f64,
+    },
+    /// Boundaries touch within the tolerance; `gap` is the signed separation (|gap| <= tol).
+    Touching {
+        /// Signed separation (mm), within the tolerance of zero.
+        gap: f64,
+    },
+    /// Disjoint; `gap` is a lower bound on the distance (the exact distance when it came from GJK).
+    Separated {
+        /// Separation (mm).
+        gap: f64,
+    },
+}
+
+#[inline]
+fn project(vertices: &[DVec3], u: DVec3) -> (f64, f64) {
+    let mut lo = f64::INFINITY;
+    let mut hi = f64::NEG_INFINITY;
+    for v in vertices {
+        let x = u.dot(*v);
+        lo = lo.min(x);
+        hi = hi.max(x);
+    }
+    (lo, hi)
+}
+
+/// The largest separating-axis gap of two placed convex polytopes (see the module documentation); stops early and
+/// returns a gap `> stop_above` as soon as one axis exceeds it.
+pub fn sat_gap(a: &PlacedConvex, b: &PlacedConvex, stop_above: f64) -> f64 {
+    let mut best = f64::NEG_INFINITY;
+    let mut test = |u: DVec3| -> bool {
+        let (a_lo, a_hi) = project(&a.vertices, u);
+        let (b_lo, b_hi) = project(&b.vertices, u);
+        let gap = (b_lo - a_hi).max(a_lo - b_hi);
+        if gap > best {
+            best = gap;
+        }
+        best > stop_above
+    };
+    for &u in a.normal_axes.iter().chain(&b.normal_axes) {
+        if test(u) {
+            return best;
+        }
+    }
+    for &da in &a.edge_directions {
+        for &db in &b.edge_directions {
+            let c = da.cross(db);
+            let len2 = c.length_squared();
+            if len2 <= 1e-18 {
+                continue; // parallel edges: covered by the face normals
+            }
+            if test(c / len2.sqrt()) {
+                return best;
+            }
+        }
+    }
+    best
+}
+
+/// Classifies a convex pair with tolerance `tol`; with `clearance > 0`, a separated pair closer than `clearance` gets
+/// its exact distance (GJK) in `Separated { gap }`.
+pub fn classify_pair(a: &PlacedConvex, b: &PlacedConvex, tol: f64, clearance: f64) -> PairContact {
+    let stop = tol.max(clearance);
+    let gap = sat_gap(a, b, stop);
+    if gap < -tol {
+        PairContact::Penetrating { depth: -gap }
+    } else if gap <= tol {
+        PairContact::Touching { gap }
+    } else if clearance > tol && gap < clearance {
+        PairContact::Separated { gap: gjk_distance(a, b).unwrap_or(gap) }
+    } else {
+        PairContact::Separated { gap }
+    }
+}
+
+/// Euclidean distance of two disjoint placed polytopes by parry3d-f64's GJK (`None` if parry cannot build a shape).
+pub fn gjk_distance(a: &PlacedConvex, b: &PlacedConvex) -> Option<f64> {
+    use parry3d_f64::math::Pose;
+    use parry3d_f64::shape::ConvexPolyhedron;
+    let sa = ConvexPolyhedron::from_convex_hull(&a.vertices)?;
+    let sb = ConvexPolyhedron::from_convex_hull(&b.vertices)?;
+    parry3d_f64::query::distance(&Pose::IDENTITY, &sa, &Pose::IDENTITY, &sb).ok().map(|d| d.distance)
+}
+
+/// A part placed in the world: `world = rotation . part + position`.
+#[derive(Debug, Clone, Copy)]
+pub struct Placement<'a> {
+    /// The part.
+    pub part: &'a Part,
+    /// Rotation.
+    pub rotation: DMat3,
+    /// Position.
+    pub position: DVec3,
+}
+
+/// One interfering (or, with clearance, too close) component pair.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct InterferencePair {
+    /// Component of the moving part.
+    pub moving_piece: usize,
+    /// Index of the placed part.
+    pub fixed_part: usize,
+    /// Component of that placed part.
+    pub fixed_piece: usize,
+    /// Penetrating, touching, or (clearance only) separated by less than the clearance.
+    pub contact: PairContact,
+}
+
+/// The placed parts of a stack, prepared once: placed components and the BVH over their AABBs.
+#[derive(Debug)]
+pub struct PlacedScene {
+    components: Vec<(usize, usize, PlacedConvex)>,
+    bvh: Bvh,
+    tolerance: Tolerance,
+}
+
+fn aabb_of(lo: DVec3, hi: DVec3, grow: f64) -> Aabb {
+    Aabb::new(lo - DVec3::splat(grow), hi + DVec3::splat(grow))
+}
+
+impl PlacedScene {
+    /// Places every component of every part and builds the BVH. The tolerance is the policy's for the largest part
+    /// (or the moving part, passed later, whichever is larger). O(n log n) in the number of components.
+    pub fn new(parts: &[Placement<'_>]) -> Self {
+        let mut components = Vec::new();
+        let mut scale: f64 = 0.0;
+        for (pi, placement) in parts.iter().enumerate() {
+            let (lo, hi) = placement.part.aabb();
+            scale = scale.max((hi - lo).length());
+            for (ci, c) in placement.part.components.iter().enumerate() {
+                components.push((pi, ci, PlacedConvex::new(c, placement.rotation, placement.position)));
+            }
+        }
+        let bvh = Bvh::from_iter(
+            BvhBuildStrategy::default(),
+            components.iter().enumerate().map(|(k, (_, _, c))| (k, aabb_of(c.aabb.0, c.aabb.1, 0.0))),
+        );
+        Self { components, bvh, tolerance: Tolerance::for_scale(scale) }
+    }
+
+    /// Number of placed components.
+    pub fn len(&self) -> usize {
+        self.components.len()
+    }
+
+    /// Whether no component is placed.
+    pub fn is_empty(&self) -> bool {
+        self.components.is_empty()
+    }
+
+    /// The interfering component pairs of `moving` placed by `(rotation, position)`: penetrating and touching pairs,
+    /// and with `clearance > 0` also separated pairs closer than `clearance`. Sorted by (moving, part, piece).
+    pub fn interference_pairs(
+        &self,
+        moving: &Part,
+        rotation: DMat3,
+        position: DVec3,
+        clearance: f64,
+    ) -> Vec<InterferencePair> {
+        let (lo, hi) = moving.aabb();
+        let tol = self.tolerance.linear.max(Tolerance::for_scale((hi - lo).length()).linear);
+        let mut out = Vec::new();
+        for (mi, c) in moving.components.iter().enumerate() {
+            let placed = PlacedConvex::new(c, rotation, position);
+            let query = aabb_of(placed.aabb.0, placed.aabb.1, clearance.max(0.0) + tol);
+            for k in self.bvh.intersect_aabb(&query) {
+                let (fixed_part, fixed_piece, other) = &self.components[k as usize];
+                let contact = classify_pair(&placed, other, tol, clearance);
+                let keep = match contact {
+                    PairContact::Penetrating { .. } | PairContact::Touching { .. } => true,
+                    PairContact::Separated { gap } => clearance > 0.0 && gap < clearance,
+                };
+                if keep {
+                    out.push(InterferencePair {
+                        moving_piece: mi,
+                        fixed_part: *fixed_part,
+                        fixed_piece: *fixed_piece,
+                        contact,
+                    });
+                }
+            }
+        }
+        out.sort_by_key(|p| (p.moving_piece, p.fixed_part, p.fixed_piece));
+        out
+    }
+
+    /// Same as [`Self::interference_pairs`] by testing every component pair (the brute-force reference).
+    pub fn interference_pairs_brute_force(
+        &self,
+        moving: &Part,
+        rotation: DMat3,
+        position: DVec3,
+        clearance: f64,
+    ) -> Vec<InterferencePair> {
+        let (lo, hi) = moving.aabb();
+        let tol = self.tolerance.linear.max(Tolerance::for_scale((hi - lo).length()).linear);
+        let mut out = Vec::new();
+        for (mi, c) in moving.components.iter().enumerate() {
+            let placed = PlacedConvex::new(c, rotation, position);
+            for (fixed_part, fixed_piece, other) in &self.components {
+                let contact = classify_pair(&placed, other, tol, clearance);
+                let keep = match contact {
+                    PairContact::Penetrating { .. } | PairContact::Touching { .. } => true,
+                    PairContact::Separated { gap } => clearance > 0.0 && gap < clearance,
+                };
+                if keep {
+                    out.push(InterferencePair {
+                        moving_piece: mi,
+                        fixed_part: *fixed_part,
+                        fixed_piece: *fixed_piece,
+                        contact,
+                    });
+                }
+            }
+        }
+        out.sort_by_key(|p| (p.moving_piece, p.fixed_part, p.fixed_piece));
+        out
+    }
+
+    /// Only the pairs whose interiors overlap by more than the tolerance (the list `L` of [A] eq. 8).
+    pub fn penetrating_pairs(&self, moving: &Part, rotation: DMat3, position: DVec3) -> Vec<InterferencePair> {
+        let mut v = self.interference_pairs(moving, rotation, position, 0.0);
+        v.retain(|p| matches!(p.contact, PairContact::Penetrating { .. }));
+        v
+    }
+
+    /// The tolerance of the scene.
+    pub fn tolerance(&self) -> Tolerance {
+        self.tolerance
+    }
+}

@@ -1,0 +1,21 @@
+//! # stackplan-cspace
+//!
+//! Translational configuration-space obstacles of convex component pairs ([A] App. B) and what the planner derives
+//! from them:
+//!
+//! * [`minkowski`]: `C(A, B) = B (+) (-R A)` by Gauss-map overlay with vertex and face provenance;
+//! * [`offset`]: clearance (mitred plane offset, [A] eq. 10-11), insertion obstacles (`C (+) {-t z}`, [A]
+//!   condition 4) and slices at constant `p_z`;
+//! * [`interference`]: interference pairs between placed parts ([A] eq. 6-8): a BVH broad phase and an exact
+//!   separating-axis narrow phase reporting penetrating vs touching;
+//! * [`cache`]: an obstacle cache with construction/hit counters.
+
+pub mod cache;
+pub mod interference;
+pub mod minkowski;
+pub mod offset;
+
+pub use cache::{CacheStats, ObstacleCache};
+pub use interference::{InterferencePair, PairContact, PlacedConvex, PlacedScene, Placement};
+pub use minkowski::{FaceKind, Feature, Obstacle, ObstacleError, Route, facet_bound, obstacle, obstacle_by_hull};
+pub use offset::{HalfSpaces, clearance, insertion, insertion_polytope, slice};

@@ -1,0 +1,728 @@
+//! Translational c-space obstacle of a convex pair: `C(A, B) = B (+) (-R A)` with full provenance.
+//!
+//! Paper: Ayyadevara et al. 2002 ([A]) Appendix B, eq. 12: `C(A, B) = ConvexHull{ V_j^B - R V_i^A }`; [A] VI-A-2 (section
+//! 6.1.2 of the manuscript) asks for both an H-representation and a face-based one. The moving component `A` is placed by
+//! `x -> R x + p`; `p` interferes with the fixed component `B` iff `p` lies in the interior of `C` (touching is not
+//! interference, [A] App. A).
+//!
+//! # Algorithm: overlay of the two Gauss maps
+//!
+//! Every face of a Minkowski sum of convex polytopes has an outer normal `u` and is the sum of the support sets of the
+//! summands in direction `u` (`F_u(P + Q) = F_u(P) + F_u(Q)`). The face normals of the sum are the vertices of the
+//! overlay of the two normal fans on the unit sphere:
+//! 1. a face normal of `B` (then the face is that face of `B` plus the support feature of `-RA`: normally a vertex,
+//!    an edge when the normal lies on an edge arc of `-RA`, a face when the two faces are parallel),
+//! 2. a face normal of `-RA` (`-R n_f^A`), likewise,
+//! 3. a proper crossing of an edge arc of `-RA` with an edge arc of `B` (a parallelogram spanned by the two edges).
+//!
+//! The arc of an edge is the great-circle arc between the normals of its two faces; its circle has the edge direction as
+//! normal. Every decision on the sphere goes through one number per (arc, face normal) pair, `c_e . n_f`, classified
+//! with the angular tolerance [`ANGULAR_TOLERANCE`]: the same numbers decide "normal lies on arc" (degenerate faces) and
+//! "arcs cross properly" (edge-edge faces), so the two decisions cannot disagree. Two face normals closer than half the
+//! tolerance are the same direction: the faces are parallel and give ONE merged face (exactly what prisms and boxes
+//! produce all the time). A face polygon is built from the generating features: a face of `B` translated by a vertex
+//! keeps `B`'s vertex cycle, a face of `A` keeps `A`'s (reversed by the point reflection), an edge pair gives a
+//! parallelogram; only the degenerate merged faces need a 2-D convex sum (a hull of at most `|F| * |G|` labelled points
+//! in the face plane, with collinear points on merged parallel edges removed).
+//!
+//! Why a tolerance and not exact predicates: the input to this step is a *rotated* polytope whose coordinates are
+//! already rounded (`cos(pi / 2)` is not 0 in `f64`), so exact parallelism of a rotated face with a fixed one cannot be
+//! decided from the data; the tolerance (1e-9 rad, the policy's [`stackplan_geom::tolerance::RELATIVE`]) is six orders
+//! above rounding noise and merging faces closer than it moves vertices by less than `1e-9 * size`, inside the
+//! policy's length tolerance. Rotations about `z` keep `z` components exact, so horizontal faces merge exactly.
+//!
+//! The result is assembled into a [`ConvexPolytope`] whose construction checks that every edge is shared by exactly two
+//! consistently oriented faces; Euler's formula is checked too. If the overlay was inconsistent (only possible for input
+//! within the tolerance of a degenerate configuration, not at one) the obstacle is built by the exact-predicate hull of
+//! the `nA * nB` difference points instead ([`obstacle_by_hull`]), and the route is recorded in [`Obstacle::route`].
+//!
+//! Complexity: O(FA FB + EA EB + (FA + FB)(EA + EB) + output); the pair loops are a few flops each, which for the
+//! small components of sheet-metal parts beats the O(nA + nB + output) sweep of a true overlay (CGAL's
+//! `Gaussian_map`). The face count is at most `4 m n - 9 m - 9 n + 26` for `m` and `n` facets.
+
+use glam::{DMat3, DVec2, DVec3};
+use serde::{Deserialize, Serialize};
+use stackplan_geom::polytope::{Containment, ConvexPolytope, Plane, PolytopeError};
+use stackplan_geom::predicates::orient2d;
+use stackplan_geom::tolerance::{RELATIVE, Tolerance};
+use stackplan_geom::{HullError, convex_hull};
+use std::cmp::Ordering;
+
+/// Angular tolerance (radians) of the Gauss-map decisions: a face normal within this of an arc's circle lies on it;
+/// two face normals within half of it are the same direction.
+pub const ANGULAR_TOLERANCE: f64 = RELATIVE;
+
+/// A feature (vertex, edge or face index) of one of the two polytopes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(tag = "feature", content = "index", rename_all = "snake_case")]
+pub enum Feature {
+    /// A vertex index.
+    Vertex(usize),
+    /// An edge index (into [`ConvexPolytope::edges`]).
+    Edge(usize),
+    /// A face index.
+    Face(usize),
+}
+
+/// What generated a face of the obstacle. Indices refer to the moving polytope `A` (vertices, edges, faces of `A` in
+/// its own coordinates) and the fixed polytope `B`.
+///
+/// The first three kinds are the generic ones ([A] App. B; DESIGN.md section 3). The last three are the merged faces
+/// of degenerate configurations (parallel faces, a face parallel to an edge): they are exactly one face of the sum and
+/// name both generating features.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum FaceKind {
+    /// Face `face_b` of `B` translated by vertex `vertex_a` of `-RA`: normal = that face's normal.
+    FixedFace {
+        /// Face of `B`.
+        face_b: usize,
+        /// Vertex of `A`.
+        vertex_a: usize,
+    },
+    /// Face `face_a` of `-RA` translated by vertex `vertex_b` of `B`: normal = `-R n_A`.
+    MovingFace {
+        /// Face of `A`.
+        face_a: usize,
+        /// Vertex of `B`.
+        vertex_b: usize,
+    },
+    /// Parallelogram spanned by edge `edge_a` of `-RA` and edge `edge_b` of `B`: normal orthogonal to both.
+    EdgeEdge {
+        /// Edge of `A`.
+        edge_a: usize,
+        /// Edge of `B`.
+        edge_b: usize,
+    },
+    /// Degenerate: face `face_b` of `B` plus a parallel edge `edge_a` of `-RA`.
+    FixedFaceMovingEdge {
+        /// Face of `B`.
+        face_b: usize,
+        /// Edge of `A`.
+        edge_a: usize,
+    },
+    /// Degenerate: face `face_a` of `-RA` plus a parallel edge `edge_b` of `B`.
+    MovingFaceFixedEdge {
+        /// Face of `A`.
+        face_a: usize,
+        /// Edge of `B`.
+        edge_b: usize,
+    },
+    /// Degenerate: face `face_b` of `B` and the parallel face `face_a` of `-RA` (opposite normals in `A`'s frame).
+    FaceFace {
+        /// Face of `A`.
+        face_a: usize,
+        /// Face of `B`.
+        face_b: usize,
+    },
+    /// Only from the hull route on input within rounding of a degenerate configuration: the face's vertex provenance
+    /// does not name a pair of features that can generate a face.
+    Unclassified,
+}
+
+impl FaceKind {
+    /// The kind from the two generating features (`None` if they cannot generate a face).
+    pub fn from_features(fixed: Feature, moving: Feature) -> Option<Self> {
+        Some(match (fixed, moving) {
+            (Feature::Face(face_b), Feature::Vertex(vertex_a)) => Self::FixedFace { face_b, vertex_a },
+            (Feature::Vertex(vertex_b), Feature::Face(face_a)) => Self::MovingFace { face_a, vertex_b },
+            (Feature::Edge(edge_b), Feature::Edge(edge_a)) => Self::EdgeEdge { edge_a, edge_b },
+            (Feature::Face(face_b), Feature::Edge(edge_a)) => Self::FixedFaceMovingEdge { face_b, edge_a },
+            (Feature::Edge(edge_b), Feature::Face(face_a)) => Self::MovingFaceFixedEdge { face_a, edge_b },
+            (Feature::Face(face_b), Feature::Face(face_a)) => Self::FaceFace { face_a, face_b },
+            _ => return None,
+        })
+    }
+
+    /// The generating feature of `B` (`None` for [`FaceKind::Unclassified`]).
+    pub fn fixed_feature(&self) -> Option<Feature> {
+        Some(match *self {
+            Self::FixedFace { face_b, .. }
+            | Self::FixedFaceMovingEdge { face_b, .. }
+            | Self::FaceFace { face_b, .. } => Feature::Face(face_b),
+            Self::MovingFace { vertex_b, .. } => Feature::Vertex(vertex_b),
+            Self::EdgeEdge { edge_b, .. } | Self::MovingFaceFixedEdge { edge_b, .. } => Feature::Edge(edge_b),
+            Self::Unclassified => return None,
+        })
+    }
+
+    /// The generating feature of `A` (`None` for [`FaceKind::Unclassified`]).
+    pub fn moving_feature(&self) -> Option<Feature> {
+        Some(match *self {
+            Self::FixedFace { vertex_a, .. } => Feature::Vertex(vertex_a),
+            Self::MovingFace { face_a, .. }
+            | Self::MovingFaceFixedEdge { face_a, .. }
+            | Self::FaceFace { face_a, .. } => Feature::Face(face_a),
+            Self::EdgeEdge { edge_a, .. } | Self::FixedFaceMovingEdge { edge_a, .. } => Feature::Edge(edge_a),
+            Self::Unclassified => return None,
+        })
+    }
+
+    /// The snake-case name used in JSON (`fixed_face`, `moving_face`, `edge_edge`, ...).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::FixedFace { .. } => "fixed_face",
+            Self::MovingFace { .. } => "moving_face",
+            Self::EdgeEdge { .. } => "edge_edge",
+            Self::FixedFaceMovingEdge { .. } => "fixed_face_moving_edge",
+            Self::MovingFaceFixedEdge { .. } => "moving_face_fixed_edge",
+            Self::FaceFace { .. } => "face_face",
+            Self::Unclassified => "unclassified",
+        }
+    }
+}
+
+/// How an obstacle was built.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Route {
+    /// Gauss-map overlay (the normal route).
+    GaussMap,
+    /// Exact-predicate hull of the difference points (fallback on inconsistent near-degenerate overlays).
+    Hull,
+}
+
+/// Why an obstacle could not be built.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ObstacleError {
+    /// The rotation has a non-finite entry.
+    #[error("the rotation matrix has a non-finite entry")]
+    NonFiniteRotation,
+    /// The difference points have no 3-D hull (a flat or empty component).
+    #[error("the difference points have no 3-D hull: {0}")]
+    Hull(#[from] HullError),
+    /// The assembled boundary is not a polytope (a bug or non-convex input).
+    #[error("the assembled obstacle is not a polytope: {0}")]
+    Polytope(#[from] PolytopeError),
+}
+
+/// The c-space obstacle of a convex pair with provenance. See the module documentation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Obstacle {
+    polytope: ConvexPolytope,
+    vertex_pairs: Vec<[usize; 2]>,
+    face_kinds: Vec<FaceKind>,
+    rotation: DMat3,
+    route: Route,
+}
+
+impl Obstacle {
+    /// The obstacle as a polytope: vertices, faces (counter-clockwise from outside, unit-normal planes
+    /// `n . p <= d` inside), edges.
+    pub fn polytope(&self) -> &ConvexPolytope {
+        &self.polytope
+    }
+
+    /// `vertex_pairs()[v] = [i, j]`: vertex `v` is `V_j^B - R V_i^A` (`i` a vertex of the moving `A`, `j` of `B`),
+    /// computed as `b[j] - (R * a[i])`.
+    pub fn vertex_pairs(&self) -> &[[usize; 2]] {
+        &self.vertex_pairs
+    }
+
+    /// `face_kinds()[f]`: what generated face `f`.
+    pub fn face_kinds(&self) -> &[FaceKind] {
+        &self.face_kinds
+    }
+
+    /// The rotation `R` of the moving component.
+    pub fn rotation(&self) -> DMat3 {
+        self.rotation
+    }
+
+    /// How it was built.
+    pub fn route(&self) -> Route {
+        self.route
+    }
+
+    /// The H-representation: `p` is in the obstacle iff `plane.normal . p <= plane.offset` for every plane.
+    pub fn planes(&self) -> impl ExactSizeIterator<Item = &Plane> + '_ {
+        self.polytope.planes()
+    }
+
+    /// Where `p` is: interior = interference, boundary = touching, exterior = free.
+    pub fn classify(&self, p: DVec3, tol: Tolerance) -> Containment {
+        self.polytope.containment(p, tol)
+    }
+
+    /// Whether `p` interferes (strictly inside by more than `tol`).
+    pub fn interferes(&self, p: DVec3, tol: Tolerance) -> bool {
+        self.classify(p, tol) == Containment::Interior
+    }
+
+    /// Assembles an obstacle from parts (used by extrapolation in later crates; checks nothing beyond lengths).
+    pub fn from_parts(
+        polytope: ConvexPolytope,
+        vertex_pairs: Vec<[usize; 2]>,
+        face_kinds: Vec<FaceKind>,
+        rotation: DMat3,
+        route: Route,
+    ) -> Option<Self> {
+        (polytope.vertices().len() == vertex_pairs.len() && polytope.faces().len() == face_kinds.len())
+            .then_some(Self { polytope, vertex_pairs, face_kinds, rotation, route })
+    }
+}
+
+/// The facet bound `4 m n - 9 m - 9 n + 26` of a Minkowski sum of 3-polytopes with `m` and `n` facets.
+pub fn facet_bound(m: usize, n: usize) -> usize {
+    (4 * m * n + 26).saturating_sub(9 * m + 9 * n)
+}
+
+/// The obstacle of moving `A` (rotation `rotation`) against fixed `B`: Gauss-map overlay, hull fallback.
+pub fn obstacle(moving: &ConvexPolytope, rotation: DMat3, fixed: &ConvexPolytope) -> Result<Obstacle, ObstacleError> {
+    if !rotation.is_finite() {
+        return Err(ObstacleError::NonFiniteRotation);
+    }
+    match gauss_map_obstacle(moving, rotation, fixed) {
+        Ok(o) => Ok(o),
+        Err(reason) => {
+            tracing::debug!(?reason, "Gauss-map overlay inconsistent; building the obstacle by the exact hull");
+            obstacle_by_hull(moving, rotation, fixed)
+        }
+    }
+}
+
+/// The obstacle as the exact-predicate hull of the `nA * nB` difference points `b[j] - R a[i]`, with face kinds
+/// inferred from the vertex provenance. O(nA nB log(nA nB)) expected. The reference route and the fallback.
+pub fn obstacle_by_hull(
+    moving: &ConvexPolytope,
+    rotation: DMat3,
+    fixed: &ConvexPolytope,
+) -> Result<Obstacle, ObstacleError> {
+    if !rotation.is_finite() {
+        return Err(ObstacleError::NonFiniteRotation);
+    }
+    let ra: Vec<DVec3> = moving.vertices().iter().map(|a| rotation * *a).collect();
+    let nb = fixed.vertices().len();
+    let mut points = Vec::with_capacity(ra.len() * nb);
+    for r in &ra {
+        for b in fixed.vertices() {
+            points.push(*b - *r);
+        }
+    }
+    let hull = convex_hull(&points)?;
+    let vertex_pairs: Vec<[usize; 2]> = hull.source.iter().map(|&k| [k / nb, k % nb]).collect();
+    let face_kinds = hull
+        .polytope
+        .faces()
+        .iter()
+        .map(|f| {
+            let mut is: Vec<usize> = f.vertices.iter().map(|&v| vertex_pairs[v][0]).collect();
+            let mut js: Vec<usize> = f.vertices.iter().map(|&v| vertex_pairs[v][1]).collect();
+            let moving_feature = identify_feature(moving, &mut is);
+            let fixed_feature = identify_feature(fixed, &mut js);
+            match (fixed_feature, moving_feature) {
+                (Some(b), Some(a)) => FaceKind::from_features(b, a).unwrap_or(FaceKind::Unclassified),
+                _ => FaceKind::Unclassified,
+            }
+        })
+        .collect();
+    Ok(Obstacle { polytope: hull.polytope, vertex_pairs, face_kinds, rotation, route: Route::Hull })
+}
+
+/// The smallest feature of `p` whose vertex set contains all of `ids` (sorted and deduplicated in place).
+fn identify_feature(p: &ConvexPolytope, ids: &mut Vec<usize>) -> Option<Feature> {
+    ids.sort_unstable();
+    ids.dedup();
+    match ids.len() {
+        0 => None,
+        1 => Some(Feature::Vertex(ids[0])),
+        2 => p
+            .edges()
+            .iter()
+            .position(|e| {
+                let mut v = e.vertices;
+                v.sort_unstable();
+                v == [ids[0], ids[1]]
+            })
+            .map(Feature::Edge),
+        _ => p.faces().iter().position(|f| ids.iter().all(|i| f.vertices.contains(i))).map(Feature::Face),
+    }
+}
+
+/// Why the overlay could not be assembled (then [`obstacle`] takes the hull route).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum OverlayFailure {
+    /// A face normal lies on more than one arc interior of the other polytope.
+    #[error("a face normal lies inside two arcs of the other Gauss map")]
+    AmbiguousSupport,
+    /// A face polygon has fewer than 3 corners.
+    #[error("a face of the sum has fewer than three corners")]
+    FlatFace,
+    /// The faces do not close up into a polytope.
+    #[error("the faces do not close up: {0}")]
+    Assembly(PolytopeError),
+    /// Euler's formula fails.
+    #[error("Euler's formula fails")]
+    Euler,
+}
+
+struct Arc {
+    /// Unit circle normal, oriented so that the arc runs counter-clockwise about it from `from` to `to`.
+    circle: DVec3,
+    /// Face at the start of the arc.
+    from: usize,
+    /// Face at the end of the arc.
+    to: usize,
+    /// End vertices of the edge.
+    vertices: [usize; 2],
+}
+
+/// Arcs of a polytope whose vertices are `vertices` and face normals `normals` (edge topology from `p`).
+fn arcs(p: &ConvexPolytope, vertices: &[DVec3], normals: &[DVec3]) -> Vec<Arc> {
+    p.edges()
+        .iter()
+        .map(|e| {
+            let d = (vertices[e.vertices[1]] - vertices[e.vertices[0]]).normalize();
+            let (n0, n1) = (normals[e.faces[0]], normals[e.faces[1]]);
+            let circle = if n0.cross(n1).dot(d) >= 0.0 { d } else { -d };
+            Arc { circle, from: e.faces[0], to: e.faces[1], vertices: e.vertices }
+        })
+        .collect()
+}
+
+#[inline]
+fn tol_sign(v: f64) -> i8 {
+    if v > ANGULAR_TOLERANCE {
+        1
+    } else if v < -ANGULAR_TOLERANCE {
+        -1
+    } else {
+        0
+    }
+}
+
+/// Whether `u` (already known to lie on the arc's circle) lies strictly inside the arc.
+#[inline]
+fn strictly_inside_arc(arc: &Arc, normals: &[DVec3], u: DVec3) -> bool {
+    normals[arc.from].cross(u).dot(arc.circle) > 0.0 && u.cross(normals[arc.to]).dot(arc.circle) > 0.0
+}
+
+/// The Gauss-map route alone, without the hull fallback (for tests and benchmarks).
+pub fn gauss_map_obstacle(
+    moving: &ConvexPolytope,
+    rotation: DMat3,
+    fixed: &ConvexPolytope,
+) -> Result<Obstacle, OverlayFailure> {
+    let ra: Vec<DVec3> = moving.vertices().iter().map(|a| rotation * *a).collect();
+    // -RA: vertices -ra, normals -R n; edge arcs computed from -ra.
+    let neg_ra: Vec<DVec3> = ra.iter().map(|r| -*r).collect();
+    let am: Vec<DVec3> = moving.faces().iter().map(|f| -(rotation * f.plane.normal).normalize()).collect();
+    let bv = fixed.vertices();
+    let bn: Vec<DVec3> = fixed.faces().iter().map(|f| f.plane.normal).collect();
+    let a_arcs = arcs(moving, &neg_ra, &am);
+    let b_arcs = arcs(fixed, bv, &bn);
+    let (fa, fb) = (am.len(), bn.len());
+
+    // sides: s_ab[e * fb + g] = side of B's normal g w.r.t. the circle of A-arc e; s_ba[e * fa + f] likewise.
+    let s_ab: Vec<i8> = a_arcs.iter().flat_map(|arc| bn.iter().map(move |n| tol_sign(arc.circle.dot(*n)))).collect();
+    let s_ba: Vec<i8> = b_arcs.iter().flat_map(|arc| am.iter().map(move |n| tol_sign(arc.circle.dot(*n)))).collect();
+
+    // parallel faces: merged_with_b[f] = Some(g) when -R n_f == n_g within half the tolerance.
+    let merge_sq = (0.5 * ANGULAR_TOLERANCE) * (0.5 * ANGULAR_TOLERANCE);
+    let mut merged_with_b: Vec<Option<usize>> = vec![None; fa];
+    let mut merged_with_a: Vec<Option<usize>> = vec![None; fb];
+    for (f, m) in am.iter().enumerate() {
+        for (g, n) in bn.iter().enumerate() {
+            if (*m - *n).length_squared() <= merge_sq {
+                merged_with_b[f] = Some(g);
+                merged_with_a[g] = Some(f);
+            }
+        }
+    }
+
+    let mut faces: Vec<FaceSpec> = Vec::with_capacity(fa + fb + 16);
+    // 1. faces of B
+    for (g, &u) in bn.iter().enumerate() {
+        let moving_feature = if let Some(f) = merged_with_a[g] {
+            Feature::Face(f)
+        } else {
+            let mut found = None;
+            for (e, arc) in a_arcs.iter().enumerate() {
+                if s_ab[e * fb + g] == 0 && strictly_inside_arc(arc, &am, u) {
+                    if found.is_some() {
+                        return Err(OverlayFailure::AmbiguousSupport);
+                    }
+                    found = Some(e);
+                }
+            }
+            match found {
+                Some(e) => Feature::Edge(e),
+                None => Feature::Vertex(argmax(&neg_ra, u)),
+            }
+        };
+        faces.push(FaceSpec { normal: u, fixed: Feature::Face(g), moving: moving_feature });
+    }
+    // 2. faces of -RA not parallel to a face of B
+    for (f, &u) in am.iter().enumerate() {
+        if merged_with_b[f].is_some() {
+            continue;
+        }
+        let mut found = None;
+        for (e, arc) in b_arcs.iter().enumerate() {
+            if s_ba[e * fa + f] == 0 && strictly_inside_arc(arc, &bn, u) {
+                if found.is_some() {
+                    return Err(OverlayFailure::AmbiguousSupport);
+                }
+                found = Some(e);
+            }
+        }
+        let fixed_feature = match found {
+            Some(e) => Feature::Edge(e),
+            None => Feature::Vertex(argmax(bv, u)),
+        };
+        faces.push(FaceSpec { normal: u, fixed: fixed_feature, moving: Feature::Face(f) });
+    }
+    // 3. proper arc crossings
+    for (ea, a_arc) in a_arcs.iter().enumerate() {
+        let row = &s_ab[ea * fb..(ea + 1) * fb];
+        for (eb, b_arc) in b_arcs.iter().enumerate() {
+            let (sb0, sb1) = (row[b_arc.from], row[b_arc.to]);
+            if sb0 == 0 || sb0 != -sb1 {
+                continue;
+            }
+            let (sa0, sa1) = (s_ba[eb * fa + a_arc.from], s_ba[eb * fa + a_arc.to]);
+            if sa0 == 0 || sa0 != -sa1 {
+                continue;
+            }
+            let mut x = a_arc.circle.cross(b_arc.circle);
+            if x.dot(am[a_arc.from] + am[a_arc.to]) < 0.0 {
+                x = -x;
+            }
+            if x.dot(bn[b_arc.from] + bn[b_arc.to]) <= 0.0 {
+                continue;
+            }
+            faces.push(FaceSpec { normal: x.normalize(), fixed: Feature::Edge(eb), moving: Feature::Edge(ea) });
+        }
+    }
+    assemble(moving, fixed, rotation, &ra, &a_arcs, &b_arcs, faces)
+}
+
+struct FaceSpec {
+    normal: DVec3,
+    fixed: Feature,
+    moving: Feature,
+}
+
+fn argmax(points: &[DVec3], u: DVec3) -> usize {
+    let mut best = 0;
+    let mut best_value = f64::NEG_INFINITY;
+    for (i, p) in points.iter().enumerate() {
+        let v = u.dot(*p);
+        if v > best_value {
+            best_value = v;
+            best = i;
+        }
+    }
+    best
+}
+
+/// Vertex indices of a feature, as a counter-clockwise cycle about the feature's outward normal for a face of `p`
+/// (reversed when `reflect`, for `-RA`), the two ends for an edge, the vertex itself.
+fn feature_vertices(p: &ConvexPolytope, feature: Feature, arcs: &[Arc], reflect: bool) -> Vec<usize> {
+    match feature {
+        Feature::Vertex(v) => vec![v],
+        Feature::Edge(e) => arcs[e].vertices.to_vec(),
+        Feature::Face(f) => {
+            let mut c = p.faces()[f].vertices.clone();
+            if reflect {
+                c.reverse();
+            }
+            c
+        }
+    }
+}
+
+fn assemble(
+    moving: &ConvexPolytope,
+    fixed: &ConvexPolytope,
+    rotation: DMat3,
+    ra: &[DVec3],
+    a_arcs: &[Arc],
+    b_arcs: &[Arc],
+    specs: Vec<FaceSpec>,
+) -> Result<Obstacle, OverlayFailure> {
+    let bv = fixed.vertices();
+    let nb = bv.len();
+    let mut index_of: Vec<u32> = vec![u32::MAX; ra.len() * nb];
+    let mut vertices: Vec<DVec3> = Vec::with_capacity(specs.len() * 2);
+    let mut vertex_pairs: Vec<[usize; 2]> = Vec::with_capacity(specs.len() * 2);
+    let mut faces: Vec<Vec<usize>> = Vec::with_capacity(specs.len());
+    let mut planes: Vec<Plane> = Vec::with_capacity(specs.len());
+    let mut kinds: Vec<FaceKind> = Vec::with_capacity(specs.len());
+    let mut cycle: Vec<[usize; 2]> = Vec::with_capacity(16);
+    for spec in &specs {
+        cycle.clear();
+        match (spec.fixed, spec.moving) {
+            (Feature::Face(g), Feature::Vertex(i)) => {
+                cycle.extend(fixed.faces()[g].vertices.iter().map(|&j| [i, j]));
+            }
+            (Feature::Vertex(j), Feature::Face(f)) => {
+                cycle.extend(moving.faces()[f].vertices.iter().rev().map(|&i| [i, j]));
+            }
+            (Feature::Edge(eb), Feature::Edge(ea)) => {
+                let [j0, j1] = b_arcs[eb].vertices;
+                let [i0, i1] = a_arcs[ea].vertices;
+                // p00 -> p01 runs along B's edge, p01 -> p11 along -RA's edge
+                let d_b = bv[j1] - bv[j0];
+                let d_a = ra[i0] - ra[i1];
+                if d_b.cross(d_a).dot(spec.normal) > 0.0 {
+                    cycle.extend([[i0, j0], [i0, j1], [i1, j1], [i1, j0]]);
+                } else {
+                    cycle.extend([[i0, j0], [i1, j0], [i1, j1], [i0, j1]]);
+                }
+            }
+            (fixed_feature, moving_feature) => {
+                let js = feature_vertices(fixed, fixed_feature, b_arcs, false);
+                let is = feature_vertices(moving, moving_feature, a_arcs, true);
+                planar_sum(&is, &js, ra, bv, spec.normal, &mut cycle);
+            }
+        }
+        if cycle.len() < 3 {
+            return Err(OverlayFailure::FlatFace);
+        }
+        let mut face = Vec::with_capacity(cycle.len());
+        let mut offset = f64::NEG_INFINITY;
+        for &[i, j] in &cycle {
+            let slot = &mut index_of[i * nb + j];
+            if *slot == u32::MAX {
+                *slot = vertices.len() as u32;
+                vertices.push(bv[j] - ra[i]);
+                vertex_pairs.push([i, j]);
+            }
+            let v = *slot as usize;
+            offset = offset.max(spec.normal.dot(vertices[v]));
+            face.push(v);
+        }
+        faces.push(face);
+        planes.push(Plane { normal: spec.normal, offset });
+        kinds.push(FaceKind::from_features(spec.fixed, spec.moving).unwrap_or(FaceKind::Unclassified));
+    }
+    let (v, f) = (vertices.len(), faces.len());
+    let polytope = ConvexPolytope::with_planes(vertices, faces, planes).map_err(OverlayFailure::Assembly)?;
+    if v + f != polytope.edges().len() + 2 {
+        return Err(OverlayFailure::Euler);
+    }
+    Ok(Obstacle { polytope, vertex_pairs, face_kinds: kinds, rotation, route: Route::GaussMap })
+}
+
+/// Convex polygon `sum_{i in is, j in js} (b_j - R a_i)` in the plane orthogonal to `normal`, counter-clockwise about
+/// `normal`, as labelled corners (collinear points on merged parallel edges dropped). Andrew's monotone chain on at
+/// most `|is| |js|` points, with the angular tolerance for collinearity.
+fn planar_sum(is: &[usize], js: &[usize], ra: &[DVec3], bv: &[DVec3], normal: DVec3, out: &mut Vec<[usize; 2]>) {
+    let (e1, _) = normal.any_orthonormal_pair();
+    let e2 = normal.cross(e1);
+    let mut pts: Vec<(f64, f64, [usize; 2])> = Vec::with_capacity(is.len() * js.len());
+    for &i in is {
+        for &j in js {
+            let p = bv[j] - ra[i];
+            pts.push((p.dot(e1), p.dot(e2), [i, j]));
+        }
+    }
+    // numeric order (not total_cmp: -0.0 and 0.0 must tie, or the chain loses its lexicographic order)
+    pts.sort_by(|a, b| {
+        a.0.partial_cmp(&b.0).unwrap_or(Ordering::Equal).then(a.1.partial_cmp(&b.1).unwrap_or(Ordering::Equal))
+    });
+    // Length tolerance of the policy on the polygon's extent: points closer than it are the same point (sums of
+    // parallel features coincide up to rounding), and a point within it of a hull edge lies on that edge.
+    let (mut lo, mut hi) = ((f64::INFINITY, f64::INFINITY), (f64::NEG_INFINITY, f64::NEG_INFINITY));
+    for p in &pts {
+        lo = (lo.0.min(p.0), lo.1.min(p.1));
+        hi = (hi.0.max(p.0), hi.1.max(p.1));
+    }
+    let lin = RELATIVE * (hi.0 - lo.0).hypot(hi.1 - lo.1);
+    let mut unique: Vec<(f64, f64, [usize; 2])> = Vec::with_capacity(pts.len());
+    for p in pts {
+        if !unique.iter().any(|q| (p.0 - q.0).hypot(p.1 - q.1) <= lin) {
+            unique.push(p);
+        }
+    }
+    let pts = unique;
+
+    // strictly left of the directed line o -> b by more than `lin`
+    let turns_left = |o: &(f64, f64, [usize; 2]), a: &(f64, f64, [usize; 2]), b: &(f64, f64, [usize; 2])| {
+        let (ax, ay, bx, by) = (a.0 - o.0, a.1 - o.1, b.0 - o.0, b.1 - o.1);
+        // o -> a -> b turns left and a is farther than `lin` from the line o -> b
+        ax * by - ay * bx > lin * bx.hypot(by)
+    };
+    // the chain itself uses the exact orientation predicate (a tolerance inside the chain loses corners when nearly
+    // collinear points come in non-monotone order); near-collinear corners are removed afterwards
+    let exact_left = |o: &(f64, f64, [usize; 2]), a: &(f64, f64, [usize; 2]), b: &(f64, f64, [usize; 2])| {
+        orient2d(DVec2::new(o.0, o.1), DVec2::new(a.0, a.1), DVec2::new(b.0, b.1)) == Ordering::Greater
+    };
+    let mut hull: Vec<(f64, f64, [usize; 2])> = Vec::with_capacity(pts.len() + 1);
+    for p in pts.iter() {
+        while hull.len() >= 2 && !exact_left(&hull[hull.len() - 2], &hull[hull.len() - 1], p) {
+            hull.pop();
+        }
+        hull.push(*p);
+    }
+    let lower = hull.len() + 1;
+    for p in pts.iter().rev().skip(1) {
+        while hull.len() >= lower && !exact_left(&hull[hull.len() - 2], &hull[hull.len() - 1], p) {
+            hull.pop();
+        }
+        hull.push(*p);
+    }
+    hull.pop();
+    // The chain's first point is never tested; drop any corner (the first one included) within `lin` of the line
+    // through its neighbours.
+    let mut k = 0;
+    while hull.len() > 3 && k < hull.len() {
+        let n = hull.len();
+        if turns_left(&hull[(k + n - 1) % n], &hull[k], &hull[(k + 1) % n]) {
+            k += 1;
+        } else {
+            hull.remove(k);
+            k = k.saturating_sub(1);
+        }
+    }
+    out.extend(hull.iter().map(|h| h.2));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cuboid(lo: DVec3, hi: DVec3) -> ConvexPolytope {
+        let pts: Vec<DVec3> = (0..8)
+            .map(|i| {
+                DVec3::new(
+                    if i & 1 == 0 { lo.x } else { hi.x },
+                    if i & 2 == 0 { lo.y } else { hi.y },
+                    if i & 4 == 0 { lo.z } else { hi.z },
+                )
+            })
+            .collect();
+        convex_hull(&pts).expect("box").polytope
+    }
+
+    #[test]
+    fn box_box_identity_is_a_box() {
+        let a = cuboid(DVec3::ZERO, DVec3::new(1.0, 2.0, 3.0));
+        let b = cuboid(DVec3::ZERO, DVec3::new(4.0, 5.0, 6.0));
+        let o = obstacle(&a, DMat3::IDENTITY, &b).expect("obstacle");
+        assert_eq!(o.route(), Route::GaussMap);
+        assert_eq!(o.polytope().vertices().len(), 8);
+        assert_eq!(o.polytope().faces().len(), 6);
+        o.polytope().validate().expect("valid");
+        assert!((o.polytope().volume() - 5.0 * 7.0 * 9.0).abs() < 1e-9);
+        assert!(o.face_kinds().iter().all(|k| matches!(k, FaceKind::FaceFace { .. })));
+        let (lo, hi) = o.polytope().aabb();
+        assert_eq!(lo, DVec3::new(-1.0, -2.0, -3.0));
+        assert_eq!(hi, DVec3::new(4.0, 5.0, 6.0));
+    }
+
+    #[test]
+    fn rotated_boxes_about_z() {
+        let a = cuboid(DVec3::ZERO, DVec3::new(1.0, 2.0, 3.0));
+        let b = cuboid(DVec3::ZERO, DVec3::new(4.0, 5.0, 6.0));
+        let o = obstacle(&a, DMat3::from_rotation_z(0.3), &b).expect("obstacle");
+        assert_eq!(o.route(), Route::GaussMap);
+        o.polytope().validate().expect("valid");
+        // octagonal prism: 8 vertical faces + top + bottom
+        assert_eq!(o.polytope().faces().len(), 10);
+        assert_eq!(o.polytope().vertices().len(), 16);
+        let h = obstacle_by_hull(&a, DMat3::from_rotation_z(0.3), &b).expect("hull");
+        assert!((h.polytope().volume() - o.polytope().volume()).abs() < 1e-9);
+    }
+}
