@@ -9,13 +9,22 @@
 //! `ceil(r / 2) + 1` pieces: at most four times the optimum (Hertel & Mehlhorn's bound; for polygons with holes the
 //! same charging argument applies to the reflex vertices of the outline and the convex vertices of the holes).
 //!
-//! Every angle test is the exact [`crate::predicates::orient2d`]. An angle of exactly pi is allowed (the merged
-//! piece has a straight vertex, removed later by [`crate::polygon::drop_collinear`] before extrusion), so collinear
-//! runs do not block merges.
+//! Every angle test is the exact [`crate::predicates::orient2d`]. A merge that leaves an angle of exactly pi at `u`
+//! or `v` is made only when both edges of the merged piece at that vertex lie on the polygon's boundary. Otherwise
+//! the straight vertex, which must be dropped for a strictly convex prism, would sit on a cut shared with another
+//! piece: the prism's side face over the two collinear edges would no longer match the neighbouring prisms' side
+//! faces (a T-junction), and [`crate::part::boundary_faces`] could not recognise the cut as internal. Invariant: a
+//! straight vertex of a piece has both of its edges on the boundary, so pieces of one face meet edge to edge.
+//! (A piece only gets an angle at a vertex by a merge at that vertex, and any later merge across an edge at a
+//! straight vertex would make it reflex and is refused.) For input without three collinear vertices this is exactly
+//! Hertel-Mehlhorn with its four-times-optimal bound; when collinear vertices make some merges end at exactly pi
+//! across a cut, those merges are refused and the bound is not claimed (the tests check that merging never
+//! increases the count and that every piece is convex).
 //!
 //! Complexity: O(t) diagonals, each merge O(size of the two pieces) to splice cycles and re-label half-edges; O(t^2)
 //! in the worst case, linear in practice for the small pieces sheet metal produces.
 
+use crate::polygon::nearly_straight;
 use crate::predicates::orient2d;
 use glam::DVec2;
 use std::cmp::Ordering;
@@ -23,8 +32,12 @@ use std::collections::HashMap;
 
 /// Merges counter-clockwise triangles (indices into `points`, sharing edges as a triangulation of one polygon does)
 /// into convex counter-clockwise pieces by removing inessential diagonals (Hertel-Mehlhorn). Every returned piece is
-/// weakly convex (straight vertices may remain); the pieces tile the union of the triangles.
-pub fn merge_convex(points: &[DVec2], triangles: &[[usize; 3]]) -> Vec<Vec<usize>> {
+/// convex; a straight vertex of a piece has both its edges on the boundary; the pieces tile the union of the
+/// triangles and meet edge to edge.
+///
+/// `flat` (a length, 0 for purely exact behaviour): a merged angle that is convex but [`nearly_straight`] under
+/// `flat` is treated like an angle of exactly pi, so that no piece gets a vertex that extrusion would have to drop.
+pub fn merge_convex(points: &[DVec2], triangles: &[[usize; 3]], flat: f64) -> Vec<Vec<usize>> {
     let mut pieces: Vec<Option<Vec<usize>>> = triangles.iter().map(|t| Some(t.to_vec())).collect();
     let mut owner: HashMap<(usize, usize), usize> = HashMap::with_capacity(3 * triangles.len());
     for (p, t) in triangles.iter().enumerate() {
@@ -46,7 +59,7 @@ pub fn merge_convex(points: &[DVec2], triangles: &[[usize; 3]]) -> Vec<Vec<usize
         let (Some(piece_p), Some(piece_q)) = (&pieces[p], &pieces[q]) else {
             continue;
         };
-        let Some(merged) = merge_if_convex(points, piece_p, piece_q, u, v) else {
+        let Some(merged) = merge_if_convex(points, &owner, piece_p, piece_q, u, v, flat) else {
             continue;
         };
         owner.remove(&(u, v));
@@ -62,8 +75,16 @@ pub fn merge_convex(points: &[DVec2], triangles: &[[usize; 3]]) -> Vec<Vec<usize
 }
 
 /// The union of pieces `p` (containing the directed edge `u -> v`) and `q` (containing `v -> u`) if it is convex at
-/// `u` and `v` (angles at most pi), as one counter-clockwise cycle.
-fn merge_if_convex(points: &[DVec2], p: &[usize], q: &[usize], u: usize, v: usize) -> Option<Vec<usize>> {
+/// `u` and `v` (angles below pi, or exactly pi between two polygon-boundary edges), as one counter-clockwise cycle.
+fn merge_if_convex(
+    points: &[DVec2],
+    owner: &HashMap<(usize, usize), usize>,
+    p: &[usize],
+    q: &[usize],
+    u: usize,
+    v: usize,
+    flat: f64,
+) -> Option<Vec<usize>> {
     let (np, nq) = (p.len(), q.len());
     let i = (0..np).find(|&i| p[i] == u && p[(i + 1) % np] == v)?;
     let j = (0..nq).find(|&j| q[j] == v && q[(j + 1) % nq] == u)?;
@@ -74,9 +95,15 @@ fn merge_if_convex(points: &[DVec2], p: &[usize], q: &[usize], u: usize, v: usiz
     let after_u = q_rot[1];
     let before_v = q_rot[nq - 2];
     let after_v = p_rot[1];
-    if orient2d(points[before_u], points[u], points[after_u]) == Ordering::Less
-        || orient2d(points[before_v], points[v], points[after_v]) == Ordering::Less
+    // an angle of exactly pi is allowed only between two boundary edges (see the module documentation)
+    let on_boundary = |a: usize, b: usize| !owner.contains_key(&(b, a));
+    let acceptable = |before: usize, at: usize, after: usize| match orient2d(points[before], points[at], points[after])
     {
+        Ordering::Greater if !nearly_straight(points[before], points[at], points[after], flat) => true,
+        Ordering::Greater | Ordering::Equal => on_boundary(before, at) && on_boundary(at, after),
+        Ordering::Less => false,
+    };
+    if !acceptable(before_u, u, after_u) || !acceptable(before_v, v, after_v) {
         return None;
     }
     let mut merged = p_rot;
@@ -100,7 +127,7 @@ mod tests {
             (0..8).map(|k| v((k as f64 * 0.785).cos() * 10.0, (k as f64 * 0.785).sin() * 10.0)).collect();
         let outline: Vec<usize> = (0..8).collect();
         let tris = triangulate(&pts, &outline, &[]).expect("triangulation");
-        let pieces = merge_convex(&pts, &tris);
+        let pieces = merge_convex(&pts, &tris, 0.0);
         assert_eq!(pieces.len(), 1);
         assert_eq!(pieces[0].len(), 8);
     }
@@ -109,7 +136,7 @@ mod tests {
     fn l_shape_gives_two_pieces_and_square_hole_four() {
         let pts = vec![v(0.0, 0.0), v(4.0, 0.0), v(4.0, 2.0), v(2.0, 2.0), v(2.0, 4.0), v(0.0, 4.0)];
         let tris = triangulate(&pts, &[0, 1, 2, 3, 4, 5], &[]).expect("triangulation");
-        let pieces = merge_convex(&pts, &tris);
+        let pieces = merge_convex(&pts, &tris, 0.0);
         assert_eq!(pieces.len(), 2);
         let mut area = 0.0;
         for piece in &pieces {
@@ -131,7 +158,7 @@ mod tests {
         ];
         let tris = triangulate(&pts, &[0, 1, 2, 3], &[vec![4, 5, 6, 7]]).expect("triangulation");
         assert_eq!(tris.len(), 8);
-        let pieces = merge_convex(&pts, &tris);
+        let pieces = merge_convex(&pts, &tris, 0.0);
         // a square frame needs 4 convex pieces; Hertel-Mehlhorn finds at most 2r + 1 = 9 and in practice 4 or 5
         assert!((4..=8).contains(&pieces.len()), "{} pieces", pieces.len());
         let area: f64 = pieces

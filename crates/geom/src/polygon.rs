@@ -172,6 +172,41 @@ pub fn is_convex_ccw(points: &[DVec2]) -> bool {
     (0..n).all(|i| orient2d(points[(i + n - 1) % n], points[i], points[(i + 1) % n]) != Ordering::Less)
 }
 
+/// Whether the turn `u -> v -> w` is *nearly straight* under the length `flat`: `w` lies within `flat` of the line
+/// through `u` and `v`, or `u` within `flat` of the line through `v` and `w` (these are the distances that
+/// [`crate::polytope::ConvexPolytope::validate`] tests across the side edge at `v` of an extruded prism). Also true
+/// for an edge shorter than `flat`. Rounded arithmetic: a tolerance decision, not an exact one.
+pub fn nearly_straight(u: DVec2, v: DVec2, w: DVec2, flat: f64) -> bool {
+    let distance = |p: DVec2, a: DVec2, b: DVec2| {
+        let dir = b - a;
+        let len = dir.length();
+        if len > 0.0 { dir.perp_dot(p - a).abs() / len } else { (p - a).length() }
+    };
+    distance(w, u, v) <= flat || distance(u, v, w) <= flat
+}
+
+/// Removes nearly straight vertices ([`nearly_straight`] with `flat`) from a ring, repeatedly, keeping the input
+/// index of every kept point. Exactly straight vertices (collinear runs) are always removed. O(n^2) worst case.
+pub fn simplify_ring(ring: &[(usize, DVec2)], flat: f64) -> Vec<(usize, DVec2)> {
+    let mut out = ring.to_vec();
+    let mut k = 0;
+    let mut unchanged = 0;
+    while out.len() >= 3 && unchanged < out.len() {
+        let n = out.len();
+        let i = k % n;
+        let (u, v, w) = (out[(i + n - 1) % n].1, out[i].1, out[(i + 1) % n].1);
+        if orient2d(u, v, w) == Ordering::Equal || nearly_straight(u, v, w, flat) {
+            out.remove(i);
+            unchanged = 0;
+            k = i + n - 2; // revisit the previous vertex
+        } else {
+            unchanged += 1;
+            k = i + 1;
+        }
+    }
+    out
+}
+
 /// Drops straight vertices (exactly collinear with their neighbours) from a cycle of indices, repeatedly.
 pub fn drop_collinear(cycle: &[usize], points: &[DVec2]) -> Vec<usize> {
     let mut out: Vec<usize> = cycle.to_vec();

@@ -6,10 +6,12 @@
 
 use crate::convex_merge::merge_convex;
 use crate::part::{Part, PartError, PartOrigin};
-use crate::polygon::{FacePlane, RingDefect, check_rings, drop_collinear, is_convex_ccw, ring_orientation};
+use crate::polygon::{
+    FacePlane, RingDefect, check_rings, drop_collinear, is_convex_ccw, ring_orientation, simplify_ring,
+};
 use crate::polytope::{ConvexPolytope, PolytopeError, newell_normal};
 use crate::predicates::orient2d;
-use crate::tolerance::Tolerance;
+use crate::tolerance::{Tolerance, bounding_diagonal};
 use crate::triangulate::{TriangulationError, triangulate_avoiding_slivers};
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
@@ -192,6 +194,9 @@ pub struct FaceDecomposition {
     pub holes: Vec<Vec<usize>>,
     /// Strictly convex counter-clockwise (2-D) polygons tiling the face, straight vertices removed.
     pub pieces: Vec<Vec<usize>>,
+    /// The length below which a turn counts as straight for this face (see [`crate::polygon::nearly_straight`]):
+    /// `SLIVER_FACTOR` policy tolerances for the face's size plus the thickness.
+    pub flat: f64,
 }
 
 impl FaceDecomposition {
@@ -219,7 +224,7 @@ impl SheetMetal {
     pub fn validate(&self) -> Result<(), SheetMetalError> {
         self.check_thickness()?;
         for (i, face) in self.faces.iter().enumerate() {
-            prepare_face(i, face)?;
+            prepare_face(i, face, self.thickness)?;
         }
         Ok(())
     }
@@ -243,17 +248,17 @@ impl SheetMetal {
         let Some(f) = self.faces.get(face) else {
             return Err(SheetMetalError::NoFaces);
         };
-        let mut prepared = prepare_face(face, f)?;
+        let mut prepared = prepare_face(face, f, self.thickness)?;
         let outline_pts: Vec<DVec2> = prepared.outline.iter().map(|&i| prepared.points[i]).collect();
         let raw_pieces = if prepared.holes.is_empty() && is_convex_ccw(&outline_pts) {
             vec![prepared.outline.clone()]
         } else {
-            let sliver = SLIVER_FACTOR * Tolerance::for_points(&prepared.points_on_plane).linear;
+            let sliver = prepared.flat;
             let triangles = triangulate_avoiding_slivers(&prepared.points, &prepared.outline, &prepared.holes, sliver)
                 .map_err(|source| SheetMetalError::Triangulation { face, source })?;
             match decomposition {
                 Decomposition::Triangulation => triangles.iter().map(|t| t.to_vec()).collect(),
-                Decomposition::ConvexMerge => merge_convex(&prepared.points, &triangles),
+                Decomposition::ConvexMerge => merge_convex(&prepared.points, &triangles, prepared.flat),
             }
         };
         prepared.pieces = raw_pieces.iter().map(|p| drop_collinear(p, &prepared.points)).collect();
@@ -305,8 +310,7 @@ fn extrude(face: usize, d: &FaceDecomposition, thickness: f64) -> Result<Vec<Con
         if !keep {
             cycle.reverse();
         }
-        let corners: Vec<DVec3> = cycle.iter().flat_map(|&i| [below[i], above[i]]).collect();
-        let flat = SLIVER_FACTOR * Tolerance::for_points(&corners).linear;
+        let flat = d.flat;
         while cycle.len() >= 3 {
             let m = cycle.len();
             let Some(k) = (0..m).find(|&k| {
@@ -357,7 +361,7 @@ fn prism(cycle: &[usize], below: &[DVec3], above: &[DVec3]) -> Result<ConvexPoly
 }
 
 /// Validates a face and returns it projected, oriented, with no pieces yet.
-fn prepare_face(face: usize, f: &SheetFace) -> Result<FaceDecomposition, SheetMetalError> {
+fn prepare_face(face: usize, f: &SheetFace, thickness: f64) -> Result<FaceDecomposition, SheetMetalError> {
     // rings as given: 0 = outline, k + 1 = hole k
     let rings: Vec<&[DVec3]> =
         std::iter::once(f.outline.as_slice()).chain(f.holes.iter().map(|h| h.as_slice())).collect();
@@ -409,18 +413,36 @@ fn prepare_face(face: usize, f: &SheetFace) -> Result<FaceDecomposition, SheetMe
             return Err(SheetMetalError::ZeroArea { face, ring: Ring::from_index(r) });
         }
     }
-    check_rings(&rings2).map_err(|defect| match defect {
+    // input indices of the ring points, for error reports
+    let input_index: Vec<Vec<usize>> = cleaned.iter().map(|ring| ring.iter().map(|x| x.0).collect()).collect();
+    let report = |defect: RingDefect, index: &[Vec<usize>]| match defect {
         RingDefect::SelfIntersection { ring, edge_a, edge_b } => SheetMetalError::SelfIntersecting {
             face,
             ring: Ring::from_index(ring),
-            edge_a: cleaned[ring][edge_a].0,
-            edge_b: cleaned[ring][edge_b].0,
+            edge_a: index[ring][edge_a],
+            edge_b: index[ring][edge_b],
         },
         RingDefect::HoleNotInside { ring } => SheetMetalError::HoleNotInside { face, hole: ring - 1 },
         RingDefect::HolesOverlap { ring_a, ring_b } => {
             SheetMetalError::HolesOverlap { face, hole_a: ring_a - 1, hole_b: ring_b - 1 }
         }
-    })?;
+    };
+    check_rings(&rings2).map_err(|d| report(d, &input_index))?;
+    // Remove straight and nearly straight vertices (see `FaceDecomposition::flat`), then check again: a ring that
+    // collapses is a sliver, and rings closer than `flat` to each other may now touch.
+    let flat = SLIVER_FACTOR * Tolerance::for_scale(bounding_diagonal(&all3) + thickness).linear;
+    let mut simplified: Vec<Vec<(usize, DVec2)>> = Vec::with_capacity(rings2.len());
+    for (r, (ring, index)) in rings2.iter().zip(&input_index).enumerate() {
+        let tagged: Vec<(usize, DVec2)> = index.iter().copied().zip(ring.iter().copied()).collect();
+        let kept = simplify_ring(&tagged, flat);
+        if kept.len() < 3 {
+            return Err(SheetMetalError::ZeroArea { face, ring: Ring::from_index(r) });
+        }
+        simplified.push(kept);
+    }
+    let rings2: Vec<Vec<DVec2>> = simplified.iter().map(|r| r.iter().map(|x| x.1).collect()).collect();
+    let input_index: Vec<Vec<usize>> = simplified.iter().map(|r| r.iter().map(|x| x.0).collect()).collect();
+    check_rings(&rings2).map_err(|d| report(d, &input_index))?;
     // orient: outline counter-clockwise, holes clockwise (in 2-D)
     let mut points: Vec<DVec2> = Vec::with_capacity(all3.len());
     let mut outline = Vec::new();
@@ -440,5 +462,5 @@ fn prepare_face(face: usize, f: &SheetFace) -> Result<FaceDecomposition, SheetMe
         }
     }
     let points_on_plane = points.iter().map(|q| plane.lift(*q)).collect();
-    Ok(FaceDecomposition { plane, points, points_on_plane, outline, holes, pieces: Vec::new() })
+    Ok(FaceDecomposition { plane, points, points_on_plane, outline, holes, pieces: Vec::new(), flat })
 }

@@ -25,6 +25,7 @@
 //! Complexity: bridging O(h n^2) in the worst case (O(h n log n) typically: the nearest candidate is usually
 //! visible); ear clipping O(n^2) ear tests of O(n) each in the worst case, O(n^2) typically.
 
+use crate::polygon::nearly_straight;
 use crate::predicates::orient2d;
 use glam::DVec2;
 use std::cmp::Ordering;
@@ -77,15 +78,86 @@ pub fn triangulate_avoiding_slivers(
             return Err(TriangulationError::BadRing { ring: r });
         }
     }
-    let polygon = bridge_holes(points, outline, holes)?;
-    clip_ears(points, &polygon, sliver)
+    let polygon = bridge_holes(points, outline, holes, sliver)?;
+    let mut triangles = clip_ears(points, &polygon, sliver)?;
+    make_delaunay(points, &mut triangles);
+    Ok(triangles)
+}
+
+/// Turns a triangulation of a polygon into its *constrained Delaunay* triangulation by Lawson's edge flips
+/// (C. L. Lawson, *Software for C1 surface interpolation*, 1977; the constrained version: L. P. Chew, *Constrained
+/// Delaunay triangulations*, Algorithmica 4, 1989): an edge shared by two triangles `(a, c, x)` and `(c, a, y)` is
+/// replaced by `xy` when `y` lies strictly inside the circumcircle of `(a, c, x)` (Shewchuk's exact `incircle`) and
+/// the quadrilateral is strictly convex (exact `orient2d`). Polygon edges have one triangle and are never flipped.
+/// Each flip strictly lowers the triangulation on the paraboloid lifting, so the loop terminates; O(n^2) flips in
+/// the worst case, about O(n) in practice.
+///
+/// Why: a Delaunay triangulation maximises the smallest angle, so it avoids needle triangles wherever the polygon
+/// allows. Ear clipping on a rotated part produces needles along lines that carry several vertices (hole edges
+/// aligned across holes, common in sheet metal), and needles cannot be extruded into strictly convex prisms.
+fn make_delaunay(points: &[DVec2], triangles: &mut [[usize; 3]]) {
+    use std::collections::HashMap;
+    let incircle = |a: DVec2, b: DVec2, c: DVec2, d: DVec2| {
+        let q = |p: DVec2| robust::Coord { x: p.x, y: p.y };
+        robust::incircle(q(a), q(b), q(c), q(d)) > 0.0
+    };
+    let mut edges: HashMap<(usize, usize), usize> = HashMap::with_capacity(3 * triangles.len());
+    for (i, t) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            edges.insert((t[k], t[(k + 1) % 3]), i);
+        }
+    }
+    let mut stack: Vec<(usize, usize)> = edges.keys().copied().filter(|&(a, c)| a < c).collect();
+    stack.sort_unstable();
+    let mut budget = 8 * triangles.len() * triangles.len() + 16;
+    while let Some((a, c)) = stack.pop() {
+        if budget == 0 {
+            tracing::debug!("Delaunay flip budget exhausted");
+            return;
+        }
+        let (Some(&i), Some(&j)) = (edges.get(&(a, c)), edges.get(&(c, a))) else {
+            continue;
+        };
+        let third = |t: [usize; 3]| t.iter().copied().find(|&v| v != a && v != c);
+        let (Some(x), Some(y)) = (third(triangles[i]), third(triangles[j])) else {
+            continue;
+        };
+        let (pa, pc, px, py) = (points[a], points[c], points[x], points[y]);
+        if px == py || !incircle(pa, pc, px, py) {
+            continue;
+        }
+        if orient2d(px, pa, py) != Ordering::Greater || orient2d(py, pc, px) != Ordering::Greater {
+            continue;
+        }
+        budget -= 1;
+        for t in [triangles[i], triangles[j]] {
+            for m in 0..3 {
+                edges.remove(&(t[m], t[(m + 1) % 3]));
+            }
+        }
+        triangles[i] = [x, a, y];
+        triangles[j] = [y, c, x];
+        for idx in [i, j] {
+            let t = triangles[idx];
+            for m in 0..3 {
+                edges.insert((t[m], t[(m + 1) % 3]), idx);
+            }
+        }
+        for (u, v) in [(a, x), (x, c), (c, y), (y, a)] {
+            stack.push((u.min(v), u.max(v)));
+        }
+    }
 }
 
 /// Joins every hole to the outer polygon by a bridge; returns the weakly simple polygon (with repeated indices).
+///
+/// Among valid bridges, one that is not (nearly) collinear with an edge at either end is preferred (`sliver` as in
+/// [`clip_ears`]); validity is always decided exactly.
 pub fn bridge_holes(
     points: &[DVec2],
     outline: &[usize],
     holes: &[Vec<usize>],
+    sliver: f64,
 ) -> Result<Vec<usize>, TriangulationError> {
     let mut polygon: Vec<usize> = outline.to_vec();
     // (hole index, position of its lexicographically largest vertex)
@@ -113,7 +185,7 @@ pub fn bridge_holes(
         });
         let unmerged: Vec<&Vec<usize>> =
             holes.iter().enumerate().filter(|&(g, _)| !merged[g]).map(|(_, ring)| ring).collect();
-        let found = candidates.into_iter().find(|&k| {
+        let valid = |k: usize| {
             let n = polygon.len();
             let v = points[polygon[k]];
             let v_prev = points[polygon[(k + n - 1) % n]];
@@ -122,7 +194,22 @@ pub fn bridge_holes(
                 && strictly_inside_angle(v_prev, v, v_next, m)
                 && strictly_inside_angle(m_prev, m, m_next, v)
                 && segment_is_free(points, m, v, &polygon, &unmerged)
-        });
+        };
+        // a bridge nearly collinear with an edge at either end would give needle triangles: prefer a clean one
+        let clean = |k: usize| {
+            let n = polygon.len();
+            let v = points[polygon[k]];
+            let v_prev = points[polygon[(k + n - 1) % n]];
+            let v_next = points[polygon[(k + 1) % n]];
+            ![(v_prev, v, m), (m, v, v_next), (v, m, m_next), (m_prev, m, v)]
+                .iter()
+                .any(|&(a, b, c)| orient2d(a, b, c) == Ordering::Equal || nearly_straight(a, b, c, sliver))
+        };
+        let found = candidates
+            .iter()
+            .copied()
+            .find(|&k| clean(k) && valid(k))
+            .or_else(|| candidates.iter().copied().find(|&k| valid(k)));
         let Some(k) = found else {
             return Err(TriangulationError::NoBridge { hole: h });
         };

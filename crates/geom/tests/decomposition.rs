@@ -7,6 +7,7 @@
 use proptest::prelude::*;
 use stackplan_geom::examples;
 use stackplan_geom::polytope::newell_normal;
+use stackplan_geom::predicates::collinear;
 use stackplan_geom::sheet_metal::Ring;
 use stackplan_geom::{
     ConvexPolytope, DMat3, DVec2, DVec3, Decomposition, PartOrigin, SheetFace, SheetMetal, SheetMetalError,
@@ -30,6 +31,20 @@ fn distinct(ring: &[DVec3]) -> Vec<DVec3> {
 
 fn ring_area(ring: &[DVec3]) -> f64 {
     newell_normal(ring.iter().copied()).length() / 2.0
+}
+
+fn perimeter(face: &SheetFace) -> f64 {
+    std::iter::once(&face.outline)
+        .chain(&face.holes)
+        .map(|r| {
+            let r = distinct(r);
+            (0..r.len()).map(|i| (r[(i + 1) % r.len()] - r[i]).length()).sum::<f64>()
+        })
+        .sum()
+}
+
+fn boundary_area(part: &stackplan_geom::Part) -> f64 {
+    part.boundary.iter().map(|b| ring_area(&b.outline) - b.holes.iter().map(|h| ring_area(h)).sum::<f64>()).sum()
 }
 
 fn face_area(face: &SheetFace) -> f64 {
@@ -140,6 +155,10 @@ fn example_component_counts_match_the_seed() {
         assert_eq!(part.origin, PartOrigin::SheetMetal { thickness: 2.0 });
         let merged = check_model(&model, Decomposition::ConvexMerge);
         assert!(merged.iter().sum::<usize>() <= expected, "{name}: merging gave more pieces");
+        // the cuts inside faces are internal whichever way the faces were split
+        let merged_part = model.build_part(name, 1.0, Decomposition::ConvexMerge).expect("part");
+        let (a, b) = (boundary_area(&part), boundary_area(&merged_part));
+        assert!((a - b).abs() <= 1e-9 * a, "{name}: boundary area {a} (triangles) vs {b} (merged)");
         for (m, t) in merged.iter().zip(&counts) {
             assert!(m <= t);
         }
@@ -335,9 +354,22 @@ fn check_random_face(shape: (Vec<DVec2>, Vec<Vec<DVec2>>), placement: Placement,
     let triangles = check_model(&model, Decomposition::Triangulation)[0];
     let merged = check_model(&model, Decomposition::ConvexMerge)[0];
     assert!(merged <= triangles, "merging gave {merged} pieces from {triangles} triangles");
+    // the boundary of a single extruded face: two caps and the side walls along every ring; cuts are internal
+    let expected = 2.0 * face_area(&face) + thickness * perimeter(&face);
+    for d in [Decomposition::Triangulation, Decomposition::ConvexMerge] {
+        let part = model.build_part("random", 1.0, d).expect("part");
+        let got = boundary_area(&part);
+        assert!((got - expected).abs() <= 1e-9 * expected, "{d:?}: boundary area {got} vs {expected}");
+    }
     if let Placement::Exact { .. } = placement {
-        // exact coordinates: the triangulation has n + 2h - 2 triangles unless the face is convex without holes
-        let n = distinct(&face.outline).len() + face.holes.iter().map(|h| distinct(h).len()).sum::<usize>();
+        // exact coordinates: the triangulation has n + 2h - 2 triangles unless the face is convex without holes, where
+        // n counts the vertices that are not straight (straight vertices of collinear runs are removed first)
+        let corners = |r: &[DVec3]| {
+            let r = distinct(r);
+            let m = r.len();
+            (0..m).filter(|&i| !collinear(r[(i + m - 1) % m], r[i], r[(i + 1) % m])).count()
+        };
+        let n = corners(&face.outline) + face.holes.iter().map(|h| corners(h)).sum::<usize>();
         let h = face.holes.len();
         if triangles != 1 {
             assert_eq!(triangles, n + 2 * h - 2);
