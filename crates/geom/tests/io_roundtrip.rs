@@ -441,3 +441,18 @@ fn a_large_convex_mesh_is_checked_quickly() {
     // generous bound (shared, loaded machine); the quadratic fallback would take minutes here
     assert!(start.elapsed().as_secs_f64() < 20.0, "took {:?}", start.elapsed());
 }
+
+#[test]
+fn obj_scene_of_placed_parts_reads_back_as_their_components() {
+    let part = bracket();
+    let poses = [Pose::IDENTITY, Pose::from_translation(DVec3::new(0.0, 0.0, 64.0))];
+    let items: Vec<(&Part, Pose)> = poses.iter().map(|&p| (&part, p)).collect();
+    let text = io::obj_scene_string(&items);
+    let back = io::parse_obj(text.as_bytes(), Path::new("scene.obj"), &ReadOptions::default()).expect("scene");
+    assert_eq!(back.components.len(), 2 * part.components.len());
+    assert!((back.mass.volume - 2.0 * part.mass.volume).abs() < 1e-9 * part.mass.volume);
+    let (lo, hi) = back.aabb();
+    let (plo, phi) = part.aabb();
+    assert_eq!(lo, plo);
+    assert_eq!(hi, phi + DVec3::new(0.0, 0.0, 64.0));
+}

@@ -32,7 +32,7 @@ use std::path::{Path, PathBuf};
 pub use atomic::write_atomic;
 pub use glb::{GlbItem, write_glb};
 pub use json::{parse_part_json, part_json_string, read_part_json, write_part_json};
-pub use obj::{obj_string, parse_obj, read_obj, write_obj};
+pub use obj::{obj_scene_string, obj_string, parse_obj, read_obj, write_obj, write_obj_scene};
 pub use stack::{StackFile, StackPart, read_stack, read_stack_with, write_stack};
 pub use stl::{parse_stl, read_stl, stl_ascii_string, stl_binary_bytes, write_stl_ascii, write_stl_binary};
 

@@ -15,6 +15,7 @@
 use super::mesh::{MeshPolygon, Shell, Welder, part_from_shells};
 use super::{IoError, Place, ReadOptions, check_coordinate, stem_name};
 use crate::part::Part;
+use crate::pose::Pose;
 use glam::DVec3;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -115,6 +116,36 @@ pub fn obj_string(part: &Part) -> String {
         base += c.vertices().len();
     }
     s
+}
+
+/// Several placed parts as one OBJ (a stack export for viewers): one `o <part>_<i>_piece_<j>` per component, with
+/// world coordinates `pose.apply(v)`. Reading it back gives one convex piece per component (up to rounding of the
+/// rotation).
+pub fn obj_scene_string(items: &[(&Part, Pose)]) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "# stackplan scene: {} placed parts", items.len());
+    let mut base = 1usize;
+    for (i, (part, pose)) in items.iter().enumerate() {
+        let name: String = part.name.chars().map(|c| if c.is_whitespace() { '_' } else { c }).collect();
+        for (j, c) in part.components.iter().enumerate() {
+            let _ = writeln!(s, "o {name}_{i}_piece_{j}");
+            for v in c.vertices() {
+                let w = pose.apply(*v);
+                let _ = writeln!(s, "v {:?} {:?} {:?}", w.x, w.y, w.z);
+            }
+            for f in c.faces() {
+                let idx: Vec<String> = f.vertices.iter().map(|&v| (v + base).to_string()).collect();
+                let _ = writeln!(s, "f {}", idx.join(" "));
+            }
+            base += c.vertices().len();
+        }
+    }
+    s
+}
+
+/// Writes several placed parts as one OBJ atomically (see [`obj_scene_string`]).
+pub fn write_obj_scene(path: impl AsRef<Path>, items: &[(&Part, Pose)]) -> Result<(), IoError> {
+    super::atomic::write_atomic(path, obj_scene_string(items).as_bytes())
 }
 
 /// Writes the part as OBJ atomically.
