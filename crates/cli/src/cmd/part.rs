@@ -1,0 +1,197 @@
+//! `stackplan part info PART [--json]` and `stackplan part export PART --glb F | --obj F | --stl F`.
+
+use crate::Outcome;
+use crate::input::{PartArgs, load_part};
+use crate::output;
+use serde::Serialize;
+use stackplan_geom::io::glb::{GlbItem, glb_bytes};
+use stackplan_geom::io::obj::obj_string;
+use stackplan_geom::io::stl::stl_binary_bytes;
+use stackplan_geom::{DVec3, Part};
+use std::path::PathBuf;
+
+/// `part` subcommands.
+#[derive(Debug, clap::Subcommand)]
+pub enum PartCommand {
+    /// Components, volume, centre of gravity and bounding box of a part.
+    Info(InfoArgs),
+    /// Writes the part as binary glTF, OBJ or STL.
+    Export(ExportArgs),
+}
+
+/// Arguments of `part info`.
+#[derive(Debug, clap::Args)]
+pub struct InfoArgs {
+    /// The part.
+    #[command(flatten)]
+    pub part: PartArgs,
+    /// JSON output, including every convex component's vertices and faces.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Arguments of `part export`.
+#[derive(Debug, clap::Args)]
+#[group(id = "target", required = true, multiple = true)]
+pub struct ExportArgs {
+    /// The part.
+    #[command(flatten)]
+    pub part: PartArgs,
+    /// Binary glTF output file.
+    #[arg(long, group = "target")]
+    pub glb: Option<PathBuf>,
+    /// Wavefront OBJ output file (one object per convex component).
+    #[arg(long, group = "target")]
+    pub obj: Option<PathBuf>,
+    /// Binary STL output file.
+    #[arg(long, group = "target")]
+    pub stl: Option<PathBuf>,
+}
+
+/// Runs a `part` subcommand.
+pub fn run(cmd: &PartCommand) -> anyhow::Result<Outcome> {
+    match cmd {
+        PartCommand::Info(a) => info(a),
+        PartCommand::Export(a) => export(a),
+    }
+}
+
+/// The JSON of `part info --json` (documented in docs/formats.md).
+#[derive(Debug, Serialize)]
+pub struct PartInfo {
+    /// Part name.
+    pub name: String,
+    /// How the part was made (`convex_pieces`, `sheet_metal` with thickness, `mesh`, `approximate_decomposition`).
+    pub origin: stackplan_geom::PartOrigin,
+    /// Number of convex components.
+    pub components: usize,
+    /// Volume (mm^3).
+    pub volume: f64,
+    /// Mass (density x volume).
+    pub mass: f64,
+    /// Density used.
+    pub density: f64,
+    /// Centre of gravity (mm).
+    pub center_of_gravity: [f64; 3],
+    /// Inertia tensor about the centre of gravity, rows.
+    pub inertia: [[f64; 3]; 3],
+    /// Bounding box `[min, max]`.
+    pub bounding_box: [[f64; 3]; 2],
+    /// Number of boundary faces of the whole part.
+    pub boundary_faces: usize,
+    /// Every convex component, only with `--json`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pieces: Option<Vec<PieceJson>>,
+}
+
+/// One convex component in `part info --json`.
+#[derive(Debug, Serialize)]
+pub struct PieceJson {
+    /// Vertices.
+    pub vertices: Vec<[f64; 3]>,
+    /// Faces: vertex indices counter-clockwise seen from outside, unit outward normal and offset
+    /// (`normal . x <= offset` inside).
+    pub faces: Vec<FaceJson>,
+    /// Volume of the component.
+    pub volume: f64,
+}
+
+/// A face in JSON.
+#[derive(Debug, Serialize)]
+pub struct FaceJson {
+    /// Vertex indices, counter-clockwise seen from outside.
+    pub vertices: Vec<usize>,
+    /// Unit outward normal.
+    pub normal: [f64; 3],
+    /// Plane offset: `normal . x = offset` on the face, `<=` inside.
+    pub offset: f64,
+}
+
+fn arr(v: DVec3) -> [f64; 3] {
+    v.to_array()
+}
+
+/// The information shown by `part info`.
+pub fn part_info(part: &Part, with_pieces: bool) -> PartInfo {
+    let (lo, hi) = part.aabb();
+    let i = part.mass.inertia;
+    PartInfo {
+        name: part.name.clone(),
+        origin: part.origin.clone(),
+        components: part.components.len(),
+        volume: part.mass.volume,
+        mass: part.mass.mass,
+        density: part.density,
+        center_of_gravity: arr(part.mass.center_of_gravity),
+        inertia: [
+            [i.x_axis.x, i.y_axis.x, i.z_axis.x],
+            [i.x_axis.y, i.y_axis.y, i.z_axis.y],
+            [i.x_axis.z, i.y_axis.z, i.z_axis.z],
+        ],
+        bounding_box: [arr(lo), arr(hi)],
+        boundary_faces: part.boundary.len(),
+        pieces: with_pieces.then(|| {
+            part.components
+                .iter()
+                .map(|c| PieceJson {
+                    vertices: c.vertices().iter().map(|v| arr(*v)).collect(),
+                    faces: c
+                        .faces()
+                        .iter()
+                        .map(|f| FaceJson {
+                            vertices: f.vertices.clone(),
+                            normal: arr(f.plane.normal),
+                            offset: f.plane.offset,
+                        })
+                        .collect(),
+                    volume: c.volume(),
+                })
+                .collect()
+        }),
+    }
+}
+
+fn info(args: &InfoArgs) -> anyhow::Result<Outcome> {
+    let part = load_part(&args.part)?;
+    let info = part_info(&part, args.json);
+    if args.json {
+        output::print_json(&info)?;
+    } else {
+        let text = format!(
+            "part            {}\norigin          {}\ncomponents      {}\nvolume          {:.6} mm^3\nmass            {:.6} (density {})\ncentre of grav. [{:.6}, {:.6}, {:.6}] mm\nbounding box    [{:.3}, {:.3}, {:.3}] .. [{:.3}, {:.3}, {:.3}] mm\nboundary faces  {}\n",
+            info.name,
+            serde_json::to_string(&info.origin)?,
+            info.components,
+            info.volume,
+            info.mass,
+            info.density,
+            info.center_of_gravity[0],
+            info.center_of_gravity[1],
+            info.center_of_gravity[2],
+            info.bounding_box[0][0],
+            info.bounding_box[0][1],
+            info.bounding_box[0][2],
+            info.bounding_box[1][0],
+            info.bounding_box[1][1],
+            info.bounding_box[1][2],
+            info.boundary_faces,
+        );
+        output::print_text(&text)?;
+    }
+    Ok(Outcome::Success)
+}
+
+fn export(args: &ExportArgs) -> anyhow::Result<Outcome> {
+    let part = load_part(&args.part)?;
+    // each writer is atomic (temp file + rename); the format follows the flag, whatever the extension
+    if let Some(path) = &args.glb {
+        output::write_atomic(path, &glb_bytes(&[GlbItem::part(&part)]))?;
+    }
+    if let Some(path) = &args.obj {
+        output::write_atomic(path, obj_string(&part).as_bytes())?;
+    }
+    if let Some(path) = &args.stl {
+        output::write_atomic(path, &stl_binary_bytes(&part))?;
+    }
+    Ok(Outcome::Success)
+}

@@ -1,0 +1,98 @@
+//! The `stackplan` command line.
+//!
+//! Every subcommand is a module in `cmd/` with a `#[derive(clap::Args)] pub struct Args` and a
+//! `pub fn run(args: &Args) -> anyhow::Result<Outcome>`; [`Command`] below lists them. Library crates never print:
+//! only this crate writes to the terminal or to files (JSON on stdout or atomically into files).
+
+pub mod cmd;
+pub mod input;
+pub mod output;
+pub mod render;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// What a command reports back to `main`: success, or checks that failed (non-zero exit without an error message).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outcome {
+    /// Everything asked for was done and every check passed.
+    Success,
+    /// The command ran, but a check it performs failed (exit status 1).
+    ChecksFailed,
+}
+
+/// Plans how to stack polyhedral sheet-metal parts and analyses how parts touch.
+#[derive(Debug, Parser)]
+#[command(name = "stackplan", version, about, long_about = None)]
+pub struct Cli {
+    /// More logging (-v: info, -vv: debug, -vvv: trace).
+    #[arg(short, long, action = clap::ArgAction::Count, global = true)]
+    pub verbose: u8,
+    /// Only errors.
+    #[arg(short, long, global = true)]
+    pub quiet: bool,
+    /// Worker threads (default: all cores). Results do not depend on it.
+    #[arg(long, global = true)]
+    pub threads: Option<usize>,
+    /// The command.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Information about a part, and export to other formats.
+    #[command(subcommand)]
+    Part(cmd::part::PartCommand),
+    /// The built-in examples described and drawn under out/ (the README's first command).
+    Demo(cmd::demo::Args),
+}
+
+/// Runs the command line with the process arguments; returns the exit status.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    init_logging(cli.verbose, cli.quiet);
+    if let Some(n) = cli.threads {
+        if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build_global() {
+            tracing::warn!("could not set the thread count: {e}");
+        }
+    }
+    let result = match &cli.command {
+        Command::Part(c) => cmd::part::run(c),
+        Command::Demo(a) => cmd::demo::run(a),
+    };
+    match result {
+        Ok(Outcome::Success) => ExitCode::SUCCESS,
+        Ok(Outcome::ChecksFailed) => ExitCode::from(1),
+        Err(e) => {
+            #[allow(clippy::print_stderr)]
+            {
+                eprintln!("error: {e:#}");
+            }
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn init_logging(verbose: u8, quiet: bool) {
+    use tracing_subscriber::prelude::*;
+    let level = if quiet {
+        "error"
+    } else {
+        match verbose {
+            0 => "warn",
+            1 => "info",
+            2 => "debug",
+            _ => "trace",
+        }
+    };
+    let filter = tracing_subscriber::EnvFilter::try_from_env("STACKPLAN_LOG")
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(level));
+    let indicatif_layer = tracing_indicatif::IndicatifLayer::new();
+    let _ = tracing_subscriber::registry()
+        .with(filter)
+        .with(tracing_subscriber::fmt::layer().with_writer(indicatif_layer.get_stderr_writer()).with_target(false))
+        .with(indicatif_layer)
+        .try_init();
+}

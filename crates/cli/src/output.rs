@@ -1,0 +1,32 @@
+//! Writing results: JSON to stdout or to a file, always atomically for files (temp file + rename), so an
+//! interrupted or failed run never leaves a half-written output behind.
+
+use serde::Serialize;
+use std::io::Write;
+use std::path::Path;
+
+/// Writes `bytes` to `path` atomically (a temporary file in the same directory, synced, then renamed): the
+/// writer of `stackplan_geom::io`, so the library and the program share one implementation.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    Ok(stackplan_geom::io::atomic::write_atomic(path, bytes)?)
+}
+
+/// Pretty JSON text of `value` with a trailing newline.
+pub fn json_text(value: &impl Serialize) -> anyhow::Result<String> {
+    let mut s = serde_json::to_string_pretty(value)?;
+    s.push('\n');
+    Ok(s)
+}
+
+/// Prints `value` as JSON on stdout.
+pub fn print_json(value: &impl Serialize) -> anyhow::Result<()> {
+    print_text(&json_text(value)?)
+}
+
+/// Prints text on stdout (the one place the CLI writes results to the terminal).
+pub fn print_text(text: &str) -> anyhow::Result<()> {
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())?;
+    out.flush()?;
+    Ok(())
+}

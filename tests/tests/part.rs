@@ -1,0 +1,79 @@
+//! `stackplan part info` and `stackplan part export`, end to end.
+
+mod common;
+use common::*;
+
+#[test]
+fn part_info_json_describes_the_fixture() {
+    for (name, components) in [("channel", 3), ("triangle", 6), ("complex", 79)] {
+        let path = fixture(name);
+        let o = run(&["part", "info", path.to_str().expect("utf-8 path"), "--triangulate", "--json"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let v: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("JSON");
+        assert_eq!(v["components"], components, "{name}");
+        assert_eq!(v["pieces"].as_array().map(Vec::len), Some(components));
+        let volume = v["volume"].as_f64().expect("volume");
+        let pieces: f64 = v["pieces"].as_array().expect("pieces").iter().map(|p| p["volume"].as_f64().expect("v")).sum();
+        assert!((volume - pieces).abs() <= 1e-9 * volume, "{name}: {volume} vs {pieces}");
+        let lo = &v["bounding_box"][0];
+        let hi = &v["bounding_box"][1];
+        let cg = &v["center_of_gravity"];
+        for k in 0..3 {
+            let (l, h, c) = (lo[k].as_f64().expect("lo"), hi[k].as_f64().expect("hi"), cg[k].as_f64().expect("cg"));
+            assert!(l <= c && c <= h, "{name}: c.g. outside the bounding box");
+        }
+    }
+}
+
+#[test]
+fn part_info_text_and_builtin_example() {
+    let o = run(&["part", "info", "example:cube"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    assert!(text.contains("components      1"), "{text}");
+    assert!(text.contains("volume"), "{text}");
+}
+
+#[test]
+fn missing_and_broken_files_are_clear_errors() {
+    let o = run(&["part", "info", "no/such/part.json"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("no/such/part.json"), "{}", stderr(&o));
+
+    let dir = tempfile::tempdir().expect("tempdir");
+    let bad = dir.path().join("bad.json");
+    std::fs::write(&bad, "{\"name\": \"x\", \"sheet_metal\": {\"thickness\": 0, \"faces\": []}}").expect("write");
+    let out = dir.path().join("bad.glb");
+    let o = run_in(dir.path(), &["part", "export", "bad.json", "--glb", "bad.glb"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("bad.json"), "{}", stderr(&o));
+    assert!(!out.exists(), "no output may be written for a failed run");
+    assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 1, "no temporary files left behind");
+
+    let o = run(&["part", "info", "example:no-such-example"]);
+    assert_eq!(o.status.code(), Some(2));
+}
+
+#[test]
+fn export_writes_readable_files() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let part = fixture("channel");
+    let o = run_in(
+        dir.path(),
+        &["part", "export", part.to_str().expect("utf-8"), "--glb", "c.glb", "--obj", "c.obj", "--stl", "c.stl"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let glb = std::fs::read(dir.path().join("c.glb")).expect("glb");
+    assert_eq!(&glb[0..4], b"glTF");
+    assert_eq!(u32::from_le_bytes([glb[8], glb[9], glb[10], glb[11]]) as usize, glb.len());
+    // the exported OBJ and STL read back as parts with the same volume
+    let info = |p: &str| -> f64 {
+        let o = run_in(dir.path(), &["part", "info", p, "--json"]);
+        assert!(o.status.success(), "{p}: {}", stderr(&o));
+        let v: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("JSON");
+        v["volume"].as_f64().expect("volume")
+    };
+    let original = info(part.to_str().expect("utf-8"));
+    let obj = info("c.obj");
+    assert!((obj - original).abs() <= 1e-6 * original, "{obj} vs {original}");
+}
