@@ -63,8 +63,6 @@ pub enum Place {
         /// Point index within the piece.
         point: usize,
     },
-    /// A 0-based sheet-metal face index.
-    Face(usize),
     /// A point of a sheet-metal face outline (`hole: None`) or hole.
     FacePoint {
         /// Face index.
@@ -90,7 +88,6 @@ impl fmt::Display for Place {
             Place::Byte(b) => write!(f, "byte {b}"),
             Place::Piece(p) => write!(f, "piece {p}"),
             Place::PiecePoint { piece, point } => write!(f, "piece {piece}, point {point}"),
-            Place::Face(i) => write!(f, "face {i}"),
             Place::FacePoint { face, hole: None, point } => write!(f, "face {face}, outline point {point}"),
             Place::FacePoint { face, hole: Some(h), point } => write!(f, "face {face}, hole {h}, point {point}"),
             Place::Placement(i) => write!(f, "placement {i}"),
@@ -162,7 +159,7 @@ pub enum IoError {
         /// Byte offset where the data stops matching the header (the start of the first incomplete record, or of
         /// the first extra byte).
         offset: u64,
-        /// Triangle count from the header (`None` when even the header is incomplete).
+        /// Triangle count from the header (0 when even the 84-byte header is incomplete).
         triangles: u64,
         /// Expected size.
         expected: u64,

@@ -182,13 +182,12 @@ fn parse_ascii(bytes: &[u8], file: &Path, welder: &mut Welder) -> Result<(Option
         expect(&mut tokens, "loop")?;
         let mut vertices = Vec::with_capacity(3);
         for _ in 0..3 {
-            let vertex_line = expect(&mut tokens, "vertex")?;
+            expect(&mut tokens, "vertex")?;
             let mut p = [0.0; 3];
             for (c, axis) in p.iter_mut().zip(["x", "y", "z"]) {
                 let (v, l) = number(&mut tokens, axis)?;
                 *c = check_coordinate(v, file, || Place::Line(l))?;
             }
-            let _ = vertex_line;
             vertices.push(welder.index(DVec3::from_array(p)));
         }
         expect(&mut tokens, "endloop")?;
