@@ -390,7 +390,7 @@ impl Problem<'_> {
 
     /// Lexicographic multipliers of the working set: `mult[stage][k]` for the k-th working constraint.
     /// Returns the index (into the working set) of the constraint to drop, if any, and the stage-0 multipliers.
-    fn drop_choice(&self, sub: &Subspace, w: &WorkSet, p: &V4, bland: bool) -> (Option<usize>, V4) {
+    fn drop_choice(&self, sub: &Subspace, w: &WorkSet, p: &V4, bland: bool, banned: &[usize]) -> (Option<usize>, V4) {
         let k = w.len;
         let mut lambda0 = [0.0; MAX_N];
         if k == 0 {
@@ -404,6 +404,9 @@ impl Problem<'_> {
         }
         cholesky(&mut gram, k);
         let mut undecided = [true; MAX_N];
+        for a in 0..k {
+            undecided[a] = !banned.contains(&w.idx[a]);
+        }
         for stage in 0..=self.n {
             let gvec = if stage == 0 { self.gradient(p) } else { unit(self.tie[stage - 1]) };
             let sc = sub.newton(&gvec);
@@ -456,6 +459,10 @@ impl Problem<'_> {
         let limit = 40 * (m + 5);
         let mut p = start;
         let mut w = WorkSet::default();
+        // constraints dropped on a multiplier that rounding made negative: the next move is blocked at once by the
+        // same constraint. They stay in the working set until the point moves.
+        let mut banned: Vec<usize> = Vec::new();
+        let mut last_dropped: Option<usize> = None;
         for iter in 0..limit {
             let sub = Subspace::new(self, &w);
             match self.step(&sub, &p) {
@@ -483,14 +490,23 @@ impl Problem<'_> {
                         _ => {}
                     }
                     axpy(&mut p, alpha, &dir);
+                    if alpha * len > 1e-13 * self.length_scale {
+                        banned.clear();
+                    } else if blocking.is_some() && blocking == last_dropped {
+                        banned.extend(blocking);
+                    }
+                    last_dropped = None;
                     if let Some(j) = blocking {
                         w.push(j);
                     }
                 }
                 Step::Stationary => {
-                    let (drop, multipliers) = self.drop_choice(&sub, &w, &p, iter >= bland_after);
+                    let (drop, multipliers) = self.drop_choice(&sub, &w, &p, iter >= bland_after, &banned);
                     match drop {
-                        Some(k) => w.remove_at(k),
+                        Some(k) => {
+                            last_dropped = Some(w.idx[k]);
+                            w.remove_at(k);
+                        }
                         None => return Ok(Outcome::Optimal { point: p, working: w, multipliers }),
                     }
                 }

@@ -1,0 +1,120 @@
+//! Property tests of subtraction (set preservation, disjointness) and of Omega (the part at any vertex of Omega
+//! touches the floor volume's boundary and stays inside it).
+
+mod common;
+
+use common::{Rng, Shape, bbox, random_cell, random_points};
+use proptest::prelude::*;
+use stackplan_freespace::{
+    Cell, FloorVolume, Obstacle, SubtractOptions, Subtraction, omega, omega_fixed_z, subtract, subtract_from_all,
+};
+use stackplan_geom::{DMat3, DVec2, DVec3, convex_hull};
+
+/// Distance from `p` to the nearest plane of a cell (for skipping ambiguous samples on boundaries).
+fn near_boundary(cell: &Cell<3>, p: &[f64; 3], margin: f64) -> bool {
+    cell.halfspaces().iter().any(|h| h.excess(p).abs() <= margin)
+}
+
+fn strictly_inside(cell: &Cell<3>, p: &[f64; 3], margin: f64) -> bool {
+    cell.halfspaces().iter().all(|h| h.excess(p) < -margin)
+}
+
+proptest! {
+    #[test]
+    fn subtraction_preserves_the_set(seed in any::<u64>(), extra in 0usize..6, npts in 4usize..14, grow in any::<bool>()) {
+        let mut rng = Rng(seed);
+        let cell = random_cell(&mut rng, extra, Shape::Solid);
+        prop_assume!(cell.is_solid());
+        let c = cell.interior_point().expect("point");
+        let (lo, hi) = bbox(&cell);
+        // an obstacle near the cell: the hull of random points around a point of the cell's box
+        let centre = DVec3::new(rng.range(lo[0], hi[0]), rng.range(lo[1], hi[1]), rng.range(lo[2], hi[2]));
+        let centre = centre.lerp(DVec3::from_array(c), rng.range(0.0, 1.0));
+        let radius = rng.range(0.5, 4.0);
+        let pts = random_points(&mut rng, centre, radius, npts);
+        let hull = match convex_hull(&pts) { Ok(h) => h, Err(_) => return Err(TestCaseError::reject("flat hull")) };
+        let obstacle = Obstacle::from_polytope(7, &hull.polytope).expect("obstacle");
+        let delta = if grow { rng.range(0.0, 0.5) } else { 0.0 };
+        let opts = SubtractOptions { clearance: delta, remove_redundant: rng.below(2) == 0 };
+        let pieces = match subtract(&cell, &obstacle, opts).expect("subtract") {
+            Subtraction::Untouched => vec![cell.clone()],
+            Subtraction::Eliminated => vec![],
+            Subtraction::Pieces(p) => p,
+        };
+        let grown: Vec<([f64; 3], f64)> = obstacle.faces().iter().map(|(n, d)| (*n, d + delta)).collect();
+        let margin = 1e-7;
+        let mut checked = 0;
+        for _ in 0..400 {
+            let p = [rng.range(lo[0], hi[0]), rng.range(lo[1], hi[1]), rng.range(lo[2], hi[2])];
+            let obstacle_excess = grown.iter().map(|(n, d)| common::dot(n, &p) - d).fold(f64::NEG_INFINITY, f64::max);
+            if near_boundary(&cell, &p, margin) || obstacle_excess.abs() <= margin
+                || pieces.iter().any(|q| near_boundary(q, &p, margin)) {
+                continue;
+            }
+            checked += 1;
+            let expected = strictly_inside(&cell, &p, margin) && obstacle_excess > margin;
+            let count = pieces.iter().filter(|q| strictly_inside(q, &p, margin)).count();
+            prop_assert_eq!(count, usize::from(expected), "point {:?}: in {} pieces", p, count);
+        }
+        prop_assert!(checked > 100);
+        for i in 0..pieces.len() {
+            prop_assert!(pieces[i].is_solid());
+            for j in i + 1..pieces.len() {
+                let both = pieces[i].intersection(&pieces[j]).expect("intersection");
+                prop_assert!(!both.is_solid(), "pieces {} and {} overlap", i, j);
+            }
+        }
+        // the batch form agrees
+        let all = subtract_from_all(vec![cell.clone()], &obstacle, opts).expect("batch");
+        prop_assert_eq!(all.len(), pieces.len());
+    }
+
+    #[test]
+    fn part_at_any_vertex_of_omega_touches_and_stays_inside(seed in any::<u64>(), sides in 3usize..9, npts in 5usize..20) {
+        let mut rng = Rng(seed);
+        // a convex floor polygon: points on an ellipse at sorted random angles
+        let (a, b) = (rng.range(4.0, 15.0), rng.range(4.0, 15.0));
+        let mut angles: Vec<f64> = (0..sides).map(|_| rng.range(0.0, std::f64::consts::TAU)).collect();
+        angles.sort_by(f64::total_cmp);
+        let polygon: Vec<DVec2> = angles.iter().map(|t| DVec2::new(1.0 + a * t.cos(), -2.0 + b * t.sin())).collect();
+        let floor = match FloorVolume::new(polygon, rng.range(2.0, 10.0)) {
+            Ok(f) => f,
+            Err(_) => return Err(TestCaseError::reject("degenerate polygon")),
+        };
+        let radius = rng.range(0.5, 3.0);
+        let pts = random_points(&mut rng, DVec3::new(0.3, -0.2, 0.5), radius, npts);
+        let hull = match convex_hull(&pts) { Ok(h) => h, Err(_) => return Err(TestCaseError::reject("flat hull")) };
+        let rotation = DMat3::from_rotation_z(rng.range(0.0, 6.3)) * DMat3::from_rotation_x(rng.range(-1.5, 1.5));
+        let rotated: Vec<DVec3> = hull.polytope.vertices().iter().map(|v| rotation * *v).collect();
+        let om = omega(&floor, &rotated).expect("omega");
+        let sigma = floor.halfspaces();
+        let tol = om.tolerance().linear;
+        let pz = -rotated.iter().map(|v| v.z).fold(f64::INFINITY, f64::min);
+        let o2 = omega_fixed_z(&floor, &rotated, pz).expect("2d omega");
+        if om.is_empty() {
+            // the floor is too small for the part: then no height helps either
+            prop_assert!(o2.is_empty());
+            return Ok(());
+        }
+        let poly = om.polyhedron();
+        prop_assert!(poly.vertices.len() >= 4 || !om.is_solid());
+        for p in &poly.vertices {
+            let placed: Vec<[f64; 3]> = rotated.iter().map(|v| [v.x + p[0], v.y + p[1], v.z + p[2]]).collect();
+            let mut touching = 0;
+            for h in &sigma {
+                let worst = placed.iter().map(|q| h.excess(q)).fold(f64::NEG_INFINITY, f64::max);
+                prop_assert!(worst <= 10.0 * tol, "a part vertex leaves the floor volume by {}", worst);
+                if worst >= -10.0 * tol {
+                    touching += 1;
+                }
+            }
+            // a vertex of the 3-D Omega has three tight inequalities: three walls (or floor/ceiling) touched
+            prop_assert!(touching >= 3, "only {} walls touched at an Omega vertex", touching);
+        }
+        // the 2-D Omega at the floor height is the horizontal slice of the 3-D one
+        prop_assert!(!o2.is_empty());
+        for q in o2.polygon() {
+            prop_assert!(om.contains(&[q[0], q[1], pz]) != stackplan_geom::Containment::Exterior);
+        }
+    }
+}
