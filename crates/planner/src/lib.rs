@@ -1,0 +1,28 @@
+//! # stackplan-planner
+//!
+//! Placement of one part in a stack of stationary parts by best-first search over partial c-space obstacles
+//! (Ayyadevara et al. 2002, [A] sections V-VI; DESIGN.md section 6).
+//!
+//! * [`request`]: inputs (part, resting poses, theta set, stack, floor volume or fixed `p_z`, clearance, cost,
+//!   insertion, `k`) and their validation;
+//! * [`orientation`]: per orientation the permissible set `Omega` ([A] eq. 3) and the cost as a separable quadratic;
+//! * [`symmetry`]: rotational symmetry about z in a resting pose (one period searched);
+//! * [`detect`]: interference pairs at a configuration (broad phase + exact narrow phase, insertion sweeps);
+//! * [`obstacles`]: the pair obstacles cut out (plain, insertion, clearance) with face provenance;
+//! * [`qp`]: the QP on a free-space cell with its active constraints;
+//! * [`search`]: the best-first search and its statistics ([A] Tables I-II);
+//! * [`reference`]: the brute-force reference (complete obstacles, complete free space) used by the tests;
+//! * [`regress`]: the scenarios of [A] Figs. 15-17 for `cargo xtask regress`.
+
+pub mod detect;
+pub mod obstacles;
+pub mod orientation;
+pub mod qp;
+pub mod reference;
+pub mod regress;
+pub mod request;
+pub mod search;
+pub mod symmetry;
+
+pub use request::{Cost, FloorVolume, PlacementError, PlacementRequest, StackPart, thetas_with_step, uniform_thetas};
+pub use search::{Contact, NoPlacement, Placement, PlacementResult, PlacementStats, place, place_with_cache};

@@ -1,0 +1,105 @@
+//! The obstacles the search cuts out: the c-space obstacle of one (moving component, stack component) pair at one
+//! orientation ([A] App. B, built by `stackplan-cspace`'s Gauss-map overlay through its [`ObstacleCache`]), turned
+//! into the half-spaces the search subtracts:
+//!
+//! * plain: the obstacle's face planes `n_k . p <= d_k`;
+//! * with insertion: the insertion obstacle `C (+) {-t z : t >= 0}` ([A] condition 4), whose planes are the faces of
+//!   `C` that do not face down plus one vertical plane per silhouette edge;
+//! * with clearance `delta`: every plane moved out by `delta` (the mitred offset of [A] eq. 10-11, a superset of the
+//!   exact `delta`-offset).
+//!
+//! Each plane keeps its provenance (the face kind of `C`, or "insertion side") so an active constraint at an optimum
+//! names the contact. Position `p` *interferes* with the pair iff it lies in the interior of this set by more than
+//! the tolerance: `n_k . p < d_k - tol` for every `k` — the same test, with the same tolerance, as the cells'
+//! membership, so a point on a face (touching) is free everywhere. O(F) per obstacle after its construction.
+
+use crate::detect::StackScene;
+use crate::orientation::Orientation;
+use serde::{Deserialize, Serialize};
+use stackplan_cspace::{FaceKind, ObstacleCache, insertion};
+use stackplan_geom::Part;
+use stackplan_geom::polytope::Plane;
+
+/// Where a plane of a derived obstacle comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum PlaneOrigin {
+    /// A face of the c-space obstacle of the pair.
+    Face {
+        /// The face's kind and generating features.
+        face: FaceKind,
+    },
+    /// A vertical side of the insertion obstacle (through a silhouette edge).
+    InsertionSide,
+}
+
+impl PlaneOrigin {
+    /// Short name for reports (`fixed_face`, `moving_face`, `edge_edge`, ..., `insertion_side`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            PlaneOrigin::Face { face } => face.name(),
+            PlaneOrigin::InsertionSide => "insertion_side",
+        }
+    }
+}
+
+/// An obstacle ready for subtraction.
+#[derive(Debug, Clone)]
+pub struct DerivedObstacle {
+    /// Orientation index.
+    pub orientation: usize,
+    /// Moving component.
+    pub moving: usize,
+    /// Stack component (index into the scene).
+    pub fixed: usize,
+    /// `p` is in the obstacle iff `normal . p <= offset` for all planes.
+    pub planes: Vec<Plane>,
+    /// Provenance of each plane.
+    pub origins: Vec<PlaneOrigin>,
+}
+
+impl DerivedObstacle {
+    /// Builds the obstacle of a pair (see the module documentation). `Err` carries the builder's message.
+    pub fn build(
+        part: &Part,
+        orientation: &Orientation,
+        moving: usize,
+        scene: &StackScene,
+        fixed: usize,
+        cache: &ObstacleCache,
+        clearance: f64,
+        with_insertion: bool,
+    ) -> Result<Self, String> {
+        let sc = &scene.components[fixed];
+        let raw = cache
+            .get_or_build(moving, sc.part, sc.piece, &part.components[moving], orientation.rotation, &sc.world)
+            .map_err(|e| e.to_string())?;
+        let (mut planes, origins): (Vec<Plane>, Vec<PlaneOrigin>) = if with_insertion {
+            let poly = raw.polytope();
+            let ins = insertion(poly);
+            let kept: Vec<PlaneOrigin> = poly
+                .faces()
+                .iter()
+                .zip(raw.face_kinds())
+                .filter(|(f, _)| f.plane.normal.z >= -stackplan_cspace::minkowski::ANGULAR_TOLERANCE)
+                .map(|(_, k)| PlaneOrigin::Face { face: *k })
+                .collect();
+            let mut origins = kept;
+            origins.resize(ins.planes.len(), PlaneOrigin::InsertionSide);
+            (ins.planes, origins)
+        } else {
+            (raw.planes().copied().collect(), raw.face_kinds().iter().map(|k| PlaneOrigin::Face { face: *k }).collect())
+        };
+        if clearance > 0.0 {
+            for p in &mut planes {
+                p.offset += clearance;
+            }
+        }
+        Ok(Self { orientation: orientation.index, moving, fixed, planes, origins })
+    }
+
+    /// Whether `p` lies in the interior by more than `tol` (interference).
+    pub fn interior_contains(&self, p: glam::DVec3, tol: f64) -> bool {
+        self.planes.iter().all(|pl| pl.normal.dot(p) < pl.offset - tol)
+    }
+}

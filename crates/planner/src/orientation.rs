@@ -1,0 +1,140 @@
+//! One discrete orientation of the new part: rotation, the permissible set `Omega` ([A] eq. 3) and the cost as a
+//! separable quadratic (DESIGN.md section 5).
+//!
+//! With `Sigma = {x : a_k . x <= b_k}` and the rotated vertices `R v`,
+//! `Omega(R) = {p : a_k . p <= b_k - max_v a_k . (R v)}`: one inequality per side of the floor polygon, the floor
+//! `p_z >= -min_v (R v)_z` and the ceiling `p_z <= H - max_v (R v)_z`. At a fixed `p_z` the floor and ceiling become
+//! a test of that value and the sides stay. O(V (S + 2)) for `V` vertices and `S` floor sides.
+//!
+//! Both costs are `f(p) = constant + sum_i h_i (p_i - c_i)^2` with `h_i >= 0`. For cost (1) with extents
+//! `x_min, x_max` of `R v`: `(p_x + x_max - x0)^2 + (p_x + x_min - x0)^2 = 2 (p_x - c_x)^2 + (x_max - x_min)^2 / 2`
+//! with `c_x = x0 - (x_max + x_min) / 2`, so `h_x = 2 w`, likewise `y`, and `h_z = 4 (1 - w)`, `c_z = z0 - z_c`.
+//! For the target cost `h = (1, 1, 1)` and `c = target - R g`.
+
+use crate::request::{Cost, FloorVolume};
+use glam::{DMat3, DVec3};
+use stackplan_cspace::PlacedConvex;
+use stackplan_freespace::cell::{Halfspace, Tag};
+use stackplan_geom::Part;
+
+/// A separable convex quadratic `constant + sum_i h_i (p_i - c_i)^2` in three variables.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SeparableQuadratic {
+    /// Curvatures (>= 0).
+    pub h: [f64; 3],
+    /// Centres.
+    pub c: [f64; 3],
+    /// Constant term.
+    pub constant: f64,
+}
+
+impl SeparableQuadratic {
+    /// The value at `p`.
+    pub fn value(&self, p: DVec3) -> f64 {
+        let p = p.to_array();
+        self.constant + (0..3).map(|i| self.h[i] * (p[i] - self.c[i]) * (p[i] - self.c[i])).sum::<f64>()
+    }
+
+    /// The cost of `cost` for a part whose rotated vertices span `[lo, hi]` (relative to the position) and whose
+    /// rotated c.g. offset is `cg`.
+    pub fn of_cost(cost: &Cost, lo: DVec3, hi: DVec3, cg: DVec3) -> Self {
+        match *cost {
+            Cost::Stacking { w, origin } => {
+                let hz = 4.0 * (1.0 - w);
+                Self {
+                    h: [2.0 * w, 2.0 * w, hz],
+                    c: [origin.x - 0.5 * (hi.x + lo.x), origin.y - 0.5 * (hi.y + lo.y), origin.z - cg.z],
+                    constant: 0.5 * w * ((hi.x - lo.x).powi(2) + (hi.y - lo.y).powi(2)),
+                }
+            }
+            Cost::Target { target } => Self { h: [1.0; 3], c: (target - cg).to_array(), constant: 0.0 },
+        }
+    }
+}
+
+/// A discrete orientation with everything the search needs at it.
+#[derive(Debug, Clone)]
+pub struct Orientation {
+    /// Index in the search's orientation list.
+    pub index: usize,
+    /// Resting-pose index.
+    pub rest: usize,
+    /// Index into the theta set.
+    pub theta_index: usize,
+    /// The angle about world z (radians).
+    pub theta: f64,
+    /// `R = R_z(theta) R_rest`.
+    pub rotation: DMat3,
+    /// Lowest corner of the rotated vertices (relative to the position).
+    pub lo: DVec3,
+    /// Highest corner of the rotated vertices.
+    pub hi: DVec3,
+    /// Rotated c.g. offset `R g`.
+    pub cg: DVec3,
+    /// The components rotated, at position zero.
+    pub components: Vec<PlacedConvex>,
+    /// The cost at this orientation.
+    pub quadratic: SeparableQuadratic,
+}
+
+impl Orientation {
+    /// Builds the orientation data. O(total size of the part).
+    pub fn new(
+        part: &Part,
+        index: usize,
+        rest: usize,
+        theta_index: usize,
+        theta: f64,
+        rest_rotation: DMat3,
+        cost: &Cost,
+    ) -> Self {
+        let rotation = DMat3::from_rotation_z(theta) * rest_rotation;
+        let components: Vec<PlacedConvex> =
+            part.components.iter().map(|c| PlacedConvex::new(c, rotation, DVec3::ZERO)).collect();
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for c in &components {
+            lo = lo.min(c.aabb.0);
+            hi = hi.max(c.aabb.1);
+        }
+        let cg = rotation * part.mass.center_of_gravity;
+        let quadratic = SeparableQuadratic::of_cost(cost, lo, hi, cg);
+        Self { index, rest, theta_index, theta, rotation, lo, hi, cg, components, quadratic }
+    }
+
+    /// `max_v d . (R v)` over the rotated vertices.
+    fn support(&self, d: DVec3) -> f64 {
+        self.components.iter().flat_map(|c| c.vertices.iter()).map(|v| d.dot(*v)).fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// The 3-D permissible set's inequalities (sides, floor, ceiling) in that order.
+    pub fn omega_3d(&self, floor: &FloorVolume) -> Vec<Halfspace<3>> {
+        let mut out = Vec::with_capacity(floor.polygon.len() + 2);
+        for (side, (n, d)) in floor.side_planes().into_iter().enumerate() {
+            let dir = DVec3::new(n.x, n.y, 0.0);
+            out.push(Halfspace::new([n.x, n.y, 0.0], d - self.support(dir), Tag::FloorSide { side: side as u32 }));
+        }
+        out.push(Halfspace::new([0.0, 0.0, -1.0], self.lo.z, Tag::Floor));
+        out.push(Halfspace::new([0.0, 0.0, 1.0], floor.height - self.hi.z, Tag::Ceiling));
+        out
+    }
+
+    /// The 2-D permissible set at `p_z = z`: the sides only, or `None` when `z` violates the floor or the ceiling by
+    /// more than `tol` (the part would leave `Sigma`).
+    pub fn omega_2d(&self, floor: &FloorVolume, z: f64, tol: f64) -> Option<Vec<Halfspace<2>>> {
+        if z + self.lo.z < -tol || z + self.hi.z > floor.height + tol {
+            return None;
+        }
+        Some(
+            floor
+                .side_planes()
+                .into_iter()
+                .enumerate()
+                .map(|(side, (n, d))| {
+                    let dir = DVec3::new(n.x, n.y, 0.0);
+                    Halfspace::new([n.x, n.y], d - self.support(dir), Tag::FloorSide { side: side as u32 })
+                })
+                .collect(),
+        )
+    }
+}

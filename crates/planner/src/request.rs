@@ -1,0 +1,272 @@
+//! The inputs of a placement ([A] section II-C, problem (2)): the new part and its candidate orientations, the
+//! stack, the floor volume `Sigma` (or a fixed `p_z`), the clearance, the cost, the insertion option and `k`.
+//!
+//! Validation ([`PlacementRequest::validate`]) is O(size of the floor polygon + number of orientations) and turns every
+//! bad option into a [`PlacementError`] naming the offending value, so the search itself never meets bad input.
+
+use glam::{DMat3, DVec2, DVec3};
+use serde::{Deserialize, Serialize};
+use stackplan_geom::{Part, Pose};
+
+/// The floor volume `Sigma`: a convex floor polygon (counter-clockwise seen from above, in the plane `z = 0`) times
+/// `[0, height]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FloorVolume {
+    /// Corners of the convex floor polygon, counter-clockwise seen from above (mm).
+    pub polygon: Vec<DVec2>,
+    /// Maximum stack height (mm).
+    pub height: f64,
+}
+
+impl FloorVolume {
+    /// The rectangle `[x0, x1] x [y0, y1]` times `[0, height]`.
+    pub fn rectangle(x0: f64, y0: f64, x1: f64, y1: f64, height: f64) -> Self {
+        Self { polygon: vec![DVec2::new(x0, y0), DVec2::new(x1, y0), DVec2::new(x1, y1), DVec2::new(x0, y1)], height }
+    }
+
+    /// The vertex centroid of the floor polygon at `z = 0` (the default origin `(x0, y0, z0)` of cost (1)).
+    pub fn centre(&self) -> DVec3 {
+        let n = self.polygon.len().max(1) as f64;
+        let s = self.polygon.iter().fold(DVec2::ZERO, |a, b| a + *b) / n;
+        DVec3::new(s.x, s.y, 0.0)
+    }
+
+    /// Outward unit normals and offsets of the polygon's sides: `n . (x, y) <= d` inside; side `k` runs from corner
+    /// `k` to corner `k + 1`.
+    pub fn side_planes(&self) -> Vec<(DVec2, f64)> {
+        let n = self.polygon.len();
+        (0..n)
+            .map(|k| {
+                let (a, b) = (self.polygon[k], self.polygon[(k + 1) % n]);
+                let e = b - a;
+                let normal = DVec2::new(e.y, -e.x).normalize();
+                (normal, normal.dot(a))
+            })
+            .collect()
+    }
+}
+
+/// The cost minimised over positions at each orientation; both are separable convex quadratics in `p`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Cost {
+    /// The new part's term of [A] eq. (1) with the rotated part's bounding-box extents and c.g. height
+    /// (DESIGN.md section 5): `w [(p_x + x_max - x0)^2 + (p_x + x_min - x0)^2 + (p_y + y_max - y0)^2 +
+    /// (p_y + y_min - y0)^2] + 4 (1 - w) (p_z + z_c - z0)^2`.
+    Stacking {
+        /// Weight of floor-space use against c.g. height, in `[0, 1]`.
+        w: f64,
+        /// `(x0, y0, z0)`: the centre or a corner of the floor area.
+        origin: DVec3,
+    },
+    /// The squared distance of the part's c.g. to a desired position ([A] section 7.1).
+    Target {
+        /// Desired c.g. position (mm).
+        target: DVec3,
+    },
+}
+
+/// A part already in the stack: never moves during a placement.
+#[derive(Debug, Clone, Copy)]
+pub struct StackPart<'a> {
+    /// The part.
+    pub part: &'a Part,
+    /// Its pose (`world = rotation . v + position`).
+    pub pose: Pose,
+}
+
+/// Everything a placement needs. See the module documentation; [`PlacementRequest::new`] gives the defaults.
+#[derive(Debug, Clone)]
+pub struct PlacementRequest<'a> {
+    /// The new part.
+    pub part: &'a Part,
+    /// Candidate resting poses as rotations `R(phi, psi)` applied before `R_z(theta)` (default: the identity, the
+    /// part as it lies in its file).
+    pub resting_rotations: Vec<DMat3>,
+    /// The discrete rotation angles about world `z` (radians; default 1-degree steps over a full turn).
+    pub thetas: Vec<f64>,
+    /// The stack.
+    pub stack: Vec<StackPart<'a>>,
+    /// The floor volume `Sigma`.
+    pub floor: FloorVolume,
+    /// `Some(z)`: the 2-D permissible set at `p_z = z` ([A] VII-A-2); `None`: the 3-D one.
+    pub fixed_z: Option<f64>,
+    /// Minimum distance between the new part's components and the stack's (mm); obstacles grown by it ([A] eq. 10-11).
+    pub clearance: f64,
+    /// The cost.
+    pub cost: Cost,
+    /// Require the final position to be reachable by a straight vertical descent from above (insertion obstacles).
+    pub insertion: bool,
+    /// How many placements (best first, one per free-space cell).
+    pub k: usize,
+    /// Search one period of the part's rotational symmetry about z only (when the theta set allows it).
+    pub use_symmetry: bool,
+    /// Largest number of search nodes popped before giving up with [`PlacementError::NodeBudget`].
+    pub node_budget: usize,
+}
+
+/// `n` angles `0, 2 pi / n, ...` (a full turn in equal steps).
+pub fn uniform_thetas(n: usize) -> Vec<f64> {
+    (0..n).map(|k| k as f64 * std::f64::consts::TAU / n as f64).collect()
+}
+
+/// Angles `0, step, 2 step, ...` below a full turn (`step` in radians, positive).
+pub fn thetas_with_step(step: f64) -> Vec<f64> {
+    if !(step > 0.0 && step.is_finite()) {
+        return Vec::new();
+    }
+    let n = (std::f64::consts::TAU / step - 1e-9).ceil().max(1.0) as usize;
+    (0..n).map(|k| k as f64 * step).collect()
+}
+
+impl<'a> PlacementRequest<'a> {
+    /// Defaults: the part as it lies, 1-degree steps, no clearance, cost (1) with `w = 0.5` about the floor centre,
+    /// no insertion, `k = 1`, symmetry on, 3-D permissible set.
+    pub fn new(part: &'a Part, stack: Vec<StackPart<'a>>, floor: FloorVolume) -> Self {
+        let origin = floor.centre();
+        Self {
+            part,
+            resting_rotations: vec![DMat3::IDENTITY],
+            thetas: uniform_thetas(360),
+            stack,
+            floor,
+            fixed_z: None,
+            clearance: 0.0,
+            cost: Cost::Stacking { w: 0.5, origin },
+            insertion: false,
+            k: 1,
+            use_symmetry: true,
+            node_budget: 2_000_000,
+        }
+    }
+
+    /// Checks every option; see [`PlacementError`].
+    pub fn validate(&self) -> Result<(), PlacementError> {
+        let poly = &self.floor.polygon;
+        if poly.len() < 3 {
+            return Err(PlacementError::BadFloor(format!(
+                "the floor polygon has {} corners, needs at least 3",
+                poly.len()
+            )));
+        }
+        if let Some(i) = poly.iter().position(|c| !c.is_finite()) {
+            return Err(PlacementError::BadFloor(format!("floor corner {i} is not finite")));
+        }
+        let n = poly.len();
+        let mut area2 = 0.0;
+        for k in 0..n {
+            let (a, b, c) = (poly[k], poly[(k + 1) % n], poly[(k + 2) % n]);
+            area2 += a.perp_dot(b);
+            if (b - a).length() == 0.0 {
+                return Err(PlacementError::BadFloor(format!("floor corners {k} and {} coincide", (k + 1) % n)));
+            }
+            if (b - a).perp_dot(c - b) < 0.0 {
+                return Err(PlacementError::BadFloor(format!(
+                    "the floor polygon is not convex and counter-clockwise at corner {}",
+                    (k + 1) % n
+                )));
+            }
+        }
+        if area2.is_nan() || area2 <= 0.0 {
+            return Err(PlacementError::BadFloor("the floor polygon has no area (or is clockwise)".into()));
+        }
+        if !(self.floor.height > 0.0 && self.floor.height.is_finite()) {
+            return Err(PlacementError::BadFloor(format!(
+                "the maximum height must be positive and finite, got {}",
+                self.floor.height
+            )));
+        }
+        if self.thetas.is_empty() {
+            return Err(PlacementError::BadOption("the theta set is empty".into()));
+        }
+        if let Some(i) = self.thetas.iter().position(|t| !t.is_finite()) {
+            return Err(PlacementError::BadOption(format!("theta {i} is not finite")));
+        }
+        if self.resting_rotations.is_empty() {
+            return Err(PlacementError::BadOption("no resting pose given".into()));
+        }
+        for (i, r) in self.resting_rotations.iter().enumerate() {
+            if Pose::new(*r, DVec3::ZERO).is_err() {
+                return Err(PlacementError::BadOption(format!("resting pose {i} is not a proper rotation")));
+            }
+        }
+        for (i, s) in self.stack.iter().enumerate() {
+            if s.pose.check().is_err() {
+                return Err(PlacementError::BadOption(format!("stack part {i} has an invalid pose")));
+            }
+        }
+        if !(self.clearance >= 0.0 && self.clearance.is_finite()) {
+            return Err(PlacementError::BadOption(format!(
+                "the clearance must be non-negative and finite, got {}",
+                self.clearance
+            )));
+        }
+        if self.k == 0 {
+            return Err(PlacementError::BadOption("k must be at least 1".into()));
+        }
+        if self.node_budget == 0 {
+            return Err(PlacementError::BadOption("the node budget must be at least 1".into()));
+        }
+        match self.cost {
+            Cost::Stacking { w, origin } => {
+                if !(0.0..=1.0).contains(&w) {
+                    return Err(PlacementError::BadOption(format!("w must lie in [0, 1], got {w}")));
+                }
+                if !origin.is_finite() {
+                    return Err(PlacementError::BadOption("the cost origin is not finite".into()));
+                }
+            }
+            Cost::Target { target } => {
+                if !target.is_finite() {
+                    return Err(PlacementError::BadOption("the target is not finite".into()));
+                }
+            }
+        }
+        if self.fixed_z.is_some_and(|z| !z.is_finite()) {
+            return Err(PlacementError::BadOption("the fixed p_z is not finite".into()));
+        }
+        Ok(())
+    }
+}
+
+/// Why a placement could not be computed. "Fits nowhere" is not an error: it is an empty
+/// [`crate::search::Placement`] list with [`crate::search::NoPlacement`] as the reason.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PlacementError {
+    /// The floor volume is malformed.
+    #[error("bad floor volume: {0}")]
+    BadFloor(String),
+    /// An option is out of range or contradictory.
+    #[error("bad option: {0}")]
+    BadOption(String),
+    /// An obstacle could not be built for a component pair.
+    #[error(
+        "obstacle of moving component {moving_piece} against stack part {fixed_part} component {fixed_piece}: {reason}"
+    )]
+    Obstacle {
+        /// Component of the new part.
+        moving_piece: usize,
+        /// Stack part.
+        fixed_part: usize,
+        /// Its component.
+        fixed_piece: usize,
+        /// The obstacle builder's message.
+        reason: String,
+    },
+    /// The placement QP or a cell LP failed numerically.
+    #[error("free-space cell of orientation {orientation}: {reason}")]
+    FreeSpace {
+        /// Orientation index.
+        orientation: usize,
+        /// The solver's message.
+        reason: String,
+    },
+    /// The search popped more nodes than allowed (a safeguard; the search always terminates in exact arithmetic).
+    #[error("the search exceeded its node budget of {budget} nodes after finding {found} placement(s)")]
+    NodeBudget {
+        /// The budget.
+        budget: usize,
+        /// Placements found before giving up.
+        found: usize,
+    },
+}

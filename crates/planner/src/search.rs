@@ -1,0 +1,606 @@
+//! Best-first search over (orientation, free-space cell) nodes: the placement of one part ([A] V-A..C, DESIGN.md
+//! section 6).
+//!
+//! A node is an orientation `theta_k`, a convex cell `K` of positions (an H-polytope, [A] VI-A-1) and the optimum
+//! `p*` of the cost over `K` (`f(p*)` is the key). The roots are `(theta_k, Omega(theta_k))`. Loop:
+//!
+//! 1. pop the cheapest node (ties: lower orientation index, then lower cell id — deterministic);
+//! 2. detect the interfering component pairs at `(theta_k, p*)` ([`crate::detect`]);
+//! 3. take the first of them (deepest violation first) whose obstacle ([`crate::obstacles`]) contains `p*` in its
+//!    interior by more than the tolerance, and split `K` into the children
+//!    `K n {n_k . p >= d_k} n {n_j . p <= d_j, j < k}` ([A] VI-A-3), solving each child's QP ([`crate::qp`]) and
+//!    pushing the non-empty ones;
+//! 4. if there is none, `p*` is free: it is the next placement (one per cell, in cost order, [A] VI-A-4).
+//!
+//! **Exactness.** The children cover `K` minus the obstacle's interior and each lies in `K`, so no child costs less
+//! than its parent; a position is free iff it lies in no pair's obstacle interior. Hence the first free optimum popped
+//! is the minimum of the cost over the free positions of all discrete orientations ([A] eq. 9 and section 5.3); the
+//! next pops give the next best cells. Orientations whose root is never popped before the `k`-th solution are never
+//! expanded, and only the obstacles of pairs met at popped optima are built.
+//!
+//! **Touching.** The QP's optimum lies on the planes of its active constraints; the obstacle test, the cell
+//! membership and the narrow phase all use the one tolerance of the problem ([`stackplan_geom::Tolerance`], the
+//! largest part's diagonal), so a point on an obstacle face is free and a popped node is never split by an obstacle it
+//! was already cut from (this is also checked explicitly: each node carries the obstacles applied on its path).
+//!
+//! **Termination.** A node is split only by an obstacle whose interior holds its optimum; children lie outside that
+//! interior, so along a path each (orientation, pair) obstacle is applied at most once and every path is finite. A
+//! node budget guards against numerical trouble with a typed error.
+//!
+//! **Cost.** One QP per node; per popped node one interference detection (O(m_part m_stack) box tests plus the
+//! narrow phase on overlapping boxes) and at most one obstacle construction. Root QPs run in parallel (rayon); the
+//! loop itself is sequential, so the result does not depend on the thread count.
+
+use crate::detect::{DetectCounts, StackScene, SweepAxes, candidates};
+use crate::obstacles::DerivedObstacle;
+use crate::orientation::{Orientation, SeparableQuadratic};
+use crate::qp::{QpOptimum, Quadratic, minimise};
+use crate::request::{PlacementError, PlacementRequest};
+use crate::symmetry::{is_uniform_full_turn, period_length, rotational_order};
+use glam::{DMat3, DVec3};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use stackplan_cspace::ObstacleCache;
+use stackplan_freespace::cell::{Cell, Halfspace, Tag};
+use stackplan_geom::{Pose, Tolerance};
+use std::cmp::Ordering;
+use std::collections::{BinaryHeap, HashMap};
+use std::time::Instant;
+
+/// What the new part touches at a placement (from the active constraints of its cell).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "with", rename_all = "snake_case")]
+pub enum Contact {
+    /// A component of a stack part, through the obstacle face of the given kind.
+    Stack {
+        /// Component of the new part.
+        our_component: usize,
+        /// Stack part index.
+        stack_part: usize,
+        /// Its component.
+        stack_component: usize,
+        /// Face kind of the c-space obstacle (`fixed_face`: a face of the stack component against one of our
+        /// vertices; `moving_face`: one of our faces against a stack vertex; `edge_edge`; the degenerate merged kinds
+        /// `face_face`, `fixed_face_moving_edge`, `moving_face_fixed_edge`; `insertion_side`).
+        face_kind: String,
+    },
+    /// The part rests on the floor.
+    Floor,
+    /// The part touches the maximum height.
+    Ceiling,
+    /// The part touches side `side` of the floor polygon (from corner `side` to `side + 1`).
+    FloorSide {
+        /// The side.
+        side: u32,
+    },
+}
+
+/// One placement of the new part.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Placement {
+    /// Position `p` (mm): world vertex = rotation . v + position.
+    pub position: [f64; 3],
+    /// Rotation matrix rows `R_z(theta) R_rest`.
+    pub rotation: [[f64; 3]; 3],
+    /// Angle about z (radians).
+    pub theta: f64,
+    /// Angle about z (degrees).
+    pub theta_deg: f64,
+    /// Index of the resting pose (into the request's list).
+    pub resting_pose: usize,
+    /// The cost (the new part's term of cost (1), or the squared c.g. distance to the target).
+    pub cost: f64,
+    /// What it touches.
+    pub contacts: Vec<Contact>,
+}
+
+impl Placement {
+    /// The pose.
+    pub fn pose(&self) -> Pose {
+        Pose {
+            rotation: DMat3::from_cols_array_2d(&self.rotation).transpose(),
+            position: DVec3::from_array(self.position),
+        }
+    }
+}
+
+/// Counters and timings of a search, as [A] Tables I-II.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct PlacementStats {
+    /// Resting poses x theta values asked for.
+    pub orientations_requested: usize,
+    /// Orientations in the search after symmetry reduction.
+    pub orientations_searched: usize,
+    /// Symmetry order about z of each resting pose (1 = none).
+    pub symmetry_orders: Vec<usize>,
+    /// Orientations whose root was popped at least once ("considered").
+    pub orientations_considered: usize,
+    /// Orientations whose permissible set was empty.
+    pub orientations_empty_omega: usize,
+    /// Components of the new part.
+    pub part_components: usize,
+    /// Components of the stack.
+    pub stack_components: usize,
+    /// m_part x m_stack x orientations requested (the seed's "total pairs").
+    pub total_pairs: u64,
+    /// m_part x m_stack x orientations searched.
+    pub total_pairs_searched: u64,
+    /// Distinct (orientation, component pair) whose obstacle was built or extrapolated.
+    pub pairs_evaluated: u64,
+    /// Obstacles constructed from scratch (Gauss-map overlay).
+    pub obstacles_constructed: u64,
+    /// Obstacles extrapolated within a constant-topology interval (0 until orient-interval is integrated).
+    pub obstacles_extrapolated: u64,
+    /// Obstacle lookups answered by the cache.
+    pub obstacle_cache_hits: u64,
+    /// Interference detections (configurations tested).
+    pub interference_tests: u64,
+    /// Exact narrow-phase pair tests.
+    pub narrow_phase_tests: u64,
+    /// Nodes popped.
+    pub nodes_expanded: u64,
+    /// Nodes pushed (non-empty cells).
+    pub nodes_pushed: u64,
+    /// Children found empty.
+    pub cells_empty: u64,
+    /// QPs solved.
+    pub qp_solves: u64,
+    /// Setup time (orientations, scene), ms.
+    pub time_setup_ms: f64,
+    /// Root QPs, ms.
+    pub time_roots_ms: f64,
+    /// Interference detection, ms.
+    pub time_interference_ms: f64,
+    /// Obstacle construction, ms.
+    pub time_obstacles_ms: f64,
+    /// Cell subtraction and child QPs, ms.
+    pub time_cells_ms: f64,
+    /// Whole search, ms.
+    pub time_total_ms: f64,
+}
+
+/// Why no placement was found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NoPlacement {
+    /// The part does not fit in the floor volume at any orientation (Omega is empty).
+    EmptyOmega,
+    /// Every free-space cell of every orientation was exhausted: the part fits nowhere.
+    FitsNowhere,
+}
+
+/// The result of a placement search.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlacementResult {
+    /// The best placements, cheapest first (at most `k`).
+    pub placements: Vec<Placement>,
+    /// Set when fewer than `k` were found: why the search ran dry.
+    pub exhausted: Option<NoPlacement>,
+    /// Counters and timings.
+    pub stats: PlacementStats,
+}
+
+struct Node<const D: usize> {
+    cost: f64,
+    orientation: usize,
+    id: u64,
+    cell: Cell<D>,
+    optimum: QpOptimum<D>,
+    applied: Vec<u32>,
+}
+
+impl<const D: usize> PartialEq for Node<D> {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+impl<const D: usize> Eq for Node<D> {}
+impl<const D: usize> PartialOrd for Node<D> {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl<const D: usize> Ord for Node<D> {
+    /// Reversed so that `BinaryHeap` pops the cheapest (then lowest orientation, then lowest id).
+    fn cmp(&self, other: &Self) -> Ordering {
+        other.cost.total_cmp(&self.cost).then(other.orientation.cmp(&self.orientation)).then(other.id.cmp(&self.id))
+    }
+}
+
+/// The point of `D` variables in the world (`p_z = fixed_z` when `D = 2`).
+fn lift<const D: usize>(p: &[f64; D], fixed_z: f64) -> DVec3 {
+    if D == 3 { DVec3::new(p[0], p[1], p[2]) } else { DVec3::new(p[0], p[1], fixed_z) }
+}
+
+/// A world plane restricted to the `D` variables: `Ok(halfspace)`, or `Err(holds)` when it does not depend on them
+/// (`holds`: satisfied by every point, within `tol`).
+fn restrict<const D: usize>(normal: DVec3, offset: f64, fixed_z: f64, tol: f64) -> Result<([f64; D], f64), bool> {
+    if D == 3 {
+        return Ok((std::array::from_fn(|i| normal[i]), offset));
+    }
+    let off = offset - normal.z * fixed_z;
+    if normal.x.hypot(normal.y) <= 1e-12 {
+        return Err(off >= -tol);
+    }
+    Ok((std::array::from_fn(|i| normal[i]), off))
+}
+
+fn restrict_quadratic<const D: usize>(q: &SeparableQuadratic, fixed_z: f64) -> Quadratic<D> {
+    let mut constant = q.constant;
+    if D == 2 {
+        constant += q.h[2] * (fixed_z - q.c[2]).powi(2);
+    }
+    Quadratic { h: std::array::from_fn(|i| q.h[i]), c: std::array::from_fn(|i| q.c[i]), constant }
+}
+
+/// The search state shared by the loop.
+struct Search<'r, 'a> {
+    request: &'r PlacementRequest<'a>,
+    orientations: Vec<Orientation>,
+    sweeps: Vec<Option<SweepAxes>>,
+    scene: StackScene,
+    tol: Tolerance,
+    cache: &'r ObstacleCache,
+    obstacles: Vec<DerivedObstacle>,
+    obstacle_ids: HashMap<(usize, usize, usize), u32>,
+    stats: PlacementStats,
+}
+
+/// Places the part (see the module documentation) with a fresh obstacle cache.
+pub fn place(request: &PlacementRequest<'_>) -> Result<PlacementResult, PlacementError> {
+    place_with_cache(request, &ObstacleCache::new())
+}
+
+/// Places the part, building obstacles through `cache` (shareable across successive placements into a growing stack
+/// whose parts keep their indices and poses: a cached obstacle depends only on the pair and the rotation).
+pub fn place_with_cache(
+    request: &PlacementRequest<'_>,
+    cache: &ObstacleCache,
+) -> Result<PlacementResult, PlacementError> {
+    request.validate()?;
+    let start = Instant::now();
+    let part = request.part;
+    let scale = request
+        .stack
+        .iter()
+        .map(|s| {
+            let (lo, hi) = s.part.aabb();
+            (hi - lo).length()
+        })
+        .fold(
+            {
+                let (lo, hi) = part.aabb();
+                (hi - lo).length()
+            },
+            f64::max,
+        );
+    let tol = Tolerance::for_scale(scale);
+    // orientations, one symmetry period per resting pose
+    let n_theta = request.thetas.len();
+    let uniform = is_uniform_full_turn(&request.thetas);
+    let mut orientations = Vec::new();
+    let mut symmetry_orders = Vec::new();
+    for (rest, r) in request.resting_rotations.iter().enumerate() {
+        let order = if request.use_symmetry { rotational_order(part, *r, 10.0 * part.tolerance().linear) } else { 1 };
+        symmetry_orders.push(order);
+        let count = if uniform { period_length(n_theta, order) } else { n_theta };
+        for (ti, &theta) in request.thetas.iter().enumerate().take(count) {
+            orientations.push((rest, ti, theta, *r));
+        }
+    }
+    let orientations: Vec<Orientation> = orientations
+        .into_par_iter()
+        .enumerate()
+        .map(|(i, (rest, ti, theta, r))| Orientation::new(part, i, rest, ti, theta, r, &request.cost))
+        .collect();
+    let stack_refs: Vec<(&stackplan_geom::Part, Pose)> = request.stack.iter().map(|s| (s.part, s.pose)).collect();
+    let scene = StackScene::new(&stack_refs);
+    let sweeps: Vec<Option<SweepAxes>> = if request.insertion {
+        orientations.par_iter().map(|o| Some(SweepAxes::new(part, o.rotation, o))).collect()
+    } else {
+        vec![None; orientations.len()]
+    };
+    let stats = PlacementStats {
+        orientations_requested: request.resting_rotations.len() * n_theta,
+        orientations_searched: orientations.len(),
+        symmetry_orders,
+        part_components: part.components.len(),
+        stack_components: scene.components.len(),
+        total_pairs: (part.components.len() * scene.components.len() * request.resting_rotations.len() * n_theta)
+            as u64,
+        total_pairs_searched: (part.components.len() * scene.components.len() * orientations.len()) as u64,
+        ..Default::default()
+    };
+    let mut search = Search {
+        request,
+        orientations,
+        sweeps,
+        scene,
+        tol,
+        cache,
+        obstacles: Vec::new(),
+        obstacle_ids: HashMap::new(),
+        stats,
+    };
+    let before = cache.stats();
+    search.stats.time_setup_ms = ms(start);
+    let result = match request.fixed_z {
+        None => search.run::<3>(0.0),
+        Some(z) => search.run::<2>(z),
+    };
+    let after = cache.stats();
+    let mut result = result?;
+    result.stats.obstacles_constructed = after.constructions - before.constructions;
+    result.stats.obstacle_cache_hits = after.hits - before.hits;
+    result.stats.time_total_ms = ms(start);
+    tracing::info!(
+        placements = result.placements.len(),
+        nodes = result.stats.nodes_expanded,
+        pairs = result.stats.pairs_evaluated,
+        total_pairs = result.stats.total_pairs,
+        ms = result.stats.time_total_ms,
+        "placement search done"
+    );
+    Ok(result)
+}
+
+fn ms(since: Instant) -> f64 {
+    since.elapsed().as_secs_f64() * 1e3
+}
+
+impl Search<'_, '_> {
+    fn root_cell<const D: usize>(&self, o: &Orientation, fixed_z: f64) -> Result<Option<Cell<D>>, PlacementError> {
+        let fs_err = |e: stackplan_freespace::cell::CellError| PlacementError::FreeSpace {
+            orientation: o.index,
+            reason: e.to_string(),
+        };
+        let hs: Vec<Halfspace<D>> = if D == 3 {
+            o.omega_3d(&self.request.floor)
+                .into_iter()
+                .map(|h| Halfspace::new(std::array::from_fn(|i| h.normal[i]), h.offset, h.tag))
+                .collect()
+        } else {
+            match o.omega_2d(&self.request.floor, fixed_z, self.tol.linear) {
+                Some(v) => v
+                    .into_iter()
+                    .map(|h| Halfspace::new(std::array::from_fn(|i| h.normal[i]), h.offset, h.tag))
+                    .collect(),
+                None => return Ok(None),
+            }
+        };
+        let cell = Cell::new(hs, self.tol).map_err(fs_err)?;
+        Ok((!cell.is_empty()).then_some(cell))
+    }
+
+    fn run<const D: usize>(&mut self, fixed_z: f64) -> Result<PlacementResult, PlacementError> {
+        let t_roots = Instant::now();
+        // roots in parallel, collected in orientation order
+        let roots: Vec<Result<Option<(Cell<D>, QpOptimum<D>)>, PlacementError>> = self
+            .orientations
+            .par_iter()
+            .map(|o| {
+                let Some(cell) = self.root_cell::<D>(o, fixed_z)? else {
+                    return Ok(None);
+                };
+                let q = restrict_quadratic::<D>(&o.quadratic, fixed_z);
+                let opt =
+                    minimise(&cell, &q).map_err(|reason| PlacementError::FreeSpace { orientation: o.index, reason })?;
+                Ok(opt.map(|opt| (cell, opt)))
+            })
+            .collect();
+        let mut heap: BinaryHeap<Node<D>> = BinaryHeap::new();
+        let mut next_id: u64 = 0;
+        for (i, r) in roots.into_iter().enumerate() {
+            match r? {
+                Some((cell, optimum)) => {
+                    self.stats.qp_solves += 1;
+                    heap.push(Node {
+                        cost: optimum.value,
+                        orientation: i,
+                        id: next_id,
+                        cell,
+                        optimum,
+                        applied: Vec::new(),
+                    });
+                }
+                None => self.stats.orientations_empty_omega += 1,
+            }
+            next_id += 1;
+        }
+        self.stats.nodes_pushed = heap.len() as u64;
+        self.stats.time_roots_ms = ms(t_roots);
+        if heap.is_empty() {
+            return Ok(PlacementResult {
+                placements: Vec::new(),
+                exhausted: Some(NoPlacement::EmptyOmega),
+                stats: self.stats.clone(),
+            });
+        }
+        let mut considered = vec![false; self.orientations.len()];
+        let mut placements: Vec<Placement> = Vec::new();
+        let mut found_points: Vec<(usize, DVec3)> = Vec::new();
+        let clearance = self.request.clearance;
+        let tol = self.tol.linear;
+        while let Some(node) = heap.pop() {
+            self.stats.nodes_expanded += 1;
+            if self.stats.nodes_expanded > self.request.node_budget as u64 {
+                return Err(PlacementError::NodeBudget { budget: self.request.node_budget, found: placements.len() });
+            }
+            considered[node.orientation] = true;
+            let p = lift(&node.optimum.point, fixed_z);
+            let t_det = Instant::now();
+            let mut counts = DetectCounts::default();
+            let cands = candidates(
+                &self.scene,
+                &self.orientations[node.orientation],
+                self.sweeps[node.orientation].as_ref(),
+                p,
+                clearance,
+                tol,
+                &mut counts,
+            );
+            self.stats.interference_tests += 1;
+            self.stats.narrow_phase_tests += counts.narrow_phase;
+            self.stats.time_interference_ms += ms(t_det);
+            // the first candidate whose obstacle holds p* in its interior
+            let mut cutting: Option<u32> = None;
+            for c in &cands {
+                let id = self.obstacle_id(node.orientation, c.moving, c.fixed)?;
+                if node.applied.contains(&id) {
+                    continue;
+                }
+                if self.obstacles[id as usize].interior_contains(p, tol) {
+                    cutting = Some(id);
+                    break;
+                }
+            }
+            let Some(id) = cutting else {
+                // free: a placement, unless it repeats one already found (cells share boundaries)
+                let dup = found_points
+                    .iter()
+                    .any(|(oi, q)| *oi == node.orientation && (*q - p).abs().max_element() <= 1e3 * tol);
+                if !dup {
+                    found_points.push((node.orientation, p));
+                    placements.push(self.placement(&node, p));
+                    if placements.len() >= self.request.k {
+                        break;
+                    }
+                }
+                continue;
+            };
+            let t_cells = Instant::now();
+            let children = self.split::<D>(&node, id, fixed_z)?;
+            for (cell, optimum) in children {
+                let mut applied = node.applied.clone();
+                applied.push(id);
+                self.stats.nodes_pushed += 1;
+                heap.push(Node {
+                    cost: optimum.value,
+                    orientation: node.orientation,
+                    id: next_id,
+                    cell,
+                    optimum,
+                    applied,
+                });
+                next_id += 1;
+            }
+            self.stats.time_cells_ms += ms(t_cells);
+        }
+        self.stats.orientations_considered = considered.iter().filter(|c| **c).count();
+        let exhausted = (placements.len() < self.request.k).then_some(NoPlacement::FitsNowhere);
+        Ok(PlacementResult { placements, exhausted, stats: self.stats.clone() })
+    }
+
+    /// The id of the derived obstacle of a pair at an orientation, building it on first use.
+    fn obstacle_id(&mut self, orientation: usize, moving: usize, fixed: usize) -> Result<u32, PlacementError> {
+        if let Some(id) = self.obstacle_ids.get(&(orientation, moving, fixed)) {
+            return Ok(*id);
+        }
+        let t = Instant::now();
+        let o = &self.orientations[orientation];
+        let built = DerivedObstacle::build(
+            self.request.part,
+            o,
+            moving,
+            &self.scene,
+            fixed,
+            self.cache,
+            self.request.clearance,
+            self.request.insertion,
+        )
+        .map_err(|reason| {
+            let sc = &self.scene.components[fixed];
+            PlacementError::Obstacle { moving_piece: moving, fixed_part: sc.part, fixed_piece: sc.piece, reason }
+        })?;
+        let id = self.obstacles.len() as u32;
+        self.obstacles.push(built);
+        self.obstacle_ids.insert((orientation, moving, fixed), id);
+        self.stats.pairs_evaluated += 1;
+        self.stats.time_obstacles_ms += ms(t);
+        Ok(id)
+    }
+
+    /// The children of `node` cut by obstacle `id`, with their optima (empty children dropped).
+    fn split<const D: usize>(
+        &mut self,
+        node: &Node<D>,
+        id: u32,
+        fixed_z: f64,
+    ) -> Result<Vec<(Cell<D>, QpOptimum<D>)>, PlacementError> {
+        let tol = self.tol.linear;
+        let obstacle = &self.obstacles[id as usize];
+        let o = &self.orientations[node.orientation];
+        let q = restrict_quadratic::<D>(&o.quadratic, fixed_z);
+        let fs_err = |reason: String| PlacementError::FreeSpace { orientation: node.orientation, reason };
+        let mut inside: Vec<Halfspace<D>> = Vec::new();
+        let mut children = Vec::new();
+        for (k, plane) in obstacle.planes.iter().enumerate() {
+            let face = k as u32;
+            match restrict::<D>(plane.normal, plane.offset, fixed_z, tol) {
+                Ok((normal, offset)) => {
+                    let keep = Halfspace::new(normal, offset, Tag::ObstacleFace { obstacle: u64::from(id), face });
+                    let outside = keep.flipped(Tag::ObstacleFace { obstacle: u64::from(id), face });
+                    let extra = inside.iter().copied().chain(std::iter::once(outside));
+                    let cell = node.cell.with_halfspaces(extra).map_err(|e| fs_err(e.to_string()))?;
+                    if cell.is_empty() {
+                        self.stats.cells_empty += 1;
+                    } else {
+                        self.stats.qp_solves += 1;
+                        match minimise(&cell, &q).map_err(fs_err)? {
+                            Some(opt) => children.push((cell, opt)),
+                            None => self.stats.cells_empty += 1,
+                        }
+                    }
+                    inside.push(Halfspace::new(normal, offset, Tag::ObstacleCut { obstacle: u64::from(id), face }));
+                }
+                // a horizontal plane at fixed z: satisfied everywhere (no outside child, no cut needed) or nowhere
+                // (the slice of the obstacle is empty: nothing to cut; cannot happen for an obstacle holding p*)
+                Err(true) => {}
+                Err(false) => {
+                    return Err(fs_err(format!(
+                        "obstacle {id} holds the optimum but its slice at p_z = {fixed_z} is empty (inconsistent)"
+                    )));
+                }
+            }
+        }
+        Ok(children)
+    }
+
+    fn placement<const D: usize>(&self, node: &Node<D>, p: DVec3) -> Placement {
+        let o = &self.orientations[node.orientation];
+        let mut contacts = Vec::new();
+        for &j in &node.optimum.active {
+            let contact = match node.cell.halfspaces()[j].tag {
+                Tag::ObstacleFace { obstacle, face } => {
+                    let ob = &self.obstacles[obstacle as usize];
+                    let sc = &self.scene.components[ob.fixed];
+                    Contact::Stack {
+                        our_component: ob.moving,
+                        stack_part: sc.part,
+                        stack_component: sc.piece,
+                        face_kind: ob.origins[face as usize].name().to_string(),
+                    }
+                }
+                Tag::Floor => Contact::Floor,
+                Tag::Ceiling => Contact::Ceiling,
+                Tag::FloorSide { side } => Contact::FloorSide { side },
+                Tag::ObstacleCut { .. } | Tag::User(_) => continue,
+            };
+            if !contacts.contains(&contact) {
+                contacts.push(contact);
+            }
+        }
+        if D == 2 && (p.z + o.lo.z).abs() <= self.tol.linear {
+            contacts.push(Contact::Floor);
+        }
+        Placement {
+            position: p.to_array(),
+            rotation: o.rotation.transpose().to_cols_array_2d(),
+            theta: o.theta,
+            theta_deg: o.theta.to_degrees(),
+            resting_pose: o.rest,
+            cost: o.quadratic.value(p),
+            contacts,
+        }
+    }
+}

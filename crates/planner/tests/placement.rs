@@ -1,0 +1,115 @@
+//! Placement of one part: golden cases by hand, errors, symmetry, determinism.
+
+use glam::{DMat3, DVec3};
+use stackplan_geom::{Part, PartOrigin, Pose, convex_hull};
+use stackplan_planner::reference::violations;
+use stackplan_planner::{
+    Contact, Cost, FloorVolume, NoPlacement, PlacementError, PlacementRequest, StackPart, place, uniform_thetas,
+};
+
+fn cuboid_part(lo: DVec3, hi: DVec3) -> Part {
+    let pts: Vec<DVec3> = (0..8)
+        .map(|i| {
+            DVec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            )
+        })
+        .collect();
+    Part::from_components("box", vec![convex_hull(&pts).expect("box").polytope], 1.0, PartOrigin::ConvexPieces)
+        .expect("part")
+}
+
+#[test]
+fn box_goes_on_top_of_a_box() {
+    let base = cuboid_part(DVec3::ZERO, DVec3::new(100.0, 100.0, 50.0));
+    let small = cuboid_part(DVec3::ZERO, DVec3::new(50.0, 50.0, 50.0));
+    let floor = FloorVolume::rectangle(-200.0, -200.0, 300.0, 300.0, 400.0);
+    let stack = vec![StackPart { part: &base, pose: Pose::IDENTITY }];
+    let mut req = PlacementRequest::new(&small, stack.clone(), floor);
+    req.thetas = uniform_thetas(4);
+    req.cost = Cost::Target { target: DVec3::new(50.0, 50.0, 0.0) };
+    req.k = 3;
+    let res = place(&req).expect("placement");
+    assert!(!res.placements.is_empty());
+    let best = &res.placements[0];
+    assert!((best.cost - 75.0 * 75.0).abs() < 1e-6, "cost {}", best.cost);
+    let pose = best.pose();
+    let cg = pose.apply(small.mass.center_of_gravity);
+    assert!((cg - DVec3::new(50.0, 50.0, 75.0)).length() < 1e-6, "c.g. {cg}");
+    assert!(best.contacts.iter().any(|c| matches!(c, Contact::Stack { stack_part: 0, .. })), "{:?}", best.contacts);
+    // sorted, and every one valid by the independent all-pairs check
+    for w in res.placements.windows(2) {
+        assert!(w[0].cost <= w[1].cost + 1e-9);
+    }
+    for p in &res.placements {
+        let pose = p.pose();
+        let v = violations(&small, pose.rotation, pose.position, &stack, &req, 1e-6, 5.0);
+        assert!(v.is_empty(), "{v:?}");
+    }
+    // symmetry of a square box: one quarter turn searched
+    assert_eq!(res.stats.symmetry_orders, vec![4]);
+    assert_eq!(res.stats.orientations_searched, 1);
+}
+
+#[test]
+fn w_zero_puts_it_on_the_floor_beside() {
+    let base = cuboid_part(DVec3::ZERO, DVec3::new(100.0, 100.0, 50.0));
+    let small = cuboid_part(DVec3::ZERO, DVec3::new(40.0, 20.0, 10.0));
+    let floor = FloorVolume::rectangle(0.0, 0.0, 200.0, 100.0, 300.0);
+    let stack = vec![StackPart { part: &base, pose: Pose::IDENTITY }];
+    let mut req = PlacementRequest::new(&small, stack, floor);
+    req.thetas = uniform_thetas(8);
+    req.cost = Cost::Stacking { w: 0.0, origin: DVec3::ZERO };
+    let res = place(&req).expect("placement");
+    let best = &res.placements[0];
+    // w = 0: only the c.g. height counts; on the floor beside the box: c.g. at z = 5, cost 4 * 25
+    assert!((best.cost - 100.0).abs() < 1e-6, "cost {}", best.cost);
+    assert!(best.position[2].abs() < 1e-6);
+    assert!(best.contacts.contains(&Contact::Floor));
+}
+
+#[test]
+fn errors_and_empty_results() {
+    let big = cuboid_part(DVec3::ZERO, DVec3::new(100.0, 100.0, 50.0));
+    let floor = FloorVolume::rectangle(0.0, 0.0, 50.0, 50.0, 300.0);
+    let mut req = PlacementRequest::new(&big, vec![], floor.clone());
+    req.thetas = uniform_thetas(4);
+    let res = place(&req).expect("runs");
+    assert!(res.placements.is_empty());
+    assert_eq!(res.exhausted, Some(NoPlacement::EmptyOmega));
+    // fits nowhere: the floor is fully occupied
+    let small = cuboid_part(DVec3::ZERO, DVec3::new(10.0, 10.0, 10.0));
+    let blocker = cuboid_part(DVec3::ZERO, DVec3::new(50.0, 50.0, 300.0));
+    let mut req =
+        PlacementRequest::new(&small, vec![StackPart { part: &blocker, pose: Pose::IDENTITY }], floor.clone());
+    req.thetas = uniform_thetas(4);
+    let res = place(&req).expect("runs");
+    assert!(res.placements.is_empty());
+    assert_eq!(res.exhausted, Some(NoPlacement::FitsNowhere));
+    // bad options
+    let mut req = PlacementRequest::new(&small, vec![], floor.clone());
+    req.cost = Cost::Stacking { w: 1.5, origin: DVec3::ZERO };
+    assert!(matches!(place(&req), Err(PlacementError::BadOption(_))));
+    let mut req = PlacementRequest::new(&small, vec![], floor.clone());
+    req.k = 0;
+    assert!(matches!(place(&req), Err(PlacementError::BadOption(_))));
+    let mut req = PlacementRequest::new(&small, vec![], floor.clone());
+    req.thetas.clear();
+    assert!(matches!(place(&req), Err(PlacementError::BadOption(_))));
+    let mut req = PlacementRequest::new(&small, vec![], floor.clone());
+    req.clearance = -1.0;
+    assert!(matches!(place(&req), Err(PlacementError::BadOption(_))));
+    let mut bad = floor.clone();
+    bad.polygon.reverse();
+    let req = PlacementRequest::new(&small, vec![], bad);
+    assert!(matches!(place(&req), Err(PlacementError::BadFloor(_))));
+    let mut req = PlacementRequest::new(&small, vec![], floor.clone());
+    req.resting_rotations = vec![DMat3::from_diagonal(DVec3::new(1.0, 1.0, -1.0))];
+    assert!(matches!(place(&req), Err(PlacementError::BadOption(_))));
+    // fixed z outside the height range: empty Omega
+    let mut req = PlacementRequest::new(&small, vec![], floor);
+    req.fixed_z = Some(-5.0);
+    assert_eq!(place(&req).expect("runs").exhausted, Some(NoPlacement::EmptyOmega));
+}
