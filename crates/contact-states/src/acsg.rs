@@ -1,0 +1,433 @@
+//! The assembly contact state graph (ACSG), generated bottom-up with search-range refinement ([P] IV-B, steps 1-7,
+//! Propositions 1-2).
+//!
+//! 1. PPCs (f-v, v-f, e-e) between the surfaces ([`all_ppcs`]); a PPC whose elements cannot meet for any
+//!    configuration in the box (bounding boxes apart after the largest translation and rotation) is dropped unseen.
+//! 2. Each PPC is a level-1 hypothesis. Hypotheses are processed level by level (all of one level in parallel);
+//!    every feasible state is combined with every feasible PPC it does not contain (step 2), the combination is mapped
+//!    to its highest-level description (step 3, [`ContactState::canonical`]) and queued if new and of higher level.
+//! 3. Search range (step 4): the hull of the extremal ranges of the known feasible CLCN states (Proposition 1), and
+//!    the intersection of the ranges of the state's single PCs evaluated as states (Proposition 2); a PC known
+//!    infeasible, or an empty intersection, makes the hypothesis infeasible without a search. The refined box is
+//!    widened by `widen` of the initial widths (the extremals are found numerically) and clipped to the initial box.
+//! 4. Feasibility (step 5): minimise eq. 8 in the refined box with the GA and polish ([`crate::ga`]); feasible iff the
+//!    minimum is at most `threshold_relative * L`.
+//! 5. Extremals (step 6) of feasible states ([`crate::extremal`]); step 7 repeats until no new hypothesis appears.
+//!
+//! Finally the CLCN/CMCN relations are computed among the feasible states. Every hypothesis gets its own seed
+//! (the user's seed mixed with a stable hash of its PCs), so the graph is identical at any thread count.
+//! Cost: one GA run per hypothesis surviving the pruning plus 12 per feasible state; hypotheses per level are at most
+//! (feasible states of lower levels) x (feasible PPCs).
+
+use crate::criteria::{ContactPart, Objective, Weights};
+use crate::extremal::{Extremal, extremals, range_of};
+use crate::ga::{GaSettings, minimise, mix_seed};
+use crate::pose::{Config, ConfigBox, VARIABLE_NAMES};
+use crate::principal_contact::{ContactState, PrincipalContact, all_ppcs};
+use crate::surface::{Element, ElementKind, SurfaceElements};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use stackplan_geom::DVec3;
+use std::collections::{BTreeMap, HashMap, HashSet};
+
+/// Settings of the generation.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct AcsgSettings {
+    /// GA settings of the feasibility searches (extremal searches use half the population and generations).
+    pub ga: GaSettings,
+    /// Feasibility threshold relative to the characteristic length `L`: feasible iff `min f <= threshold_relative * L`.
+    pub threshold_relative: f64,
+    /// Widening of refined search boxes, as a fraction of the initial box widths.
+    pub widen: f64,
+    /// Highest level hypothesised.
+    pub max_level: usize,
+}
+
+impl Default for AcsgSettings {
+    fn default() -> Self {
+        Self { ga: GaSettings::default(), threshold_relative: 1e-5, widen: 0.02, max_level: 12 }
+    }
+}
+
+/// One evaluated hypothesis.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StateRecord {
+    /// Index in [`Acsg::states`].
+    pub id: usize,
+    /// The PCs.
+    pub state: ContactState,
+    /// Label such as `{f2-v3}` (A's element first).
+    pub label: String,
+    /// Level (number of point contacts).
+    pub level: usize,
+    /// Whether a configuration in the box satisfies all criteria.
+    pub feasible: bool,
+    /// Minimum of eq. 8 found (`None` when pruned without a search).
+    pub objective: Option<f64>,
+    /// Why the hypothesis was rejected without a search, if it was.
+    pub pruned: Option<String>,
+    /// The configuration attaining `objective`.
+    pub witness: Option<Config>,
+    /// The refined search box (step 4).
+    pub search_box: Option<ConfigBox>,
+    /// Extremal configurations (feasible states only): for each variable its minimum then maximum.
+    pub extremals: Vec<Extremal>,
+    /// The range spanned by the extremals.
+    pub range: Option<ConfigBox>,
+}
+
+/// A CLCN/CMCN relation: `less` is a close less constrained neighbour of `more`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Relation {
+    /// Less constrained state id.
+    pub less: usize,
+    /// More constrained state id.
+    pub more: usize,
+}
+
+/// Counters of the generation.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct AcsgStats {
+    /// PPC candidates.
+    pub ppc_candidates: usize,
+    /// PPCs dropped because their elements cannot meet within the box.
+    pub ppc_unreachable: usize,
+    /// Hypotheses evaluated by a search.
+    pub searched: usize,
+    /// Hypotheses rejected by Propositions 1-2 without a search.
+    pub pruned: usize,
+    /// Objective evaluations (approximate: GA + polish budgets).
+    pub evaluations: usize,
+}
+
+/// The graph.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Acsg {
+    /// Name of the fixed part A.
+    pub fixed: String,
+    /// Name of the moving part B.
+    pub moving: String,
+    /// Initial box (mm, rad).
+    pub bounds: ConfigBox,
+    /// Settings.
+    pub settings: AcsgSettings,
+    /// Characteristic length `L` (mm).
+    pub length: f64,
+    /// Feasibility threshold (mm).
+    pub threshold: f64,
+    /// Evaluated hypotheses (feasible and infeasible), in evaluation order.
+    pub states: Vec<StateRecord>,
+    /// CLCN/CMCN relations between feasible states.
+    pub relations: Vec<Relation>,
+    /// Counters.
+    pub stats: AcsgStats,
+}
+
+fn stable_hash(state: &ContactState) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut feed = |x: u64| {
+        for b in x.to_le_bytes() {
+            h ^= b as u64;
+            h = h.wrapping_mul(0x0100_0000_01b3);
+        }
+    };
+    for pc in &state.pcs {
+        for e in [pc.a, pc.b] {
+            feed(e.kind as u64);
+            feed(e.index as u64);
+        }
+    }
+    h
+}
+
+fn element_points(s: &SurfaceElements, e: Element) -> Vec<DVec3> {
+    match e.kind {
+        ElementKind::Vertex => vec![s.vertices[e.index].position],
+        ElementKind::Edge => {
+            let (a, b) = s.edge_points(e.index);
+            vec![a, b]
+        }
+        ElementKind::Face => s.faces[e.index].vertices.iter().map(|&v| s.vertices[v].position).collect(),
+    }
+}
+
+/// Whether the elements of `pc` can meet for some configuration in `bounds`: A's element's bounding box against
+/// B's element's bounding box moved by every translation in the box and grown by `|p| theta_max` (a rotation by at
+/// most `theta_max` moves `p` by at most `|p| theta_max`). Conservative: never rejects a reachable pair.
+pub fn reachable(pc: &PrincipalContact, a: &SurfaceElements, b: &SurfaceElements, bounds: &ConfigBox) -> bool {
+    let pa = element_points(a, pc.a);
+    let pb = element_points(b, pc.b);
+    let theta = bounds.max_rotation_angle().min(2.0);
+    let r = pb.iter().map(|p| p.length()).fold(0.0, f64::max) * theta;
+    let tol = a.tolerance.max(b.tolerance);
+    for k in 0..3 {
+        let (alo, ahi) = pa.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| (l.min(p[k]), h.max(p[k])));
+        let (blo, bhi) = pb.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| (l.min(p[k]), h.max(p[k])));
+        let lo = blo - r + bounds.min[k] - tol;
+        let hi = bhi + r + bounds.max[k] + tol;
+        if hi < alo || lo > ahi {
+            return false;
+        }
+    }
+    true
+}
+
+struct Context<'a> {
+    fixed: &'a ContactPart,
+    moving: &'a ContactPart,
+    bounds: ConfigBox,
+    settings: AcsgSettings,
+    weights: Weights,
+    threshold: f64,
+}
+
+impl Context<'_> {
+    fn evaluate(
+        &self,
+        state: &ContactState,
+        known: &HashMap<ContactState, StateRecord>,
+        feasible_ids: &[&StateRecord],
+    ) -> StateRecord {
+        let (sa, sb) = (&self.fixed.surface, &self.moving.surface);
+        let mut record = StateRecord {
+            id: 0,
+            state: state.clone(),
+            label: state.label(),
+            level: state.level(),
+            feasible: false,
+            objective: None,
+            pruned: None,
+            witness: None,
+            search_box: None,
+            extremals: Vec::new(),
+            range: None,
+        };
+        if let Some(pc) = state.pcs.iter().find(|pc| !reachable(pc, sa, sb, &self.bounds)) {
+            record.pruned = Some(format!("{} cannot be reached within the bounds", pc.label()));
+            return record;
+        }
+        // Proposition 1: hull of the CLCN states' ranges
+        let clcn: Vec<&&StateRecord> = feasible_ids.iter().filter(|r| r.state.is_clcn_of(state, sa, sb)).collect();
+        let mut search = self.bounds;
+        let mut seeds: Vec<Config> = Vec::new();
+        if !clcn.is_empty() {
+            let mut hull: Option<ConfigBox> = None;
+            for r in &clcn {
+                if let Some(range) = r.range {
+                    hull = Some(hull.map_or(range, |h| h.hull(&range)));
+                }
+                if let Some(w) = r.witness {
+                    seeds.push(w);
+                }
+            }
+            if let Some(h) = hull {
+                search = match search.intersect(&h) {
+                    Some(b) => b,
+                    None => {
+                        record.pruned = Some("empty range by Proposition 1".into());
+                        return record;
+                    }
+                };
+            }
+        }
+        // Proposition 2: intersection of the single PCs' ranges
+        if state.pcs.len() > 1 {
+            for pc in &state.pcs {
+                if let Some(single) = known.get(&ContactState::single(*pc)) {
+                    if !single.feasible {
+                        record.pruned = Some(format!("{} alone is infeasible (Proposition 2)", pc.label()));
+                        return record;
+                    }
+                    if let Some(range) = single.range {
+                        search = match search.intersect(&range.widened_within(&self.bounds, self.settings.widen)) {
+                            Some(b) => b,
+                            None => {
+                                record.pruned = Some("empty range by Proposition 2".into());
+                                return record;
+                            }
+                        };
+                    }
+                }
+            }
+        }
+        let search = search.widened_within(&self.bounds, self.settings.widen);
+        record.search_box = Some(search);
+        let objective = Objective { fixed: self.fixed, moving: self.moving, state, weights: self.weights };
+        let f = |t: &Config| objective.value(t);
+        let ga = GaSettings { seed: mix_seed(self.settings.ga.seed, stable_hash(state)), ..self.settings.ga };
+        seeds.truncate(ga.population / 2);
+        let m = minimise(&f, &search, &ga, &seeds);
+        record.objective = Some(m.value);
+        record.witness = Some(m.t);
+        record.feasible = m.value <= self.threshold;
+        if record.feasible {
+            record.extremals = extremals(&objective, &search, m.t, self.threshold, &ga);
+            record.range = Some(range_of(&record.extremals, &search));
+        }
+        tracing::debug!(state = %record.label, value = m.value, feasible = record.feasible, "hypothesis evaluated");
+        record
+    }
+}
+
+/// Generates the ACSG of the moving part B against the fixed part A within `bounds`.
+pub fn generate(fixed: &ContactPart, moving: &ContactPart, bounds: ConfigBox, settings: AcsgSettings) -> Acsg {
+    let weights = Weights::for_parts(moving);
+    let threshold = settings.threshold_relative * weights.length;
+    let ctx = Context { fixed, moving, bounds, settings, weights, threshold };
+    let (sa, sb) = (&fixed.surface, &moving.surface);
+    let mut stats = AcsgStats::default();
+    let candidates = all_ppcs(sa, sb);
+    stats.ppc_candidates = candidates.len();
+    let ppcs: Vec<PrincipalContact> = candidates.into_iter().filter(|pc| reachable(pc, sa, sb, &bounds)).collect();
+    stats.ppc_unreachable = stats.ppc_candidates - ppcs.len();
+    tracing::info!(candidates = stats.ppc_candidates, reachable = ppcs.len(), "PPCs");
+
+    let mut known: HashMap<ContactState, StateRecord> = HashMap::new();
+    let mut order: Vec<ContactState> = Vec::new();
+    let mut queue: BTreeMap<usize, Vec<ContactState>> = BTreeMap::new();
+    let mut seen: HashSet<ContactState> = HashSet::new();
+    for pc in &ppcs {
+        let s = ContactState::single(*pc);
+        if seen.insert(s.clone()) {
+            queue.entry(1).or_default().push(s);
+        }
+    }
+    let mut feasible_ppcs: Vec<PrincipalContact> = Vec::new();
+    while let Some((level, batch)) = queue.pop_first() {
+        if level > settings.max_level {
+            break;
+        }
+        let feasible_so_far: Vec<&StateRecord> =
+            order.iter().filter_map(|s| known.get(s)).filter(|r| r.feasible).collect();
+        let records: Vec<StateRecord> = batch.par_iter().map(|s| ctx.evaluate(s, &known, &feasible_so_far)).collect();
+        let mut new_feasible: Vec<ContactState> = Vec::new();
+        for r in records {
+            if r.pruned.is_some() {
+                stats.pruned += 1;
+            } else {
+                stats.searched += 1;
+                stats.evaluations +=
+                    settings.ga.population * (settings.ga.generations + 1) + settings.ga.polish_evaluations;
+            }
+            if r.feasible {
+                new_feasible.push(r.state.clone());
+                if level == 1 {
+                    feasible_ppcs.push(r.state.pcs[0]);
+                }
+            }
+            order.push(r.state.clone());
+            known.insert(r.state.clone(), r);
+        }
+        tracing::info!(level, hypotheses = batch.len(), feasible = new_feasible.len(), "level evaluated");
+        // level 1 completes before any combination, so every feasible PPC is known here
+        for s in &new_feasible {
+            for p in &feasible_ppcs {
+                if s.pcs.contains(p) {
+                    continue;
+                }
+                let mut pcs = s.pcs.clone();
+                pcs.push(*p);
+                let c = ContactState::canonical(pcs, sa, sb);
+                if c.level() > s.level() && seen.insert(c.clone()) {
+                    queue.entry(c.level()).or_default().push(c);
+                }
+            }
+        }
+        if level == 1 {
+            // feasible single states at level 1 were all pushed above only after every PPC was evaluated
+            continue;
+        }
+    }
+    let mut states: Vec<StateRecord> = order.iter().filter_map(|s| known.remove(s)).collect();
+    for (i, r) in states.iter_mut().enumerate() {
+        r.id = i;
+    }
+    let feasible: Vec<&StateRecord> = states.iter().filter(|r| r.feasible).collect();
+    let mut relations = Vec::new();
+    for a in &feasible {
+        for b in &feasible {
+            if a.level < b.level && a.state.is_clcn_of(&b.state, sa, sb) {
+                relations.push(Relation { less: a.id, more: b.id });
+            }
+        }
+    }
+    Acsg {
+        fixed: fixed.name.clone(),
+        moving: moving.name.clone(),
+        bounds,
+        settings,
+        length: weights.length,
+        threshold,
+        states,
+        relations,
+        stats,
+    }
+}
+
+impl Acsg {
+    /// The feasible states.
+    pub fn feasible(&self) -> impl Iterator<Item = &StateRecord> + '_ {
+        self.states.iter().filter(|s| s.feasible)
+    }
+
+    /// Number of feasible states per level (index = level).
+    pub fn counts_per_level(&self) -> Vec<usize> {
+        let max = self.feasible().map(|s| s.level).max().unwrap_or(0);
+        let mut out = vec![0; max + 1];
+        for s in self.feasible() {
+            out[s.level] += 1;
+        }
+        out
+    }
+
+    /// The graph in Graphviz DOT: feasible states as nodes ranked by level, CLCN -> CMCN arrows.
+    pub fn to_dot(&self) -> String {
+        let mut s = String::from("digraph acsg {\n  rankdir=TB;\n  node [shape=box, fontsize=10];\n");
+        let mut levels: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+        for r in self.feasible() {
+            levels.entry(r.level).or_default().push(r.id);
+            s.push_str(&format!("  s{} [label=\"{}\\nlevel {}\"];\n", r.id, r.label.replace('"', "'"), r.level));
+        }
+        for ids in levels.values() {
+            let names: Vec<String> = ids.iter().map(|i| format!("s{i}")).collect();
+            s.push_str(&format!("  {{ rank=same; {}; }}\n", names.join("; ")));
+        }
+        for rel in &self.relations {
+            s.push_str(&format!("  s{} -> s{};\n", rel.less, rel.more));
+        }
+        s.push_str("}\n");
+        s
+    }
+
+    /// A [P] Table I-style table: state, objective, feasibility, lower and upper bounds (mm, rad).
+    pub fn extremal_table(&self) -> String {
+        let mut out = format!(
+            "{:<32} {:>11} {:<11} {:<60} {:<60}\n",
+            "CS", "objective", "feasibility", "lower bounds [x y z rx ry rz]", "upper bounds"
+        );
+        for r in &self.states {
+            if r.pruned.is_some() {
+                continue;
+            }
+            let fmt = |b: &[f64; 6]| b.iter().map(|v| format!("{v:.3e}")).collect::<Vec<_>>().join(" ");
+            let (lo, hi) = match &r.range {
+                Some(b) => (fmt(&b.min), fmt(&b.max)),
+                None => (String::new(), String::new()),
+            };
+            out.push_str(&format!(
+                "{:<32} {:>11.3e} {:<11} {:<60} {:<60}\n",
+                r.label,
+                r.objective.unwrap_or(f64::NAN),
+                if r.feasible { "feasible" } else { "infeasible" },
+                lo,
+                hi
+            ));
+        }
+        out
+    }
+
+    /// Names of the configuration variables, in order.
+    pub fn variable_names() -> [&'static str; 6] {
+        VARIABLE_NAMES
+    }
+}
