@@ -6,3 +6,4 @@
 
 pub use stackplan_geom as geom;
 pub use stackplan_freespace as freespace;
+pub use stackplan_planner as planner;
