@@ -87,8 +87,8 @@ pub fn channel() -> SheetMetal {
 /// leans outwards by `atan(1/2)` = 26.6 degrees from the vertical); the lips run from the rim out to an equilateral
 /// triangle of inradius 65 in `z = 40` (15 wide). The triangles are centred on the z axis with a vertex on +y.
 /// Thickness 2. Identical copies nest in the same orientation: a copy lowered onto another stops when its walls
-/// meet the walls below, `2 / cos(atan(1/2)) * 2 = 4.47` mm higher (the wall planes are `dz / sqrt(5)` apart), far
-/// less than the part height of 40.
+/// meet the walls below, `t * sqrt(5) = 4.47` mm higher (a vertical shift `dz` puts the wall planes `dz / sqrt(5)`
+/// apart), far less than the part height of 40.
 pub fn triangle() -> SheetMetal {
     let corner = |inradius: f64, k: usize, z: f64| {
         let angle = std::f64::consts::FRAC_PI_2 + k as f64 * 2.0 * std::f64::consts::FRAC_PI_3;

@@ -99,6 +99,33 @@ fn interiors_disjoint(a: &ConvexPolytope, b: &ConvexPolytope, tol: f64) -> bool 
     separates(a, b) || separates(b, a)
 }
 
+/// Full separating-axis test for two convex polytopes: face normals of both and cross products of edge directions.
+/// True when some axis separates them (touching within `tol` counts as separated).
+fn separated_sat(a: &ConvexPolytope, b: &ConvexPolytope, tol: f64) -> bool {
+    let dirs = |p: &ConvexPolytope| {
+        p.edges().iter().map(|e| p.vertices()[e.vertices[1]] - p.vertices()[e.vertices[0]]).collect::<Vec<_>>()
+    };
+    let mut axes: Vec<DVec3> = a.planes().chain(b.planes()).map(|pl| pl.normal).collect();
+    for u in dirs(a) {
+        for v in dirs(b) {
+            let c = u.cross(v);
+            if c.length() > 1e-12 * u.length() * v.length() {
+                axes.push(c.normalize());
+            }
+        }
+    }
+    axes.iter().any(|&n| {
+        let range = |p: &ConvexPolytope| {
+            p.vertices()
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(n.dot(*v)), hi.max(n.dot(*v))))
+        };
+        let (a0, a1) = range(a);
+        let (b0, b1) = range(b);
+        a1 <= b0 + tol || b1 <= a0 + tol
+    })
+}
+
 /// All the decomposition invariants for one model: convex valid prisms, per-face volume = thickness x area, pieces
 /// of one face pairwise interior-disjoint and inside the face. Returns the number of pieces per face.
 fn check_model(model: &SheetMetal, decomposition: Decomposition) -> Vec<usize> {
@@ -212,6 +239,24 @@ fn example_volumes_and_shapes() {
     }
     assert!(examples::by_name("l_corner").is_some());
     assert!(examples::by_name("nonsense").is_none());
+}
+
+#[test]
+fn triangle_parts_nest_in_one_orientation() {
+    let part = examples::triangle().build_part("triangle", 1.0, Decomposition::ConvexMerge).expect("part");
+    // a copy 4.5 mm higher (> t * sqrt(5) = 4.47) touches nothing; 4.4 mm is too little (the walls' 2 mm slabs are
+    // then 4.4 / sqrt(5) = 1.97 mm apart). The separating-axis test is complete for convex pairs.
+    let shifted = |dz: f64| -> Vec<ConvexPolytope> {
+        part.components.iter().map(|c| c.transformed(DMat3::IDENTITY, DVec3::new(0.0, 0.0, dz))).collect()
+    };
+    let all_separated =
+        |upper: &[ConvexPolytope]| upper.iter().all(|a| part.components.iter().all(|b| separated_sat(a, b, 1e-9)));
+    let dz = 4.5;
+    assert!(all_separated(&shifted(dz)));
+    assert!(!all_separated(&shifted(4.4)));
+    // and it is nested: the copy's lowest point is far below the lower part's top
+    let (lo, hi) = part.aabb();
+    assert!(lo.z + dz < hi.z - 30.0);
 }
 
 // ---------------------------------------------------------------- random polygons with holes
