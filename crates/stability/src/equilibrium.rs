@@ -1,0 +1,420 @@
+//! Static equilibrium with Coulomb friction as a second-order cone program (DESIGN.md section 7; [A] II-B (ii)).
+//!
+//! Unknowns: a force `f_k = fn_k n_k + ft1_k t1_k + ft2_k t2_k` at every contact point `k` (the patch vertices of
+//! [`crate::contacts`]), exerted by body `a` on part `b` of its patch (and `-f_k` on `a`), inside the friction cone
+//! `||(ft1_k, ft2_k)|| <= mu fn_k` (clarabel `SecondOrderConeT(3)`) with `fn_k >= 0`. Equalities: for every movable
+//! part `i` with mass `m_i` and c.g. `c_i`,
+//!
+//! ```text
+//! sum_k s_ik f_k                 + alpha m_i g d = m_i g z     (force balance, gravity -m_i g z)
+//! sum_k s_ik (p_k - c_i) x f_k                   = 0           (moment balance about the c.g.)
+//! ```
+//!
+//! with `s_ik = +1` when `i` is the patch's `b`, `-1` when it is `a`. Fixed bodies (the floor, and the supports in the
+//! "new part" problem) carry no equations. Units: `g = 1`, so forces are in the part's mass unit times g (a part of
+//! mass m weighs m). The problem is scaled internally (forces by the total movable mass, moment arms by the stack size)
+//! so that clarabel sees O(1) data.
+//!
+//! * Equilibrium (`alpha = 0`): minimise `1/2 sum ||f_k||^2` (a unique, minimum-norm force distribution). Solved ->
+//!   [`Verdict::Stable`]; `PrimalInfeasible` -> [`Verdict::Unstable`]; any other status -> [`Verdict::Unknown`],
+//!   never stable.
+//! * Robustness margin: the largest horizontal load factor `alpha` (a horizontal force `alpha m_i g` at every
+//!   movable part's c.g., the same direction `d` for all — a quasi-static horizontal acceleration of `alpha g`) that
+//!   the stack still resists, minimised over `directions` evenly spaced horizontal directions (8 by default), capped
+//!   at [`MARGIN_CAP`]. Each direction is one SOCP `max alpha`. A margin of 0.1 means the stack tolerates a sideways
+//!   push of 10 % of its weight from every sampled direction (between samples the true minimum can be lower).
+//!
+//! Fast pre-check: when every contact of a single movable part is a horizontal support from below (normal +z) and the
+//! c.g. projects outside the convex hull of the contact points by more than the tolerance, the part is unstable
+//! without a solve. The pre-check never declares stability, and never applies to inclined supports.
+//!
+//! The model is the usual "forces at patch vertices" discretisation: exact for the normal-force distribution over a
+//! flat convex patch; it ignores torsional friction inside a patch, so it is slightly conservative. Feasibility means
+//! that *some* admissible force distribution exists (rigid-body statics, no dynamics or compliance).
+//!
+//! Cost: an interior-point solve with `3 K + 1` variables and `6 M` equalities (K contact points, M movable parts);
+//! one margin costs `directions` more solves.
+
+use crate::contacts::{Body, ContactPatch, plane_basis};
+use crate::polygon2d::{convex_hull_2d, signed_boundary_distance};
+use crate::world::WorldPart;
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SecondOrderConeT, SolverStatus, SupportedConeT,
+    ZeroConeT,
+};
+use glam::{DVec2, DVec3};
+use serde::{Deserialize, Serialize};
+
+/// Upper bound of the reported robustness margin (a stack that resists 10 g sideways is locked).
+pub const MARGIN_CAP: f64 = 10.0;
+
+/// Outcome of an equilibrium analysis.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(tag = "verdict", content = "status", rename_all = "snake_case")]
+pub enum Verdict {
+    /// Admissible contact forces exist.
+    Stable,
+    /// No admissible contact forces exist (solver certificate of infeasibility, or the pre-check).
+    Unstable,
+    /// The solver ended with another status (reported verbatim); never to be read as stable.
+    Unknown(String),
+}
+
+impl Verdict {
+    /// True only for [`Verdict::Stable`].
+    pub fn is_stable(&self) -> bool {
+        matches!(self, Verdict::Stable)
+    }
+}
+
+/// Parameters of the equilibrium analysis.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct EquilibriumOptions {
+    /// Coulomb friction coefficient (>= 0).
+    pub mu: f64,
+    /// Number of horizontal load directions for the margin (0 = no margin).
+    pub directions: usize,
+}
+
+impl Default for EquilibriumOptions {
+    fn default() -> Self {
+        Self { mu: 0.5, directions: 8 }
+    }
+}
+
+/// A contact force at one point.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ContactForce {
+    /// Index of the patch in the list given to the solver.
+    pub patch: usize,
+    /// The point (world coordinates).
+    pub point: DVec3,
+    /// Force exerted by the patch's `a` on its `b` (units: mass x g).
+    pub force: DVec3,
+}
+
+/// Result of an equilibrium analysis.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Equilibrium {
+    /// Stable, unstable or unknown.
+    pub verdict: Verdict,
+    /// Contact forces of the minimum-norm solution (empty unless stable).
+    pub forces: Vec<ContactForce>,
+    /// Robustness margin: the smallest over the sampled directions of the largest horizontal load factor resisted
+    /// (None when not stable, not requested, or a margin solve did not end `Solved`).
+    pub margin: Option<f64>,
+    /// The direction achieving the smallest load factor.
+    pub weakest_direction: Option<DVec3>,
+    /// True when the answer came from the pre-check without a solve.
+    pub decided_by_precheck: bool,
+}
+
+/// Why an equilibrium problem cannot be set up.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EquilibriumError {
+    /// Friction coefficient negative or not finite.
+    #[error("friction coefficient must be finite and >= 0, got {0}")]
+    BadFriction(f64),
+    /// A patch refers to a part that does not exist.
+    #[error("contact patch {patch} refers to part {part}, but there are {len} parts")]
+    BadPart {
+        /// Patch index.
+        patch: usize,
+        /// Part index.
+        part: usize,
+        /// Number of parts.
+        len: usize,
+    },
+    /// Clarabel rejected the problem data (a bug or non-finite input).
+    #[error("the solver rejected the problem: {0}")]
+    Solver(String),
+}
+
+struct Point {
+    patch: usize,
+    p: DVec3,
+    frame: [DVec3; 3],
+    a: Option<usize>,
+    b: usize,
+}
+
+/// The equilibrium SOCP over `parts` with the given contact `patches`; `movable[i]` says whether part `i` moves.
+/// Patches between two fixed bodies are ignored.
+pub fn solve_equilibrium(
+    parts: &[WorldPart],
+    movable: &[bool],
+    patches: &[ContactPatch],
+    options: &EquilibriumOptions,
+) -> Result<Equilibrium, EquilibriumError> {
+    if !(options.mu >= 0.0 && options.mu.is_finite()) {
+        return Err(EquilibriumError::BadFriction(options.mu));
+    }
+    let is_movable = |i: usize| movable.get(i).copied().unwrap_or(false);
+    let mut points = Vec::new();
+    for (k, patch) in patches.iter().enumerate() {
+        if patch.b >= parts.len() {
+            return Err(EquilibriumError::BadPart { patch: k, part: patch.b, len: parts.len() });
+        }
+        let a = match patch.a {
+            Body::Floor => None,
+            Body::Part(i) => {
+                if i >= parts.len() {
+                    return Err(EquilibriumError::BadPart { patch: k, part: i, len: parts.len() });
+                }
+                Some(i)
+            }
+        };
+        if !is_movable(patch.b) && !a.is_some_and(is_movable) {
+            continue;
+        }
+        let (t1, t2) = plane_basis(patch.normal);
+        for &p in &patch.points {
+            points.push(Point { patch: k, p, frame: [patch.normal, t1, t2], a, b: patch.b });
+        }
+    }
+    let movers: Vec<usize> = (0..parts.len()).filter(|&i| is_movable(i)).collect();
+    if movers.is_empty() {
+        return Ok(Equilibrium {
+            verdict: Verdict::Stable,
+            forces: Vec::new(),
+            margin: None,
+            weakest_direction: None,
+            decided_by_precheck: false,
+        });
+    }
+    if let Some(result) = precheck(parts, &movers, &points) {
+        return Ok(result);
+    }
+    let problem = Problem::new(parts, &movers, &points, options.mu);
+    let (status, x) = problem.solve(None)?;
+    let verdict = verdict_of(status);
+    if !verdict.is_stable() {
+        tracing::debug!(?status, "equilibrium not stable");
+        return Ok(Equilibrium {
+            verdict,
+            forces: Vec::new(),
+            margin: None,
+            weakest_direction: None,
+            decided_by_precheck: false,
+        });
+    }
+    let forces = points
+        .iter()
+        .enumerate()
+        .map(|(k, pt)| ContactForce {
+            patch: pt.patch,
+            point: pt.p,
+            force: (pt.frame[0] * x[3 * k] + pt.frame[1] * x[3 * k + 1] + pt.frame[2] * x[3 * k + 2])
+                * problem.force_scale,
+        })
+        .collect();
+    let mut margin = None;
+    let mut weakest_direction = None;
+    if options.directions > 0 {
+        let mut smallest = f64::INFINITY;
+        let mut all_solved = true;
+        for j in 0..options.directions {
+            let angle = std::f64::consts::TAU * j as f64 / options.directions as f64;
+            let d = DVec3::new(angle.cos(), angle.sin(), 0.0);
+            let (status, x) = problem.solve(Some(d))?;
+            if status != SolverStatus::Solved {
+                tracing::debug!(?status, direction = j, "margin solve did not end Solved");
+                all_solved = false;
+                break;
+            }
+            let alpha = x[x.len() - 1].clamp(0.0, MARGIN_CAP);
+            if alpha < smallest {
+                smallest = alpha;
+                weakest_direction = Some(d);
+            }
+        }
+        if all_solved {
+            margin = Some(smallest);
+        } else {
+            weakest_direction = None;
+        }
+    }
+    Ok(Equilibrium { verdict, forces, margin, weakest_direction, decided_by_precheck: false })
+}
+
+fn verdict_of(status: SolverStatus) -> Verdict {
+    match status {
+        SolverStatus::Solved => Verdict::Stable,
+        SolverStatus::PrimalInfeasible => Verdict::Unstable,
+        other => Verdict::Unknown(format!("{other:?}")),
+    }
+}
+
+/// The pre-check of the module documentation (single movable part on horizontal supports only).
+fn precheck(parts: &[WorldPart], movers: &[usize], points: &[Point]) -> Option<Equilibrium> {
+    let [i] = movers else { return None };
+    let mine: Vec<&Point> = points.iter().filter(|p| p.b == *i || p.a == Some(*i)).collect();
+    let horizontal_support = |p: &Point| p.b == *i && p.frame[0].z >= 1.0 - 1e-12;
+    let tol = 1e-9 * parts[*i].diagonal().max(1.0);
+    let unstable = Equilibrium {
+        verdict: Verdict::Unstable,
+        forces: Vec::new(),
+        margin: None,
+        weakest_direction: None,
+        decided_by_precheck: true,
+    };
+    if mine.is_empty() {
+        return Some(unstable);
+    }
+    if !mine.iter().all(|p| horizontal_support(p)) {
+        return None;
+    }
+    let hull = convex_hull_2d(&mine.iter().map(|p| DVec2::new(p.p.x, p.p.y)).collect::<Vec<_>>(), tol);
+    let c = parts[*i].center_of_gravity;
+    let c2 = DVec2::new(c.x, c.y);
+    let outside = match hull.len() {
+        0 => true,
+        1 => (hull[0] - c2).length() > tol,
+        2 => crate::polygon2d::point_segment_distance(c2, hull[0], hull[1]) > tol,
+        _ => signed_boundary_distance(c2, &hull) < -tol,
+    };
+    if outside { Some(unstable) } else { None }
+}
+
+/// The assembled SOCP data shared by the equilibrium and margin solves.
+struct Problem {
+    n_points: usize,
+    /// Equality rows as triplets (row, column, value) over the force variables; rhs per row.
+    rows: Vec<(usize, usize, f64)>,
+    rhs: Vec<f64>,
+    /// Per movable part: its first row and its scaled weight (for the load column).
+    mover_rows: Vec<(usize, f64)>,
+    mu: f64,
+    force_scale: f64,
+}
+
+impl Problem {
+    fn new(parts: &[WorldPart], movers: &[usize], points: &[Point], mu: f64) -> Self {
+        let force_scale: f64 = movers.iter().map(|&i| parts[i].mass).sum::<f64>().max(f64::MIN_POSITIVE);
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for &i in movers {
+            lo = lo.min(parts[i].aabb.0);
+            hi = hi.max(parts[i].aabb.1);
+        }
+        let length_scale = (hi - lo).length().max(1.0);
+        let mut row_of = vec![usize::MAX; parts.len()];
+        let mut mover_rows = Vec::with_capacity(movers.len());
+        let mut rhs = Vec::with_capacity(6 * movers.len());
+        for (m, &i) in movers.iter().enumerate() {
+            row_of[i] = 6 * m;
+            let w = parts[i].mass / force_scale;
+            mover_rows.push((6 * m, w));
+            rhs.extend_from_slice(&[0.0, 0.0, w, 0.0, 0.0, 0.0]);
+        }
+        let mut rows = Vec::new();
+        for (k, pt) in points.iter().enumerate() {
+            let mut add = |body: usize, sign: f64| {
+                let r = row_of[body];
+                if r == usize::MAX {
+                    return;
+                }
+                let arm = (pt.p - parts[body].center_of_gravity) / length_scale;
+                for (c, dir) in pt.frame.iter().enumerate() {
+                    let f = *dir * sign;
+                    let moment = arm.cross(f);
+                    for (axis, value) in [f.x, f.y, f.z, moment.x, moment.y, moment.z].into_iter().enumerate() {
+                        if value != 0.0 {
+                            rows.push((r + axis, 3 * k + c, value));
+                        }
+                    }
+                }
+            };
+            add(pt.b, 1.0);
+            if let Some(a) = pt.a {
+                add(a, -1.0);
+            }
+        }
+        Self { n_points: points.len(), rows, rhs, mover_rows, mu, force_scale }
+    }
+
+    /// Solves the equilibrium problem (`load = None`) or the margin problem `max alpha` for load direction `d`.
+    /// Returns the status and the primal solution (forces in the local frames, then alpha when present).
+    fn solve(&self, load: Option<DVec3>) -> Result<(SolverStatus, Vec<f64>), EquilibriumError> {
+        let nf = 3 * self.n_points;
+        let n = nf + usize::from(load.is_some());
+        let n_eq = self.rhs.len();
+        let (mut ri, mut ci, mut vi) = (Vec::new(), Vec::new(), Vec::new());
+        for &(r, c, v) in &self.rows {
+            ri.push(r);
+            ci.push(c);
+            vi.push(v);
+        }
+        if let Some(d) = load {
+            // + alpha w d in the force rows (moves to the left-hand side of  sum f + alpha w d = w z)
+            for &(r, w) in &self.mover_rows {
+                for (axis, value) in [d.x, d.y, d.z].into_iter().enumerate() {
+                    if value != 0.0 {
+                        ri.push(r + axis);
+                        ci.push(nf);
+                        vi.push(w * value);
+                    }
+                }
+            }
+        }
+        let mut b = self.rhs.clone();
+        let mut row = n_eq;
+        let mut cones: Vec<SupportedConeT<f64>> = vec![ZeroConeT(n_eq)];
+        // fn >= 0  <=>  -fn + s = 0, s >= 0
+        for k in 0..self.n_points {
+            ri.push(row + k);
+            ci.push(3 * k);
+            vi.push(-1.0);
+        }
+        let mut n_nonneg = self.n_points;
+        if load.is_some() {
+            // alpha >= 0 and alpha <= cap
+            ri.push(row + self.n_points);
+            ci.push(nf);
+            vi.push(-1.0);
+            ri.push(row + self.n_points + 1);
+            ci.push(nf);
+            vi.push(1.0);
+            n_nonneg += 2;
+        }
+        b.extend(std::iter::repeat_n(0.0, self.n_points));
+        if load.is_some() {
+            b.push(0.0);
+            b.push(MARGIN_CAP);
+        }
+        cones.push(NonnegativeConeT(n_nonneg));
+        row += n_nonneg;
+        // (mu fn, ft1, ft2) in SOC
+        for k in 0..self.n_points {
+            for (c, scale) in [(0, self.mu), (1, 1.0), (2, 1.0)] {
+                ri.push(row + c);
+                ci.push(3 * k + c);
+                vi.push(-scale);
+            }
+            b.extend_from_slice(&[0.0, 0.0, 0.0]);
+            cones.push(SecondOrderConeT(3));
+            row += 3;
+        }
+        let a = CscMatrix::new_from_triplets(row, n, ri, ci, vi);
+        let (p, q) = match load {
+            None => {
+                let diag: Vec<usize> = (0..n).collect();
+                (CscMatrix::new_from_triplets(n, n, diag.clone(), diag, vec![1.0; n]), vec![0.0; n])
+            }
+            Some(_) => {
+                let mut q = vec![0.0; n];
+                q[nf] = -1.0;
+                (CscMatrix::zeros((n, n)), q)
+            }
+        };
+        let settings = DefaultSettingsBuilder::default()
+            .verbose(false)
+            .build()
+            .map_err(|e| EquilibriumError::Solver(format!("{e:?}")))?;
+        let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings)
+            .map_err(|e| EquilibriumError::Solver(format!("{e:?}")))?;
+        solver.solve();
+        Ok((solver.solution.status, solver.solution.x.clone()))
+    }
+}

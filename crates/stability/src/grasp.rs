@@ -1,0 +1,467 @@
+//! Suction grasp: upward horizontal faces that hold a suction cup (DESIGN.md section 7; [A] II-B condition (iii)).
+//!
+//! For a part in a pose, the candidate grasp regions are the horizontal planar faces whose outward normal is within
+//! [`UP_COS_TOLERANCE`] of +z. Coplanar upward component faces at the same height (within the part's tolerance) form
+//! one region — a sheet decomposed into prisms presents one top surface — and everything of the part's own material
+//! above that height is removed: every component is clipped to `z >= h + tol` and its vertical projection (a convex
+//! polygon) is subtracted. Holes of the sheet are not covered by any component face, so they are excluded
+//! automatically; so are component faces shared with another component (the neighbour lies above them).
+//!
+//! The region `R = (union of face polygons) \ (union of projections of material above)` holds a cup of radius `r`
+//! centred at `c` iff `d(c) = dist(c, boundary of R) >= r` with `c` in `R`. The largest inscribed disc:
+//!
+//! * **exact** when `R` is a single convex polygon with nothing above it: the Chebyshev centre, the LP
+//!   `max r  s.t.  nu_e . (c - a_e) >= r` for every edge (inward unit normal `nu_e`, a point `a_e`), solved by clarabel;
+//! * **approximate** otherwise (non-convex unions, holes, material above): the boundary of `R` is assembled from the
+//!   edges of all polygons, split at their mutual intersections and kept where exactly one side lies in `R`; `d` is
+//!   evaluated on an `N x N` grid over the region's bounding box (spacing `h`) and the best grid points are refined by
+//!   a compass (pattern) search. Since `d` is 1-Lipschitz, the true maximum radius `r*` satisfies
+//!   `r_found <= r* <= max_grid d + h / sqrt(2)`; both bounds are reported (`inscribed_radius`,
+//!   `radius_upper_bound`). A cup is declared to fit only when `r_found >= r_cup`: never optimistic.
+//!
+//! Several cups in a pattern (cup centres given relative to a grasp point): the pattern fits at grasp point `g` and
+//! rotation `theta` about z iff every cup centre `g + R(theta) o_k` has `d >= r_cup`; searched over the grid and
+//! `angle_steps` rotations, then refined by compass search in (x, y, theta). Also conservative (a found placement is
+//! verified by evaluating `d` at every cup centre).
+//!
+//! Only the part's own material is considered: when a part is placed, the parts that will lie above it are not there
+//! yet. The robot's approach path beyond the cup is not checked.
+//!
+//! Cost: O(S^2) to build the boundary (S polygon edges), O(N^2 S) for the grid.
+
+use crate::polygon2d::{area, contains as polygon_contains, convex_hull_2d, point_segment_distance};
+use crate::world::WorldComponent;
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus};
+use glam::{DMat3, DVec2, DVec3};
+use serde::{Deserialize, Serialize};
+use stackplan_geom::Part;
+
+/// A face counts as upward when its outward normal has `n.z >= 1 - UP_COS_TOLERANCE` (about 0.0026 degrees).
+pub const UP_COS_TOLERANCE: f64 = 1e-9;
+
+/// Options of the grasp analysis.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GraspOptions {
+    /// Suction cup diameter (mm).
+    pub cup_diameter: f64,
+    /// Cup centres relative to the grasp point (mm) for a multi-cup gripper; empty = a single cup.
+    pub pattern: Vec<DVec2>,
+    /// Grid resolution N of the approximate search (N x N samples).
+    pub grid: usize,
+    /// Rotations tried for a pattern (over a full turn).
+    pub angle_steps: usize,
+}
+
+impl Default for GraspOptions {
+    fn default() -> Self {
+        Self { cup_diameter: 30.0, pattern: Vec::new(), grid: 48, angle_steps: 24 }
+    }
+}
+
+/// Where a pattern of cups fits.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PatternFit {
+    /// Grasp point (world coordinates, on the face).
+    pub point: DVec3,
+    /// Rotation of the pattern about z (radians).
+    pub angle: f64,
+    /// Smallest `d(cup centre) - r_cup` over the cups (>= 0 when it fits).
+    pub slack: f64,
+}
+
+/// An upward horizontal face region of a posed part.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GraspFace {
+    /// Height of the face (world z, mm).
+    pub height: f64,
+    /// The component face polygons making up the region (world coordinates, counter-clockwise from above).
+    pub polygons: Vec<Vec<DVec3>>,
+    /// Area of the region before removing material above (mm^2).
+    pub area: f64,
+    /// Radius of the largest inscribed disc found (a lower bound; exact when `exact`).
+    pub inscribed_radius: f64,
+    /// Upper bound of the largest inscribed disc radius (equal to `inscribed_radius` when `exact`).
+    pub radius_upper_bound: f64,
+    /// Centre of that disc (world).
+    pub center: DVec3,
+    /// Whether the radius is exact (single convex polygon, nothing above, LP).
+    pub exact: bool,
+    /// Whether a single cup of the given diameter fits (`inscribed_radius >= cup_diameter / 2`).
+    pub fits_cup: bool,
+    /// Best placement of the cup pattern (when a pattern is given).
+    pub pattern_fit: Option<PatternFit>,
+}
+
+/// The planar region of one face height: convex pieces minus convex obstacles.
+#[derive(Debug, Clone)]
+pub struct Region {
+    /// Convex face polygons (counter-clockwise).
+    pub pieces: Vec<Vec<DVec2>>,
+    /// Convex projections of material above (counter-clockwise).
+    pub obstacles: Vec<Vec<DVec2>>,
+    /// Boundary segments of the region.
+    pub boundary: Vec<(DVec2, DVec2)>,
+    tol: f64,
+}
+
+impl Region {
+    /// Builds the region and its boundary.
+    pub fn new(pieces: Vec<Vec<DVec2>>, obstacles: Vec<Vec<DVec2>>, tol: f64) -> Self {
+        let mut region = Self { pieces, obstacles, boundary: Vec::new(), tol };
+        region.boundary = region.build_boundary();
+        region
+    }
+
+    /// Whether `p` lies in the region (closed pieces, open obstacles, with the tolerance).
+    pub fn contains(&self, p: DVec2) -> bool {
+        self.pieces.iter().any(|poly| polygon_contains(poly, p, self.tol))
+            && !self.obstacles.iter().any(|o| crate::polygon2d::signed_boundary_distance(p, o) > self.tol)
+    }
+
+    /// `d(p)`: distance to the boundary when inside, 0 outside.
+    pub fn clearance(&self, p: DVec2) -> f64 {
+        if !self.contains(p) {
+            return 0.0;
+        }
+        self.boundary.iter().map(|&(a, b)| point_segment_distance(p, a, b)).fold(f64::INFINITY, f64::min)
+    }
+
+    fn bbox(&self) -> (DVec2, DVec2) {
+        let mut lo = DVec2::splat(f64::INFINITY);
+        let mut hi = DVec2::splat(f64::NEG_INFINITY);
+        for p in self.pieces.iter().flatten() {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        (lo, hi)
+    }
+
+    fn build_boundary(&self) -> Vec<(DVec2, DVec2)> {
+        let mut segments = Vec::new();
+        for poly in self.pieces.iter().chain(self.obstacles.iter()) {
+            for k in 0..poly.len() {
+                segments.push((poly[k], poly[(k + 1) % poly.len()]));
+            }
+        }
+        let (lo, hi) = self.bbox();
+        let eps = (1e-7 * (hi - lo).length()).max(100.0 * self.tol);
+        let mut out = Vec::new();
+        for (i, &(a, b)) in segments.iter().enumerate() {
+            let d = b - a;
+            let len = d.length();
+            if len <= self.tol {
+                continue;
+            }
+            let mut cuts = vec![0.0, 1.0];
+            for (j, &(c, e)) in segments.iter().enumerate() {
+                if i == j {
+                    continue;
+                }
+                let f = e - c;
+                let denom = d.perp_dot(f);
+                if denom.abs() <= 1e-14 * len * f.length() {
+                    // parallel: the endpoints of a collinear neighbour cut this segment
+                    for q in [c, e] {
+                        if point_segment_distance(q, a, b) <= self.tol {
+                            cuts.push(((q - a).dot(d) / (len * len)).clamp(0.0, 1.0));
+                        }
+                    }
+                    continue;
+                }
+                let t = (c - a).perp_dot(f) / denom;
+                let s = (c - a).perp_dot(d) / denom;
+                if (-1e-12..=1.0 + 1e-12).contains(&t) && (-1e-12..=1.0 + 1e-12).contains(&s) {
+                    cuts.push(t.clamp(0.0, 1.0));
+                }
+            }
+            cuts.sort_by(f64::total_cmp);
+            let normal = DVec2::new(-d.y, d.x) / len;
+            for w in cuts.windows(2) {
+                if (w[1] - w[0]) * len <= self.tol {
+                    continue;
+                }
+                let m = a + d * (0.5 * (w[0] + w[1]));
+                if self.contains(m + normal * eps) != self.contains(m - normal * eps) {
+                    out.push((a + d * w[0], a + d * w[1]));
+                }
+            }
+        }
+        out
+    }
+
+    /// Largest inscribed disc by grid sampling and compass refinement: `(centre, radius found, upper bound)`.
+    pub fn largest_disc_sampled(&self, grid: usize) -> (DVec2, f64, f64) {
+        let (lo, hi) = self.bbox();
+        let n = grid.max(4);
+        let h = (hi - lo).max_element() / n as f64;
+        let mut samples: Vec<(f64, DVec2)> = Vec::new();
+        let nx = ((hi.x - lo.x) / h).ceil() as usize + 1;
+        let ny = ((hi.y - lo.y) / h).ceil() as usize + 1;
+        for i in 0..nx {
+            for j in 0..ny {
+                let p = DVec2::new(lo.x + h * i as f64, lo.y + h * j as f64);
+                let d = self.clearance(p);
+                if d > 0.0 {
+                    samples.push((d, p));
+                }
+            }
+        }
+        let grid_best = samples.iter().map(|s| s.0).fold(0.0, f64::max);
+        samples.sort_by(|a, b| b.0.total_cmp(&a.0));
+        let mut best = (DVec2::ZERO, 0.0);
+        if let Some(first) = samples.first() {
+            best = (first.1, first.0);
+        }
+        for &(_, start) in samples.iter().take(8) {
+            let (p, d) = compass(|q| self.clearance(q), start, h, h * 1e-6);
+            if d > best.1 {
+                best = (p, d);
+            }
+        }
+        (best.0, best.1, grid_best + h * std::f64::consts::FRAC_1_SQRT_2)
+    }
+
+    /// Best placement of a cup pattern: `(grasp point, angle, slack)`.
+    pub fn fit_pattern(
+        &self,
+        offsets: &[DVec2],
+        cup_radius: f64,
+        grid: usize,
+        angle_steps: usize,
+    ) -> Option<(DVec2, f64, f64)> {
+        if offsets.is_empty() {
+            return None;
+        }
+        let slack = |g: DVec2, angle: f64| {
+            let (s, c) = angle.sin_cos();
+            offsets
+                .iter()
+                .map(|o| self.clearance(g + DVec2::new(c * o.x - s * o.y, s * o.x + c * o.y)) - cup_radius)
+                .fold(f64::INFINITY, f64::min)
+        };
+        let (lo, hi) = self.bbox();
+        let n = grid.max(4);
+        let h = (hi - lo).max_element() / n as f64;
+        let steps = angle_steps.max(1);
+        let mut best: Option<(DVec2, f64, f64)> = None;
+        let nx = ((hi.x - lo.x) / h).ceil() as usize + 1;
+        let ny = ((hi.y - lo.y) / h).ceil() as usize + 1;
+        for k in 0..steps {
+            let angle = std::f64::consts::TAU * k as f64 / steps as f64;
+            for i in 0..nx {
+                for j in 0..ny {
+                    let g = DVec2::new(lo.x + h * i as f64, lo.y + h * j as f64);
+                    let s = slack(g, angle);
+                    if best.is_none_or(|b| s > b.2) {
+                        best = Some((g, angle, s));
+                    }
+                }
+            }
+        }
+        let (g, angle, _) = best?;
+        // compass search in (x, y, angle) with the angle scaled by the pattern's size
+        let size = offsets.iter().map(|o| o.length()).fold(0.0, f64::max).max(h);
+        let (p, _) = compass3(
+            |x: DVec3| slack(DVec2::new(x.x, x.y), x.z / size),
+            DVec3::new(g.x, g.y, angle * size),
+            h,
+            h * 1e-6,
+        );
+        let angle = p.z / size;
+        let g = DVec2::new(p.x, p.y);
+        Some((g, angle, slack(g, angle)))
+    }
+}
+
+/// Maximises `f` by compass search from `start` with initial step `step` down to `min_step`.
+fn compass(f: impl Fn(DVec2) -> f64, start: DVec2, step: f64, min_step: f64) -> (DVec2, f64) {
+    let mut p = start;
+    let mut value = f(p);
+    let mut h = step;
+    while h > min_step {
+        let mut improved = false;
+        for d in [
+            DVec2::X,
+            DVec2::NEG_X,
+            DVec2::Y,
+            DVec2::NEG_Y,
+            DVec2::ONE,
+            -DVec2::ONE,
+            DVec2::new(1.0, -1.0),
+            DVec2::new(-1.0, 1.0),
+        ] {
+            let q = p + d * h;
+            let v = f(q);
+            if v > value {
+                p = q;
+                value = v;
+                improved = true;
+                break;
+            }
+        }
+        if !improved {
+            h *= 0.5;
+        }
+    }
+    (p, value)
+}
+
+fn compass3(f: impl Fn(DVec3) -> f64, start: DVec3, step: f64, min_step: f64) -> (DVec3, f64) {
+    let mut p = start;
+    let mut value = f(p);
+    let mut h = step;
+    let dirs = [DVec3::X, DVec3::NEG_X, DVec3::Y, DVec3::NEG_Y, DVec3::Z, DVec3::NEG_Z];
+    while h > min_step {
+        let mut improved = false;
+        for d in dirs {
+            let q = p + d * h;
+            let v = f(q);
+            if v > value {
+                p = q;
+                value = v;
+                improved = true;
+                break;
+            }
+        }
+        if !improved {
+            h *= 0.5;
+        }
+    }
+    (p, value)
+}
+
+/// Chebyshev centre of a convex counter-clockwise polygon by LP: `(centre, radius)`; None if the LP is not Solved.
+pub fn chebyshev_center(poly: &[DVec2]) -> Option<(DVec2, f64)> {
+    let n = poly.len();
+    if n < 3 {
+        return None;
+    }
+    let (mut ri, mut ci, mut vi, mut b) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut row = 0;
+    for k in 0..n {
+        let a = poly[k];
+        let e = poly[(k + 1) % n] - a;
+        let len = e.length();
+        if len == 0.0 {
+            continue;
+        }
+        let nu = DVec2::new(-e.y, e.x) / len; // inward for counter-clockwise
+        // nu . (c - a) >= r   <=>   -nu . c + r <= -nu . a
+        for (c, v) in [(0, -nu.x), (1, -nu.y), (2, 1.0)] {
+            ri.push(row);
+            ci.push(c);
+            vi.push(v);
+        }
+        b.push(-nu.dot(a));
+        row += 1;
+    }
+    let a = CscMatrix::new_from_triplets(row, 3, ri, ci, vi);
+    let p = CscMatrix::zeros((3, 3));
+    let q = [0.0, 0.0, -1.0];
+    let settings = DefaultSettingsBuilder::default().verbose(false).build().ok()?;
+    let mut solver = DefaultSolver::new(&p, &q, &a, &b, &[NonnegativeConeT(row)], settings).ok()?;
+    solver.solve();
+    if solver.solution.status != SolverStatus::Solved {
+        return None;
+    }
+    let x = &solver.solution.x;
+    Some((DVec2::new(x[0], x[1]), x[2]))
+}
+
+/// Clips a convex polytope to `z >= h` and projects it onto the xy-plane (convex hull; may be degenerate).
+fn projection_above(component: &WorldComponent, h: f64, tol: f64) -> Vec<DVec2> {
+    let v = component.polytope.vertices();
+    let mut pts: Vec<DVec2> = v.iter().filter(|p| p.z >= h).map(|p| DVec2::new(p.x, p.y)).collect();
+    for e in component.polytope.edges() {
+        let (a, b) = (v[e.vertices[0]], v[e.vertices[1]]);
+        if (a.z - h) * (b.z - h) < 0.0 {
+            let t = (h - a.z) / (b.z - a.z);
+            let x = a + (b - a) * t;
+            pts.push(DVec2::new(x.x, x.y));
+        }
+    }
+    convex_hull_2d(&pts, tol)
+}
+
+/// Grasp faces of a posed part (`world = rotation * v + position`), largest inscribed radius first.
+pub fn grasp_faces(part: &Part, rotation: DMat3, position: DVec3, options: &GraspOptions) -> Vec<GraspFace> {
+    let components: Vec<WorldComponent> =
+        part.components.iter().map(|c| WorldComponent::new(c.transformed(rotation, position))).collect();
+    grasp_faces_of_components(&components, part.tolerance().linear, options)
+}
+
+/// Grasp faces of world-coordinate components (see [`grasp_faces`]).
+pub fn grasp_faces_of_components(components: &[WorldComponent], tol: f64, options: &GraspOptions) -> Vec<GraspFace> {
+    // upward faces grouped by height
+    let mut groups: Vec<(f64, Vec<Vec<DVec3>>)> = Vec::new();
+    for c in components {
+        let v = c.polytope.vertices();
+        for f in c.polytope.faces() {
+            if f.plane.normal.z < 1.0 - UP_COS_TOLERANCE {
+                continue;
+            }
+            let poly: Vec<DVec3> = f.vertices.iter().map(|&i| v[i]).collect();
+            let h = poly.iter().map(|p| p.z).sum::<f64>() / poly.len() as f64;
+            match groups.iter_mut().find(|g| (g.0 - h).abs() <= tol) {
+                Some(g) => g.1.push(poly),
+                None => groups.push((h, vec![poly])),
+            }
+        }
+    }
+    let cup_radius = 0.5 * options.cup_diameter;
+    let mut out = Vec::new();
+    for (h, polys) in groups {
+        let pieces: Vec<Vec<DVec2>> = polys
+            .iter()
+            .map(|p| convex_hull_2d(&p.iter().map(|q| DVec2::new(q.x, q.y)).collect::<Vec<_>>(), tol))
+            .filter(|p| p.len() >= 3)
+            .collect();
+        if pieces.is_empty() {
+            continue;
+        }
+        let total_area: f64 = pieces.iter().map(|p| area(p)).sum();
+        let obstacles: Vec<Vec<DVec2>> = components
+            .iter()
+            .filter(|c| c.aabb.1.z > h + tol)
+            .map(|c| projection_above(c, h + tol, tol))
+            .filter(|p| p.len() >= 3 && area(p) > tol * tol)
+            .collect();
+        let region = Region::new(pieces, obstacles, tol);
+        let lp = if region.pieces.len() == 1 && region.obstacles.is_empty() {
+            chebyshev_center(&region.pieces[0])
+        } else {
+            None
+        };
+        let (center, radius, upper, exact) = match lp {
+            Some((c, r)) => (c, r, r, true),
+            None => {
+                let (c, r, u) = region.largest_disc_sampled(options.grid);
+                (c, r, u, false)
+            }
+        };
+        let pattern_fit = region
+            .fit_pattern(&options.pattern, cup_radius, options.grid / 2, options.angle_steps)
+            .map(|(g, angle, slack)| PatternFit { point: DVec3::new(g.x, g.y, h), angle, slack });
+        out.push(GraspFace {
+            height: h,
+            polygons: polys,
+            area: total_area,
+            inscribed_radius: radius,
+            radius_upper_bound: upper,
+            center: DVec3::new(center.x, center.y, h),
+            exact,
+            fits_cup: radius >= cup_radius,
+            pattern_fit,
+        });
+    }
+    out.sort_by(|a, b| b.inscribed_radius.total_cmp(&a.inscribed_radius).then(b.height.total_cmp(&a.height)));
+    out
+}
+
+/// Whether the posed part can be grasped: some face fits a cup (and the pattern, when one is given).
+pub fn is_graspable(faces: &[GraspFace], options: &GraspOptions) -> bool {
+    faces
+        .iter()
+        .any(|f| if options.pattern.is_empty() { f.fits_cup } else { f.pattern_fit.is_some_and(|p| p.slack >= 0.0) })
+}
