@@ -37,12 +37,14 @@
 //! # Tolerance bands and conservativeness
 //!
 //! The c-space construction (`stackplan_cspace::minkowski`) treats a normal within [`ANGULAR_TOLERANCE`] of an arc's
-//! circle as lying on it. So a structure is constant exactly between the *bands* `|f| <= tol` of the (b) and (c)
-//! functions (gated by "the normal lies within the arc" at the band's root, with a generous slack). Each band is
-//! computed in closed form ([`Trig::band`]) with the tolerance slightly enlarged, and an interval ends at the entry
-//! of the next band: never later than the true change, so intervals are conservative. A band whose gate passes only
-//! through the slack, or a tangential touch that does not change the overlay, makes an interval shorter than the
-//! true one (a *conservative* event); the property tests count these.
+//! circle as lying on it, merges normals closer than half of it, and drops nearly collinear corners of merged faces.
+//! So a structure is constant between the *bands* where some (b) or (c) function is small (gated by "the normal lies
+//! within the arc" at the band's root, ends and centre, with a generous slack). Each band is computed in closed form
+//! ([`Trig::band`]) with the tolerance widened by [`BAND_SAFETY`] `* (1 + L_max / L_min)`, and an interval ends at the
+//! entry of the next band: never later than the true change (verified against sampling + bisection in the tests).
+//! An angle inside a band is a degenerate configuration whose structure is only known to hold at that angle.
+//! A band whose gate passes only through the slack, or a tangential touch that does not change the overlay, makes an
+//! interval shorter than the true one (a *conservative* event); the property tests count these.
 
 use crate::trig::{AngleArc, Band, Trig, wrap};
 use glam::DVec3;
