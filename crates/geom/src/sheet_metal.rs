@@ -3,6 +3,21 @@
 //! Each face of the zero-thickness model is extruded by the sheet thickness (symmetrically about the mid-surface,
 //! `thickness / 2` to each side) into convex prisms: a convex face without holes gives one prism; a concave face or a
 //! face with holes is first decomposed into convex polygons (see [`Decomposition`]).
+//!
+//! Pipeline per face (details, tolerances and limits in `crates/geom/README-sheet.md`):
+//! 1. validation with located errors ([`SheetMetalError`]): finite coordinates, at least three distinct vertices,
+//!    non-zero area, planarity within [`crate::polygon::PLANARITY_FACTOR`] policy tolerances of the outline's plane,
+//!    simple rings, holes strictly inside and pairwise disjoint ([`crate::polygon`], exact 2-D predicates on the
+//!    input coordinates after dropping the dominant normal axis);
+//! 2. removal of straight and nearly straight vertices ([`crate::polygon::simplify_ring`]);
+//! 3. triangulation with holes (Eberly's bridging and ear clipping, then constrained-Delaunay flips:
+//!    [`crate::triangulate`]) and, for [`Decomposition::ConvexMerge`], Hertel-Mehlhorn merging
+//!    ([`crate::convex_merge`]);
+//! 4. extrusion of every convex polygon into a prism with explicit faces, checked by
+//!    [`ConvexPolytope::validate`]. All prisms of a face share lifted vertices, so cuts are bit-identical faces.
+//!
+//! Cost: O(n log n + k) validation (k = edge pairs with overlapping x-ranges), O(n^2) typical triangulation and
+//! merging, O(n) extrusion, per face of n vertices.
 
 use crate::convex_merge::merge_convex;
 use crate::part::{Part, PartError, PartOrigin};
@@ -82,6 +97,14 @@ pub enum SheetMetalError {
     /// There are no faces.
     #[error("the sheet-metal model has no faces")]
     NoFaces,
+    /// A face index beyond the model's faces was asked for.
+    #[error("face {face} does not exist: the model has {count} faces")]
+    NoSuchFace {
+        /// The requested face.
+        face: usize,
+        /// Number of faces.
+        count: usize,
+    },
     /// A coordinate is NaN or infinite.
     #[error("face {face}, {ring}, vertex {vertex}: coordinate is not finite")]
     NonFinite {
@@ -245,8 +268,9 @@ impl SheetMetal {
         face: usize,
         decomposition: Decomposition,
     ) -> Result<FaceDecomposition, SheetMetalError> {
+        self.check_thickness()?;
         let Some(f) = self.faces.get(face) else {
-            return Err(SheetMetalError::NoFaces);
+            return Err(SheetMetalError::NoSuchFace { face, count: self.faces.len() });
         };
         let mut prepared = prepare_face(face, f, self.thickness)?;
         let outline_pts: Vec<DVec2> = prepared.outline.iter().map(|&i| prepared.points[i]).collect();

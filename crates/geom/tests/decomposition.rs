@@ -590,6 +590,16 @@ fn error_holes_outside_touching_overlapping() {
 }
 
 #[test]
+fn error_no_such_face() {
+    let m = model(vec![SheetFace { outline: square(0.0), holes: vec![] }]);
+    assert_eq!(
+        m.decompose_face(3, Decomposition::ConvexMerge).expect_err("no face 3"),
+        SheetMetalError::NoSuchFace { face: 3, count: 1 }
+    );
+    assert_eq!(m.decompose_face(0, Decomposition::ConvexMerge).expect("face 0").pieces.len(), 1);
+}
+
+#[test]
 fn error_bad_density_is_reported() {
     let m = model(vec![SheetFace { outline: square(0.0), holes: vec![] }]);
     assert!(matches!(m.build_part("x", -1.0, Decomposition::ConvexMerge), Err(SheetMetalError::Part(_))));
