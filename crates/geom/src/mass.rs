@@ -84,7 +84,7 @@ impl Moments {
 
     /// Mass properties for a uniform density. `None` when the volume is not positive.
     pub fn properties(&self, density: f64) -> Option<MassProperties> {
-        if !(self.volume > 0.0) {
+        if self.volume.is_nan() || self.volume <= 0.0 {
             return None;
         }
         let cg = self.first / self.volume;

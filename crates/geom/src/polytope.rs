@@ -450,7 +450,7 @@ impl ConvexPolytope {
 fn plane_of(vertices: &[DVec3], face: &[usize]) -> Option<Plane> {
     let n = newell_normal(face.iter().map(|&i| vertices[i]));
     let len = n.length();
-    if !(len > 0.0) || !len.is_finite() {
+    if len.is_nan() || len <= 0.0 || !len.is_finite() {
         return None;
     }
     let normal = n / len;
