@@ -47,6 +47,8 @@ pub enum Command {
     Part(cmd::part::PartCommand),
     /// The built-in examples described and drawn under out/ (the README's first command).
     Demo(cmd::demo::Args),
+    /// Constant-structure orientation intervals of every convex pair, with the events that end them.
+    Intervals(cmd::intervals::Args),
 }
 
 /// Runs the command line with the process arguments; returns the exit status.
@@ -61,6 +63,7 @@ pub fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Part(c) => cmd::part::run(c),
         Command::Demo(a) => cmd::demo::run(a),
+        Command::Intervals(a) => cmd::intervals::run(a),
     };
     match result {
         Ok(Outcome::Success) => ExitCode::SUCCESS,

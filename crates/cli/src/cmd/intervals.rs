@@ -1,0 +1,153 @@
+//! `stackplan intervals MOVING FIXED [--fixed-pose POSE.json] [--pair I,J] [--from-deg A] [--to-deg B] [--json]`:
+//! the constant-structure orientation intervals of every convex pair (moving component rotating about world z
+//! against a fixed component), with the event that ends each ([A] section IV, Appendix C).
+
+use crate::Outcome;
+use crate::input::load_part_spec;
+use crate::output;
+use anyhow::Context;
+use serde::Serialize;
+use stackplan::orient_interval::{Event, PairEvents};
+use stackplan_geom::sheet_metal::Decomposition;
+use stackplan_geom::{DMat3, DVec3, Pose};
+
+/// Arguments of `intervals`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The moving part (file or `example:NAME`); it rotates about world z.
+    pub moving: String,
+    /// The fixed part (file or `example:NAME`).
+    pub fixed: String,
+    /// Pose of the fixed part: JSON `{"position": [x, y, z], "rotation": [[row 0], [row 1], [row 2]]}`.
+    #[arg(long, value_name = "POSE.json")]
+    pub fixed_pose: Option<std::path::PathBuf>,
+    /// Only this pair: moving component I, fixed component J.
+    #[arg(long, value_name = "I,J")]
+    pub pair: Option<String>,
+    /// Only intervals reaching past this angle (degrees).
+    #[arg(long, default_value_t = 0.0)]
+    pub from_deg: f64,
+    /// Only intervals starting before this angle (degrees).
+    #[arg(long, default_value_t = 360.0)]
+    pub to_deg: f64,
+    /// Split concave sheet-metal faces by plain triangulation (the seed's component counts).
+    #[arg(long)]
+    pub triangulate: bool,
+    /// JSON output.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// JSON of one interval.
+#[derive(Debug, Serialize)]
+pub struct IntervalJson {
+    /// Start (degrees, in [0, 360)).
+    pub start_deg: f64,
+    /// End (degrees, > start; above 360 for the interval that wraps).
+    pub end_deg: f64,
+    /// Whether this is an event window (overlapping degenerate configurations) rather than a constant interval.
+    pub degenerate: bool,
+    /// The event that ends a constant interval, or the first event of a window: `{"kind", "angle_deg", features}`.
+    pub event: Option<serde_json::Value>,
+}
+
+/// JSON of one pair.
+#[derive(Debug, Serialize)]
+pub struct PairJson {
+    /// Component of the moving part.
+    pub moving_piece: usize,
+    /// Component of the fixed part.
+    pub fixed_piece: usize,
+    /// Number of event bands over the full turn.
+    pub events: usize,
+    /// The intervals overlapping the requested range, in order.
+    pub intervals: Vec<IntervalJson>,
+}
+
+/// The whole output.
+#[derive(Debug, Serialize)]
+pub struct IntervalsJson {
+    /// Per convex pair.
+    pub pairs: Vec<PairJson>,
+}
+
+fn event_json(e: &Event) -> serde_json::Value {
+    let mut v = serde_json::to_value(e.kind).unwrap_or(serde_json::Value::Null);
+    if let Some(map) = v.as_object_mut() {
+        map.insert("angle_deg".into(), serde_json::json!(e.angle.to_degrees()));
+    }
+    v
+}
+
+fn parse_pair(s: &str) -> anyhow::Result<(usize, usize)> {
+    let (i, j) = s.split_once(',').with_context(|| format!("--pair expects I,J, got {s:?}"))?;
+    Ok((i.trim().parse().context("--pair: moving index")?, j.trim().parse().context("--pair: fixed index")?))
+}
+
+fn read_pose(path: &std::path::Path) -> anyhow::Result<(DMat3, DVec3)> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let record: stackplan_geom::pose::PoseRecord =
+        serde_json::from_str(&text).with_context(|| format!("parsing the pose in {}", path.display()))?;
+    let pose = Pose::try_from(record).with_context(|| format!("the pose in {}", path.display()))?;
+    Ok((pose.rotation, pose.position))
+}
+
+/// Runs `intervals`.
+pub fn run(args: &Args) -> anyhow::Result<Outcome> {
+    let decomposition = if args.triangulate { Decomposition::Triangulation } else { Decomposition::ConvexMerge };
+    let moving = load_part_spec(&args.moving, decomposition, false)?;
+    let fixed = load_part_spec(&args.fixed, decomposition, false)?;
+    let (rotation, translation) = match &args.fixed_pose {
+        Some(p) => read_pose(p)?,
+        None => (DMat3::IDENTITY, DVec3::ZERO),
+    };
+    let only = args.pair.as_deref().map(parse_pair).transpose()?;
+    if let Some((i, j)) = only {
+        anyhow::ensure!(i < moving.components.len(), "--pair: the moving part has {} components", moving.components.len());
+        anyhow::ensure!(j < fixed.components.len(), "--pair: the fixed part has {} components", fixed.components.len());
+    }
+    anyhow::ensure!(args.from_deg <= args.to_deg, "--from-deg must not exceed --to-deg");
+    let mut pairs = Vec::new();
+    for (i, a) in moving.components.iter().enumerate() {
+        for (j, b) in fixed.components.iter().enumerate() {
+            if only.is_some_and(|p| p != (i, j)) {
+                continue;
+            }
+            let placed = b.transformed(rotation, translation);
+            let events = PairEvents::new(a, &placed);
+            let mut intervals = Vec::new();
+            for t in events.full_turn() {
+                let (s, e) = (t.start.to_degrees(), t.end.to_degrees());
+                // the interval or its copy one turn earlier overlaps [from, to]
+                let overlaps = [-360.0, 0.0, 360.0].iter().any(|k| s + k < args.to_deg && e + k > args.from_deg);
+                if overlaps {
+                    intervals.push(IntervalJson {
+                        start_deg: s,
+                        end_deg: e,
+                        degenerate: t.degenerate,
+                        event: t.events.first().map(event_json),
+                    });
+                }
+            }
+            pairs.push(PairJson { moving_piece: i, fixed_piece: j, events: events.bands().len(), intervals });
+        }
+    }
+    let out = IntervalsJson { pairs };
+    if args.json {
+        output::print_json(&out)?;
+    } else {
+        let mut text = String::new();
+        for p in &out.pairs {
+            text.push_str(&format!(
+                "pair moving {} / fixed {}: {} events\n",
+                p.moving_piece, p.fixed_piece, p.events
+            ));
+            for t in p.intervals.iter().filter(|t| !t.degenerate) {
+                let kind = t.event.as_ref().and_then(|e| e["kind"].as_str()).unwrap_or("none");
+                text.push_str(&format!("  [{:10.6}, {:10.6}) deg  ends by {kind}\n", t.start_deg, t.end_deg));
+            }
+        }
+        output::print_text(&text)?;
+    }
+    Ok(Outcome::Success)
+}
