@@ -9,17 +9,13 @@
 //! `ceil(r / 2) + 1` pieces: at most four times the optimum (Hertel & Mehlhorn's bound; for polygons with holes the
 //! same charging argument applies to the reflex vertices of the outline and the convex vertices of the holes).
 //!
-//! Every angle test is the exact [`crate::predicates::orient2d`]. A merge that leaves an angle of exactly pi at `u`
-//! or `v` is made only when both edges of the merged piece at that vertex lie on the polygon's boundary. Otherwise
-//! the straight vertex, which must be dropped for a strictly convex prism, would sit on a cut shared with another
-//! piece: the prism's side face over the two collinear edges would no longer match the neighbouring prisms' side
-//! faces (a T-junction), and [`crate::part::boundary_faces`] could not recognise the cut as internal. Invariant: a
-//! straight vertex of a piece has both of its edges on the boundary, so pieces of one face meet edge to edge.
-//! (A piece only gets an angle at a vertex by a merge at that vertex, and any later merge across an edge at a
-//! straight vertex would make it reflex and is refused.) For input without three collinear vertices this is exactly
-//! Hertel-Mehlhorn with its four-times-optimal bound; when collinear vertices make some merges end at exactly pi
-//! across a cut, those merges are refused and the bound is not claimed (the tests check that merging never
-//! increases the count and that every piece is convex).
+//! Every angle test is the exact [`crate::predicates::orient2d`]. Angles of exactly pi are allowed (standard
+//! Hertel-Mehlhorn, so the four-times-optimal bound holds); the straight vertex is dropped before extrusion, which
+//! leaves a T-junction on the cut at that vertex: the merged prism's side face spans two side faces of its
+//! neighbours. [`crate::part::boundary_faces`] recognises such partly matching opposite faces as internal by convex
+//! clipping. Only for *rounded* input (a collinear run after a rotation) is a merged angle that is convex but within
+//! the tolerance `flat` of pi ([`nearly_straight`]) accepted just between two boundary edges: such a vertex must be
+//! dropped too, and its T-junction would be off by up to `flat`, more than the boundary clipping tolerates.
 //!
 //! Complexity: O(t) diagonals, each merge O(size of the two pieces) to splice cycles and re-label half-edges; O(t^2)
 //! in the worst case, linear in practice for the small pieces sheet metal produces.
@@ -32,11 +28,11 @@ use std::collections::HashMap;
 
 /// Merges counter-clockwise triangles (indices into `points`, sharing edges as a triangulation of one polygon does)
 /// into convex counter-clockwise pieces by removing inessential diagonals (Hertel-Mehlhorn). Every returned piece is
-/// convex; a straight vertex of a piece has both its edges on the boundary; the pieces tile the union of the
-/// triangles and meet edge to edge.
+/// convex (straight vertices may remain; drop them with [`crate::polygon::drop_collinear`]); the pieces tile the
+/// union of the triangles.
 ///
 /// `flat` (a length, 0 for purely exact behaviour): a merged angle that is convex but [`nearly_straight`] under
-/// `flat` is treated like an angle of exactly pi, so that no piece gets a vertex that extrusion would have to drop.
+/// `flat` is accepted only between two polygon-boundary edges (see the module documentation).
 pub fn merge_convex(points: &[DVec2], triangles: &[[usize; 3]], flat: f64) -> Vec<Vec<usize>> {
     let mut pieces: Vec<Option<Vec<usize>>> = triangles.iter().map(|t| Some(t.to_vec())).collect();
     let mut owner: HashMap<(usize, usize), usize> = HashMap::with_capacity(3 * triangles.len());
@@ -49,7 +45,9 @@ pub fn merge_convex(points: &[DVec2], triangles: &[[usize; 3]], flat: f64) -> Ve
     let mut diagonals: Vec<(usize, usize)> =
         owner.keys().copied().filter(|&(a, b)| a < b && owner.contains_key(&(b, a))).collect();
     diagonals.sort_unstable();
-    for (u, v) in diagonals {
+    // two passes: first only merges that leave strictly convex angles, then also those reaching exactly pi (a
+    // straight merge early can block two better merges later; any order keeps the Hertel-Mehlhorn bound)
+    for (allow_straight, &(u, v)) in [false, true].iter().flat_map(|&a| diagonals.iter().map(move |d| (a, d))) {
         let (Some(&p), Some(&q)) = (owner.get(&(u, v)), owner.get(&(v, u))) else {
             continue;
         };
@@ -59,7 +57,7 @@ pub fn merge_convex(points: &[DVec2], triangles: &[[usize; 3]], flat: f64) -> Ve
         let (Some(piece_p), Some(piece_q)) = (&pieces[p], &pieces[q]) else {
             continue;
         };
-        let Some(merged) = merge_if_convex(points, &owner, piece_p, piece_q, u, v, flat) else {
+        let Some(merged) = merge_if_convex(points, &owner, piece_p, piece_q, u, v, flat, allow_straight) else {
             continue;
         };
         owner.remove(&(u, v));
@@ -75,7 +73,8 @@ pub fn merge_convex(points: &[DVec2], triangles: &[[usize; 3]], flat: f64) -> Ve
 }
 
 /// The union of pieces `p` (containing the directed edge `u -> v`) and `q` (containing `v -> u`) if it is convex at
-/// `u` and `v` (angles below pi, or exactly pi between two polygon-boundary edges), as one counter-clockwise cycle.
+/// `u` and `v` (angles at most pi; nearly straight ones only between polygon-boundary edges), as one counter-clockwise
+/// cycle.
 fn merge_if_convex(
     points: &[DVec2],
     owner: &HashMap<(usize, usize), usize>,
@@ -84,6 +83,7 @@ fn merge_if_convex(
     u: usize,
     v: usize,
     flat: f64,
+    allow_straight: bool,
 ) -> Option<Vec<usize>> {
     let (np, nq) = (p.len(), q.len());
     let i = (0..np).find(|&i| p[i] == u && p[(i + 1) % np] == v)?;
@@ -95,12 +95,13 @@ fn merge_if_convex(
     let after_u = q_rot[1];
     let before_v = q_rot[nq - 2];
     let after_v = p_rot[1];
-    // an angle of exactly pi is allowed only between two boundary edges (see the module documentation)
+    // a nearly (not exactly) straight angle is allowed only between two boundary edges (module documentation)
     let on_boundary = |a: usize, b: usize| !owner.contains_key(&(b, a));
     let acceptable = |before: usize, at: usize, after: usize| match orient2d(points[before], points[at], points[after])
     {
         Ordering::Greater if !nearly_straight(points[before], points[at], points[after], flat) => true,
-        Ordering::Greater | Ordering::Equal => on_boundary(before, at) && on_boundary(at, after),
+        Ordering::Equal => allow_straight,
+        Ordering::Greater => allow_straight && on_boundary(before, at) && on_boundary(at, after),
         Ordering::Less => false,
     };
     if !acceptable(before_u, u, after_u) || !acceptable(before_v, v, after_v) {

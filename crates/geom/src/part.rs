@@ -89,7 +89,7 @@ impl Part {
         let mut total = Moments::default();
         for (i, c) in components.iter().enumerate() {
             let m = Moments::of_polytope(c);
-            if !(m.volume > 0.0) {
+            if m.volume.is_nan() || m.volume <= 0.0 {
                 return Err(PartError::ZeroVolume(i));
             }
             total.add(&m);
@@ -128,11 +128,22 @@ impl Part {
     }
 }
 
-/// Boundary faces of a union of convex components whose shared faces coincide exactly.
+/// Boundary faces of a union of convex components with disjoint interiors.
 ///
-/// A component face is internal when another component has a face with exactly the same vertex coordinates in the
-/// opposite order (two prisms of one decomposed sheet sharing a cut). Internal faces are dropped; every other face is
-/// kept as its own boundary polygon. O(total face size) with hashing of exact coordinates.
+/// 1. A component face is internal when another component has a face with exactly the same vertex coordinates in
+///    the opposite order (two prisms of one decomposed sheet sharing a cut). O(total face size) with hashing of exact
+///    coordinates.
+/// 2. A remaining face `f` may still be covered, wholly or in part, by opposite coplanar faces of other components
+///    (a T-junction: a cut whose two sides were split at different vertices, or touching user pieces). Every face
+///    `g` with the opposite normal (within `1e-12`) on the same plane (within the policy tolerance of the part) and
+///    an overlapping bounding box is subtracted from `f` by convex clipping (Sutherland-Hodgman against each edge
+///    line of `g`: `f \ g` is the union over the edges `k` of `f` inside edges `0..k` and outside edge `k`). Pieces
+///    with area below `tolerance x diameter` are dropped. A face left whole is kept as it is; a partly covered face
+///    is replaced by its uncovered convex pieces; a fully covered face is dropped. O(F^2) candidate pairs in the
+///    worst case, with a cheap bounding-box rejection.
+///
+/// Faces are not merged across components: coplanar boundary polygons of neighbouring components stay separate
+/// polygons (without holes).
 pub fn boundary_faces(components: &[ConvexPolytope]) -> Vec<BoundaryFace> {
     type Key = Vec<[u64; 3]>;
     fn key(points: impl Iterator<Item = DVec3>) -> Key {
@@ -149,19 +160,123 @@ pub fn boundary_faces(components: &[ConvexPolytope]) -> Vec<BoundaryFace> {
             *count.entry(key(f.vertices.iter().map(|&v| c.vertices()[v]))).or_default() += 1;
         }
     }
-    let mut out = Vec::new();
+    // step 1: exact matches
+    let mut kept: Vec<(usize, Vec<DVec3>, Plane)> = Vec::new();
     for (ci, c) in components.iter().enumerate() {
         for f in c.faces() {
             let reversed = key(f.vertices.iter().rev().map(|&v| c.vertices()[v]));
             if count.contains_key(&reversed) {
                 continue;
             }
-            out.push(BoundaryFace {
-                outline: f.vertices.iter().map(|&v| c.vertices()[v]).collect(),
-                holes: Vec::new(),
-                plane: f.plane,
-                component: ci,
-            });
+            kept.push((ci, f.vertices.iter().map(|&v| c.vertices()[v]).collect(), f.plane));
+        }
+    }
+    // step 2: partial or inexact coverage by opposite coplanar faces of other components
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for c in components {
+        for v in c.vertices() {
+            lo = lo.min(*v);
+            hi = hi.max(*v);
+        }
+    }
+    let tol = Tolerance::for_scale((hi - lo).length()).linear;
+    let boxes: Vec<(DVec3, DVec3)> = kept
+        .iter()
+        .map(|(_, pts, _)| {
+            pts.iter().fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(a, b), p| {
+                (a.min(*p), b.max(*p))
+            })
+        })
+        .collect();
+    let mut out = Vec::with_capacity(kept.len());
+    for (i, (ci, polygon, plane)) in kept.iter().enumerate() {
+        let mut pieces: Vec<Vec<DVec3>> = vec![polygon.clone()];
+        let mut touched = false;
+        for (j, (cj, other, other_plane)) in kept.iter().enumerate() {
+            if cj == ci
+                || plane.normal.dot(other_plane.normal) > -1.0 + 1e-12
+                || (plane.offset + other_plane.offset).abs() > tol
+                || (0..3).any(|k| boxes[i].0[k] > boxes[j].1[k] + tol || boxes[j].0[k] > boxes[i].1[k] + tol)
+            {
+                continue;
+            }
+            let mut next = Vec::new();
+            for piece in &pieces {
+                match subtract_convex(piece, other, other_plane.normal, tol) {
+                    Some(rest) => {
+                        touched = true;
+                        next.extend(rest);
+                    }
+                    None => next.push(piece.clone()),
+                }
+            }
+            pieces = next;
+            if pieces.is_empty() {
+                break;
+            }
+        }
+        if !touched {
+            out.push(BoundaryFace { outline: polygon.clone(), holes: Vec::new(), plane: *plane, component: *ci });
+            continue;
+        }
+        for piece in pieces {
+            out.push(BoundaryFace { outline: piece, holes: Vec::new(), plane: *plane, component: *ci });
+        }
+    }
+    out
+}
+
+/// `polygon \ other` for two convex coplanar polygons (`other` counter-clockwise about `other_normal`), as convex
+/// pieces with area above `tol x diameter`; `None` when they do not overlap by more than the tolerance.
+fn subtract_convex(polygon: &[DVec3], other: &[DVec3], other_normal: DVec3, tol: f64) -> Option<Vec<Vec<DVec3>>> {
+    let area = |p: &[DVec3]| crate::polytope::newell_normal(p.iter().copied()).length() / 2.0;
+    let diameter =
+        |p: &[DVec3]| p.iter().flat_map(|a| p.iter().map(move |b| (*a - *b).length())).fold(0.0f64, f64::max);
+    let significant = |p: &[DVec3]| p.len() >= 3 && area(p) > tol * diameter(p).max(tol);
+    let n = other.len();
+    let mut rest: Vec<DVec3> = polygon.to_vec();
+    let mut pieces = Vec::new();
+    for k in 0..n {
+        let (a, b) = (other[k], other[(k + 1) % n]);
+        let len = (b - a).length();
+        if len.is_nan() || len <= 0.0 {
+            continue;
+        }
+        // signed distance in the plane: positive inside `other` (left of a -> b seen from its normal)
+        let inside = |p: DVec3| (b - a).cross(p - a).dot(other_normal) / len;
+        let outside_part = clip(&rest, |p| -inside(p), tol);
+        let inside_part = clip(&rest, inside, tol);
+        if significant(&outside_part) {
+            if !significant(&inside_part) {
+                // entirely outside this edge: no overlap at all
+                return None;
+            }
+            pieces.push(outside_part);
+        }
+        rest = inside_part;
+        if !significant(&rest) {
+            // what is left of `polygon` inside edges 0..=k is negligible: no overlap
+            return None;
+        }
+    }
+    Some(pieces)
+}
+
+/// Sutherland-Hodgman: the part of a convex polygon where `distance >= 0` (points within `tol` count as on the line).
+fn clip(polygon: &[DVec3], distance: impl Fn(DVec3) -> f64, tol: f64) -> Vec<DVec3> {
+    let m = polygon.len();
+    let mut out = Vec::with_capacity(m + 1);
+    for i in 0..m {
+        let p = polygon[i];
+        let q = polygon[(i + 1) % m];
+        let (dp, dq) = (distance(p), distance(q));
+        if dp >= -tol {
+            out.push(p);
+        }
+        if (dp > tol && dq < -tol) || (dp < -tol && dq > tol) {
+            let t = dp / (dp - dq);
+            out.push(p + (q - p) * t);
         }
     }
     out

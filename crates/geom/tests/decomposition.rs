@@ -259,6 +259,43 @@ fn triangle_parts_nest_in_one_orientation() {
     assert!(lo.z + dz < hi.z - 30.0);
 }
 
+fn cuboid(lo: DVec3, hi: DVec3) -> ConvexPolytope {
+    let corners: Vec<DVec3> = (0..8)
+        .map(|i| {
+            DVec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            )
+        })
+        .collect();
+    stackplan_geom::convex_hull(&corners).expect("box").polytope
+}
+
+#[test]
+fn boundary_faces_with_t_junctions_and_partial_contact() {
+    // A's face x = 2 is covered by two faces of B1 and B2 (a T-junction): it is internal, the union is a 3 x 1 x 1 box
+    let a = cuboid(DVec3::ZERO, DVec3::new(2.0, 1.0, 1.0));
+    let b1 = cuboid(DVec3::new(2.0, 0.0, 0.0), DVec3::new(3.0, 0.5, 1.0));
+    let b2 = cuboid(DVec3::new(2.0, 0.5, 0.0), DVec3::new(3.0, 1.0, 1.0));
+    let part = stackplan_geom::Part::from_components("t", vec![a.clone(), b1, b2], 1.0, PartOrigin::ConvexPieces)
+        .expect("part");
+    assert!((boundary_area(&part) - 14.0).abs() < 1e-12, "{}", boundary_area(&part));
+    assert!(part.boundary.iter().all(|f| f.outline.iter().any(|p| p.x != 2.0) || f.plane.normal.x.abs() < 0.5));
+    // partial contact: B covers the upper half of A's face x = 2 only; the lower half stays boundary
+    let b = cuboid(DVec3::new(2.0, 0.0, 0.5), DVec3::new(3.0, 1.0, 1.0));
+    let part = stackplan_geom::Part::from_components("p", vec![a, b], 1.0, PartOrigin::ConvexPieces).expect("part");
+    // surface of A (10) + surface of B (2 x (1 x 0.5) + 2 x (1 x 0.5) + 2 x (1 x 1) = 4) - 2 x 0.5 (contact)
+    assert!((boundary_area(&part) - 13.0).abs() < 1e-12, "{}", boundary_area(&part));
+    let at_x2: f64 = part
+        .boundary
+        .iter()
+        .filter(|f| f.plane.normal.x > 0.5 && f.outline.iter().all(|p| (p.x - 2.0).abs() < 1e-12))
+        .map(|f| ring_area(&f.outline))
+        .sum();
+    assert!((at_x2 - 0.5).abs() < 1e-12, "uncovered part of A's face: {at_x2}");
+}
+
 // ---------------------------------------------------------------- random polygons with holes
 
 /// Dyadic-grid "histogram" polygon: columns of width 4 and integer heights (equal neighbours give collinear runs and
