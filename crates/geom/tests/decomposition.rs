@@ -452,6 +452,21 @@ fn check_random_face(shape: (Vec<DVec2>, Vec<Vec<DVec2>>), placement: Placement,
             (0..m).filter(|&i| !collinear(r[(i + m - 1) % m], r[i], r[(i + 1) % m])).count()
         };
         let n = corners(&face.outline) + face.holes.iter().map(|h| corners(h)).sum::<usize>();
+        // Hertel-Mehlhorn bound: at most 2r + 1 pieces for r reflex vertices of the domain (hole corners count as
+        // reflex when the hole turns convexly); exact here since the coordinates are dyadic
+        let reflex = |r: &[DVec3], outer: bool| {
+            let r = distinct(r);
+            let m = r.len();
+            let normal = newell_normal(r.iter().copied());
+            (0..m)
+                .filter(|&i| {
+                    let turn = (r[i] - r[(i + m - 1) % m]).cross(r[(i + 1) % m] - r[i]).dot(normal);
+                    if outer { turn < 0.0 } else { turn > 0.0 }
+                })
+                .count()
+        };
+        let r = reflex(&face.outline, true) + face.holes.iter().map(|h| reflex(h, false)).sum::<usize>();
+        assert!(merged <= 2 * r + 1, "Hertel-Mehlhorn gave {merged} pieces with {r} reflex vertices");
         let h = face.holes.len();
         if triangles != 1 {
             assert_eq!(triangles, n + 2 * h - 2);

@@ -1,4 +1,4 @@
-//! Part JSON, in two forms (see `README-io.md`):
+//! Part JSON, in two forms (see `docs/formats.md`):
 //!
 //! * `{"name", "sheet_metal": {"thickness", "faces": [{"outline": [[x,y,z],...], "holes": [[[x,y,z],...],...]}]},
 //!   "density"?}` — the sheet-metal model of [A] V-A-1, built by [`SheetMetal::build_part`];

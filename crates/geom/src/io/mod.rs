@@ -1,5 +1,5 @@
 //! File formats: part JSON (sheet-metal and convex-pieces forms), STL (ASCII and binary), OBJ, binary glTF export,
-//! and the stack file. The formats are specified precisely in `crates/geom/README-io.md`.
+//! and the stack file. The formats are specified precisely in `docs/formats.md`.
 //!
 //! Every reader returns an [`IoError`] that names the file and the place (line, line and column, byte offset, piece,
 //! shell, face or placement index) and never panics on any input. Every writer goes through

@@ -1,4 +1,4 @@
-//! Wavefront OBJ (the geometric subset; see `README-io.md`), hand-written so every error carries its line number.
+//! Wavefront OBJ (the geometric subset; see `docs/formats.md`), hand-written so every error carries its line number.
 //!
 //! **Reading.** `v x y z [w]` defines a vertex (extra numbers such as vertex colours are allowed and ignored),
 //! `f i j k ...` a polygon with vertex references `i`, `i/t`, `i//n` or `i/t/n`; indices are 1-based, negative

@@ -1,4 +1,4 @@
-//! STL, ASCII and binary (see `README-io.md`).
+//! STL, ASCII and binary (see `docs/formats.md`).
 //!
 //! **Detection.** A file whose size is exactly `84 + 50 n`, `n` being the little-endian `u32` at byte 80, is binary
 //! even if it starts with `solid` (many exporters write `solid` into the binary header). Otherwise a file that starts
