@@ -21,7 +21,7 @@
 
 use crate::criteria::{ContactPart, Objective, Weights};
 use crate::extremal::{Extremal, extremals, range_of};
-use crate::ga::{GaSettings, minimise, mix_seed};
+use crate::ga::{GaSettings, minimise_with_polish, mix_seed};
 use crate::pose::{Config, ConfigBox, VARIABLE_NAMES};
 use crate::principal_contact::{ContactState, PrincipalContact, all_ppcs};
 use crate::surface::{Element, ElementKind, SurfaceElements};
@@ -45,7 +45,7 @@ pub struct AcsgSettings {
 
 impl Default for AcsgSettings {
     fn default() -> Self {
-        Self { ga: GaSettings::default(), threshold_relative: 1e-5, widen: 0.02, max_level: 12 }
+        Self { ga: GaSettings::default(), threshold_relative: 1e-4, widen: 0.15, max_level: 12 }
     }
 }
 
@@ -219,6 +219,7 @@ impl Context<'_> {
                 if let Some(w) = r.witness {
                     seeds.push(w);
                 }
+                seeds.extend(r.extremals.iter().filter(|e| e.converged).map(|e| e.t));
             }
             if let Some(h) = hull {
                 search = match search.intersect(&h) {
@@ -254,9 +255,10 @@ impl Context<'_> {
         record.search_box = Some(search);
         let objective = Objective { fixed: self.fixed, moving: self.moving, state, weights: self.weights };
         let f = |t: &Config| objective.value(t);
+        let smooth = |t: &Config| objective.smooth_value(t);
         let ga = GaSettings { seed: mix_seed(self.settings.ga.seed, stable_hash(state)), ..self.settings.ga };
         seeds.truncate(ga.population / 2);
-        let m = minimise(&f, &search, &ga, &seeds);
+        let m = minimise_with_polish(&f, &smooth, &search, &ga, &seeds);
         record.objective = Some(m.value);
         record.witness = Some(m.t);
         record.feasible = m.value <= self.threshold;

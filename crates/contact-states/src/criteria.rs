@@ -303,6 +303,23 @@ impl Objective<'_> {
             self.state.pcs.iter().map(|pc| pc_criterion(pc, self.fixed, self.moving, &pose, &self.weights)).sum();
         h + self.weights.length * penetration(self.fixed, self.moving, &pose)
     }
+
+    /// The smooth companion used by the local polish: `sum (W1 h1)^2 + (W2 h2)^2 + (W3 d_G)^2`, zero exactly where
+    /// `f` is (every term of `f` is non-negative).
+    pub fn smooth_value(&self, t: &Config) -> f64 {
+        let pose = Pose::from_config(t);
+        let w = &self.weights;
+        let h: f64 = self
+            .state
+            .pcs
+            .iter()
+            .map(|pc| {
+                let (h1, h2) = pc_terms(pc, self.fixed, self.moving, &pose, w.length);
+                (w.intersection * h1).powi(2) + (w.bounding * h2).powi(2)
+            })
+            .sum();
+        h + (w.length * penetration(self.fixed, self.moving, &pose)).powi(2)
+    }
 }
 
 #[cfg(test)]

@@ -6,19 +6,25 @@
 //! `lambda = 1e4`: the criteria are sums of absolute values, so the penalty is exact (for `lambda` above the
 //! constraint multipliers the penalised minimiser satisfies `f = 0`), and `lambda = 1e4` exceeds them for every
 //! configuration whose criteria change by at least `1e-4 L` per box width. The 12 searches use the GA with half the
-//! feasibility population and generations, seeded with the feasibility witness, then the polish. A result whose
+//! feasibility population and generations, seeded with the feasibility witness, then the polish, which works on the
+//! quadratic penalty `±(t_k - min_k)/width_k + 1e9 (sum of squared terms) / L^2` (smooth, so Nelder-Mead can follow
+//! the curved manifold of the state; the exact penalty makes coordinate moves stall). A result whose
 //! `f` exceeds the feasibility threshold is replaced by the best configuration already known to be in the state (the
 //! witness or another accepted extremal), and flagged `converged = false`.
 //! Cost: 12 GA runs per feasible state, run in parallel (each deterministic).
 
 use crate::criteria::Objective;
-use crate::ga::{GaSettings, minimise, mix_seed};
+use crate::ga::{GaSettings, minimise_with_polish, mix_seed};
 use crate::pose::{Config, ConfigBox, VARIABLE_NAMES};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Penalty factor `lambda` of eq. 11-12 (on the normalised objective).
 pub const PENALTY: f64 = 1e4;
+
+/// Quadratic penalty factor of the polish (on `sum of squares / L^2`); its minimiser violates the criteria by about
+/// `1 / (2 SMOOTH_PENALTY)` relative, far below the feasibility threshold.
+pub const SMOOTH_PENALTY: f64 = 1e9;
 
 /// One extremal configuration.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -64,10 +70,14 @@ pub fn extremals(
             }
             let sign = if upper { -1.0 } else { 1.0 };
             let g = |t: &Config| sign * (t[k] - bounds.min[k]) / width + PENALTY * objective.value(t) / length;
+            // the polish follows the state's manifold better on a smooth (quadratic) penalty
+            let smooth = |t: &Config| {
+                sign * (t[k] - bounds.min[k]) / width + SMOOTH_PENALTY * objective.smooth_value(t) / (length * length)
+            };
             let mut edge = witness;
             edge[k] = if upper { bounds.max[k] } else { bounds.min[k] };
             let s = GaSettings { seed: mix_seed(settings.seed, 1000 + 2 * k as u64 + upper as u64), ..ga };
-            let m = minimise(&g, bounds, &s, &[witness, edge]);
+            let m = minimise_with_polish(&g, &smooth, bounds, &s, &[witness, edge]);
             let f = objective.value(&m.t);
             (k, upper, m.t, f, f <= threshold)
         })
@@ -104,10 +114,12 @@ pub fn extremals(
         .collect()
 }
 
-/// The range box spanned by a state's extremals.
+/// The range box spanned by a state's extremals; a bound whose search did not converge stays at `fallback`'s (the
+/// search box), so that the refinement of Propositions 1-2 never cuts off configurations on the strength of a
+/// failed search.
 pub fn range_of(extremals: &[Extremal], fallback: &ConfigBox) -> ConfigBox {
     let mut b = *fallback;
-    for e in extremals {
+    for e in extremals.iter().filter(|e| e.converged) {
         if e.upper {
             b.max[e.variable] = e.value;
         } else {

@@ -81,7 +81,7 @@ pub struct GaSettings {
 
 impl Default for GaSettings {
     fn default() -> Self {
-        Self { population: 40, generations: 30, polish_evaluations: 600, seed: 1 }
+        Self { population: 40, generations: 30, polish_evaluations: 1200, seed: 1 }
     }
 }
 
@@ -102,6 +102,24 @@ pub fn minimise<F>(f: &F, bounds: &ConfigBox, settings: &GaSettings, initial: &[
 where
     F: Fn(&Config) -> f64 + Sync,
 {
+    minimise_with_polish(f, f, bounds, settings, initial)
+}
+
+/// The GA on `f`, then the polish on `smooth` (a smoother function with the same zero set, e.g. a sum of squares)
+/// from the three best distinct individuals and the best of `initial`, sharing `polish_evaluations` (Nelder-Mead on `smooth` for
+/// half of it, compass search on `f` for the rest); the result is the
+/// polished point with the smallest `f`.
+pub fn minimise_with_polish<F, G>(
+    f: &F,
+    smooth: &G,
+    bounds: &ConfigBox,
+    settings: &GaSettings,
+    initial: &[Config],
+) -> Minimum
+where
+    F: Fn(&Config) -> f64 + Sync,
+    G: Fn(&Config) -> f64 + Sync,
+{
     let pop_size = settings.population.max(4);
     let mut rng = SplitMix64::new(mix_seed(settings.seed, 0));
     let mut population: Vec<Config> = Vec::with_capacity(pop_size);
@@ -118,6 +136,10 @@ where
         population.push(t);
     }
     let mut values: Vec<f64> = population.par_iter().map(f).collect();
+    let n_init = initial.len().min(pop_size);
+    let best_initial: Option<(Config, f64)> = (0..n_init)
+        .min_by(|&i, &j| values[i].total_cmp(&values[j]).then(i.cmp(&j)))
+        .map(|i| (population[i], values[i]));
     let mut evaluations = pop_size;
     for g in 0..settings.generations {
         let mut rng = SplitMix64::new(mix_seed(settings.seed, g as u64 + 1));
@@ -150,9 +172,42 @@ where
         values = [values[order[0]], values[order[1]]].into_iter().chain(new_values).collect();
         population = next;
     }
-    let best = (0..pop_size).min_by(|&i, &j| values[i].total_cmp(&values[j]).then(i.cmp(&j))).unwrap_or(0);
-    let (t, value, used) = polish(f, bounds, population[best], values[best], settings.polish_evaluations);
-    Minimum { t, value, evaluations: evaluations + used }
+    let mut order: Vec<usize> = (0..pop_size).collect();
+    order.sort_by(|&i, &j| values[i].total_cmp(&values[j]).then(i.cmp(&j)));
+    let mut starts: Vec<usize> = Vec::new();
+    for &i in &order {
+        if starts.len() == 3 {
+            break;
+        }
+        if !starts.iter().any(|&j| population[j] == population[i]) {
+            starts.push(i);
+        }
+    }
+    let mut starts: Vec<(Config, f64)> = starts.into_iter().map(|i| (population[i], values[i])).collect();
+    // also polish from the best of the caller's initial individuals (configurations of neighbouring states)
+    if let Some(b) = best_initial.filter(|b| !starts.iter().any(|s| s.0 == b.0)) {
+        starts.push(b);
+    }
+    let budget = (settings.polish_evaluations / starts.len().max(1)).max(2);
+    let polished: Vec<(Config, f64, usize)> = starts
+        .par_iter()
+        .map(|&(t0, v0)| {
+            // Nelder-Mead on the smooth function, then compass search on f itself
+            let (t, _, used) = polish(smooth, bounds, t0, smooth(&t0), budget / 2);
+            let v = f(&t);
+            let (t, v) = if v <= v0 { (t, v) } else { (t0, v0) };
+            let (t, v, more) = compass(f, bounds, t, v, budget - budget / 2);
+            (t, v, used + more + 1)
+        })
+        .collect();
+    let mut best = (population[order[0]], values[order[0]]);
+    for (t, v, used) in &polished {
+        evaluations += used;
+        if *v < best.1 {
+            best = (*t, *v);
+        }
+    }
+    Minimum { t: best.0, value: best.1, evaluations }
 }
 
 /// Bounded Nelder-Mead from `start` (half the budget) then compass search (the rest). Returns `(t, f(t), evals)`.
@@ -226,8 +281,22 @@ where
         }
     }
     simplex.sort_by(|a, b| a.1.total_cmp(&b.1));
-    let (mut best, mut best_value) = simplex[0];
-    // compass search
+    let (best, best_value) = simplex[0];
+    let (t, v, used) = compass(f, bounds, best, best_value, budget.saturating_sub(evals));
+    (t, v, evals + used)
+}
+
+/// Compass search with halving steps from `start` (budget `budget`). Returns `(t, f(t), evals)`.
+pub fn compass<F>(f: &F, bounds: &ConfigBox, start: Config, start_value: f64, budget: usize) -> (Config, f64, usize)
+where
+    F: Fn(&Config) -> f64 + Sync,
+{
+    let (mut best, mut best_value) = (start, start_value);
+    let mut evals = 0;
+    let eval = |t: &Config, evals: &mut usize| {
+        *evals += 1;
+        f(t)
+    };
     let mut step: Vec<f64> = (0..6).map(|k| 0.02 * bounds.width(k)).collect();
     while evals < budget {
         let mut improved = false;
