@@ -212,6 +212,8 @@ fn expand(p: &[DVec3], tris: &mut Vec<Tri>, diameter: f64) {
     let mut epoch = 0u32;
     // next_of[v] = position in `horizon` of the horizon edge starting at v (only valid for horizon vertices)
     let mut next_of: Vec<u32> = vec![NONE; p.len()];
+    let mut ordered: Vec<(u32, u32, u32)> = Vec::new();
+    let mut orphans: Vec<u32> = Vec::new();
     while let Some(t0) = stack.pop() {
         let t0u = t0 as usize;
         if !tris[t0u].alive || tris[t0u].outside.is_empty() {
@@ -263,7 +265,7 @@ fn expand(p: &[DVec3], tris: &mut Vec<Tri>, diameter: f64) {
         }
         // order the horizon into a cycle: each start vertex appears exactly once
         let hn = horizon.len();
-        let mut ordered = Vec::with_capacity(hn);
+        ordered.clear();
         {
             for (i, h) in horizon.iter().enumerate() {
                 next_of[h.0 as usize] = i as u32;
@@ -293,13 +295,13 @@ fn expand(p: &[DVec3], tris: &mut Vec<Tri>, diameter: f64) {
         }
         mark.resize(tris.len(), 0);
         // redistribute outside points of the removed triangles
-        let mut orphans: Vec<u32> = Vec::new();
+        orphans.clear();
         for &t in &visible {
             let tr = &mut tris[t as usize];
             tr.alive = false;
             orphans.append(&mut tr.outside);
         }
-        for q in orphans {
+        for &q in &orphans {
             if q == apex {
                 continue;
             }
