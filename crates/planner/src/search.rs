@@ -8,8 +8,10 @@
 //! 2. detect the interfering component pairs at `(theta_k, p*)` ([`crate::detect`]);
 //! 3. take the first of them (deepest violation first) whose obstacle ([`crate::obstacles`]) contains `p*` in its
 //!    interior by more than the tolerance, and split `K` into the children
-//!    `K n {n_k . p >= d_k} n {n_j . p <= d_j, j < k}` ([A] VI-A-3), solving each child's QP ([`crate::qp`]) and
-//!    pushing the non-empty ones;
+//!    `K n {n_k . p >= d_k} n {n_j . p <= d_j, j < k}` ([A] VI-A-3). Children are pushed *lazily* with the
+//!    parent's cost as key (a lower bound of theirs); when a pending child is popped its cell is built (emptiness by
+//!    the Chebyshev LP) and its QP solved ([`crate::qp`]), and it is pushed back with its own cost — so children
+//!    that never become the cheapest are never solved;
 //! 4. if there is none, `p*` is free: it is the next placement (one per cell, in cost order, [A] VI-A-4).
 //!
 //! **Exactness.** The children cover `K` minus the obstacle's interior and each lies in `K`, so no child costs less
@@ -45,6 +47,7 @@ use stackplan_freespace::cell::{Cell, Halfspace, Tag};
 use stackplan_geom::{Pose, Tolerance};
 use std::cmp::Ordering;
 use std::collections::{BinaryHeap, HashMap};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// What the new part touches at a placement (from the active constraints of its cell).
@@ -137,9 +140,9 @@ pub struct PlacementStats {
     pub interference_tests: u64,
     /// Exact narrow-phase pair tests.
     pub narrow_phase_tests: u64,
-    /// Nodes popped.
+    /// Solved nodes popped (each tested for interference).
     pub nodes_expanded: u64,
-    /// Nodes pushed (non-empty cells).
+    /// Nodes pushed (roots and children; a child's cell is built and solved only when it is popped).
     pub nodes_pushed: u64,
     /// Children found empty.
     pub cells_empty: u64,
@@ -180,13 +183,20 @@ pub struct PlacementResult {
     pub stats: PlacementStats,
 }
 
+/// A node's cell: solved (with its optimum) or pending (the parent's cell plus the child's extra inequalities,
+/// keyed by the parent's cost, a valid lower bound: the child is only built and solved when popped).
+enum Body<const D: usize> {
+    Pending(Vec<Halfspace<D>>),
+    Solved(QpOptimum<D>),
+}
+
 struct Node<const D: usize> {
     cost: f64,
     orientation: usize,
     id: u64,
-    cell: Cell<D>,
-    optimum: QpOptimum<D>,
-    applied: Vec<u32>,
+    cell: Arc<Cell<D>>,
+    body: Body<D>,
+    applied: Arc<Vec<u32>>,
 }
 
 impl<const D: usize> PartialEq for Node<D> {
@@ -398,9 +408,9 @@ impl Search<'_, '_> {
                         cost: optimum.value,
                         orientation: i,
                         id: next_id,
-                        cell,
-                        optimum,
-                        applied: Vec::new(),
+                        cell: Arc::new(cell),
+                        body: Body::Solved(optimum),
+                        applied: Arc::new(Vec::new()),
                     });
                 }
                 None => self.stats.orientations_empty_omega += 1,
@@ -421,13 +431,35 @@ impl Search<'_, '_> {
         let mut found_points: Vec<(usize, DVec3)> = Vec::new();
         let clearance = self.request.clearance;
         let tol = self.tol.linear;
+        let mut pops: u64 = 0;
         while let Some(node) = heap.pop() {
-            self.stats.nodes_expanded += 1;
-            if self.stats.nodes_expanded > self.request.node_budget as u64 {
+            pops += 1;
+            if pops > self.request.node_budget as u64 {
                 return Err(PlacementError::NodeBudget { budget: self.request.node_budget, found: placements.len() });
             }
+            let optimum = match &node.body {
+                Body::Pending(extra) => {
+                    // build and solve the child now; push it back with its true cost (>= its key)
+                    let t_cells = Instant::now();
+                    let solved = self.solve_child::<D>(&node, extra, fixed_z)?;
+                    if let Some((cell, optimum)) = solved {
+                        heap.push(Node {
+                            cost: optimum.value,
+                            orientation: node.orientation,
+                            id: node.id,
+                            cell: Arc::new(cell),
+                            body: Body::Solved(optimum),
+                            applied: node.applied,
+                        });
+                    }
+                    self.stats.time_cells_ms += ms(t_cells);
+                    continue;
+                }
+                Body::Solved(optimum) => optimum,
+            };
+            self.stats.nodes_expanded += 1;
             considered[node.orientation] = true;
-            let p = lift(&node.optimum.point, fixed_z);
+            let p = lift(&optimum.point, fixed_z);
             let t_det = Instant::now();
             let mut counts = DetectCounts::default();
             let cands = candidates(
@@ -461,7 +493,7 @@ impl Search<'_, '_> {
                     .any(|(oi, q)| *oi == node.orientation && (*q - p).abs().max_element() <= 1e3 * tol);
                 if !dup {
                     found_points.push((node.orientation, p));
-                    placements.push(self.placement(&node, p));
+                    placements.push(self.placement(&node.cell, optimum, node.orientation, p));
                     if placements.len() >= self.request.k {
                         break;
                     }
@@ -469,18 +501,19 @@ impl Search<'_, '_> {
                 continue;
             };
             let t_cells = Instant::now();
-            let children = self.split::<D>(&node, id, fixed_z)?;
-            for (cell, optimum) in children {
-                let mut applied = node.applied.clone();
-                applied.push(id);
+            let children = self.split::<D>(node.orientation, id, fixed_z)?;
+            let mut applied: Vec<u32> = node.applied.as_ref().clone();
+            applied.push(id);
+            let applied = Arc::new(applied);
+            for extra in children {
                 self.stats.nodes_pushed += 1;
                 heap.push(Node {
-                    cost: optimum.value,
+                    cost: node.cost,
                     orientation: node.orientation,
                     id: next_id,
-                    cell,
-                    optimum,
-                    applied,
+                    cell: Arc::clone(&node.cell),
+                    body: Body::Pending(extra),
+                    applied: Arc::clone(&applied),
                 });
                 next_id += 1;
             }
@@ -520,18 +553,16 @@ impl Search<'_, '_> {
         Ok(id)
     }
 
-    /// The children of `node` cut by obstacle `id`, with their optima (empty children dropped).
+    /// The extra inequalities of the children of a cell cut by obstacle `id` ([A] VI-A-3): child `k` adds
+    /// `n_k . p >= d_k` and `n_j . p <= d_j` for `j < k`. The children are built and solved lazily.
     fn split<const D: usize>(
         &mut self,
-        node: &Node<D>,
+        orientation: usize,
         id: u32,
         fixed_z: f64,
-    ) -> Result<Vec<(Cell<D>, QpOptimum<D>)>, PlacementError> {
+    ) -> Result<Vec<Vec<Halfspace<D>>>, PlacementError> {
         let tol = self.tol.linear;
         let obstacle = &self.obstacles[id as usize];
-        let o = &self.orientations[node.orientation];
-        let q = restrict_quadratic::<D>(&o.quadratic, fixed_z);
-        let fs_err = |reason: String| PlacementError::FreeSpace { orientation: node.orientation, reason };
         let mut inside: Vec<Halfspace<D>> = Vec::new();
         let mut children = Vec::new();
         for (k, plane) in obstacle.planes.iter().enumerate() {
@@ -539,38 +570,62 @@ impl Search<'_, '_> {
             match restrict::<D>(plane.normal, plane.offset, fixed_z, tol) {
                 Ok((normal, offset)) => {
                     let keep = Halfspace::new(normal, offset, Tag::ObstacleFace { obstacle: u64::from(id), face });
-                    let outside = keep.flipped(Tag::ObstacleFace { obstacle: u64::from(id), face });
-                    let extra = inside.iter().copied().chain(std::iter::once(outside));
-                    let cell = node.cell.with_halfspaces(extra).map_err(|e| fs_err(e.to_string()))?;
-                    if cell.is_empty() {
-                        self.stats.cells_empty += 1;
-                    } else {
-                        self.stats.qp_solves += 1;
-                        match minimise(&cell, &q).map_err(fs_err)? {
-                            Some(opt) => children.push((cell, opt)),
-                            None => self.stats.cells_empty += 1,
-                        }
-                    }
+                    let mut extra = inside.clone();
+                    extra.push(keep.flipped(Tag::ObstacleFace { obstacle: u64::from(id), face }));
+                    children.push(extra);
                     inside.push(Halfspace::new(normal, offset, Tag::ObstacleCut { obstacle: u64::from(id), face }));
                 }
                 // a horizontal plane at fixed z: satisfied everywhere (no outside child, no cut needed) or nowhere
                 // (the slice of the obstacle is empty: nothing to cut; cannot happen for an obstacle holding p*)
                 Err(true) => {}
                 Err(false) => {
-                    return Err(fs_err(format!(
-                        "obstacle {id} holds the optimum but its slice at p_z = {fixed_z} is empty (inconsistent)"
-                    )));
+                    return Err(PlacementError::FreeSpace {
+                        orientation,
+                        reason: format!(
+                            "obstacle {id} holds the optimum but its slice at p_z = {fixed_z} is empty (inconsistent)"
+                        ),
+                    });
                 }
             }
         }
         Ok(children)
     }
 
-    fn placement<const D: usize>(&self, node: &Node<D>, p: DVec3) -> Placement {
-        let o = &self.orientations[node.orientation];
+    /// Builds a pending child's cell and solves its QP (`None` when empty).
+    fn solve_child<const D: usize>(
+        &mut self,
+        node: &Node<D>,
+        extra: &[Halfspace<D>],
+        fixed_z: f64,
+    ) -> Result<Option<(Cell<D>, QpOptimum<D>)>, PlacementError> {
+        let fs_err = |reason: String| PlacementError::FreeSpace { orientation: node.orientation, reason };
+        let cell = node.cell.with_halfspaces(extra.iter().copied()).map_err(|e| fs_err(e.to_string()))?;
+        if cell.is_empty() {
+            self.stats.cells_empty += 1;
+            return Ok(None);
+        }
+        self.stats.qp_solves += 1;
+        let q = restrict_quadratic::<D>(&self.orientations[node.orientation].quadratic, fixed_z);
+        match minimise(&cell, &q).map_err(fs_err)? {
+            Some(opt) => Ok(Some((cell, opt))),
+            None => {
+                self.stats.cells_empty += 1;
+                Ok(None)
+            }
+        }
+    }
+
+    fn placement<const D: usize>(
+        &self,
+        cell: &Cell<D>,
+        optimum: &QpOptimum<D>,
+        orientation: usize,
+        p: DVec3,
+    ) -> Placement {
+        let o = &self.orientations[orientation];
         let mut contacts = Vec::new();
-        for &j in &node.optimum.active {
-            let contact = match node.cell.halfspaces()[j].tag {
+        for &j in &optimum.active {
+            let contact = match cell.halfspaces()[j].tag {
                 Tag::ObstacleFace { obstacle, face } => {
                     let ob = &self.obstacles[obstacle as usize];
                     let sc = &self.scene.components[ob.fixed];
