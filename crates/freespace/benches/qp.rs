@@ -1,2 +1,188 @@
-//! Benchmarks (filled in below).
-fn main() {}
+//! Benchmarks: time per placement QP (exact active-set vs clarabel, same cells and costs, same run) for cells of
+//! 6, 16, 32 and 64 inequalities, and time per obstacle subtraction.
+//!
+//! Run: `cargo bench -p stackplan-freespace --bench qp -- --warm-up-time 1 --measurement-time 3`.
+//!
+//! Each benchmark runs twice: with criterion's wall clock (`*_wall`) and with the thread's on-CPU time
+//! (`*_cpu`, from `/proc/thread-self/schedstat`, nanosecond resolution), because the benchmark machine is shared
+//! (2 cores, load average above 15 while other helpers compile): wall-clock medians are inflated by time spent
+//! waiting for a core, CPU time is not.
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use stackplan_freespace::{
+    Cell, Halfspace, Obstacle, RotatedExtents, SeparableCost, SubtractOptions, Tag, minimize, minimize_clarabel,
+    stacking_cost, subtract,
+};
+use stackplan_geom::{DVec3, Tolerance, convex_hull};
+use std::hint::black_box;
+
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.next()
+    }
+    fn unit(&mut self) -> [f64; 3] {
+        loop {
+            let v = [self.range(-1.0, 1.0), self.range(-1.0, 1.0), self.range(-1.0, 1.0)];
+            let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            if l > 0.2 && l <= 1.0 {
+                return v.map(|c| c / l);
+            }
+        }
+    }
+}
+
+/// A box of half-size 50 around the origin (6 inequalities) cut by `m - 6` random planes at distance 20..50.
+fn cell(rng: &mut Rng, m: usize) -> Cell<3> {
+    let mut hs = Vec::new();
+    for i in 0..3 {
+        let mut n = [0.0; 3];
+        n[i] = 1.0;
+        hs.push(Halfspace::new(n, 50.0, Tag::User(hs.len() as u64)));
+        n[i] = -1.0;
+        hs.push(Halfspace::new(n, 50.0, Tag::User(hs.len() as u64)));
+    }
+    while hs.len() < m {
+        let n = rng.unit();
+        hs.push(Halfspace::new(n, rng.range(20.0, 50.0), Tag::User(hs.len() as u64)));
+    }
+    Cell::new(hs, Tolerance::for_scale(200.0)).expect("bounded cell")
+}
+
+/// Cost (1) with w = 0.7 and the reference outside the cell, so the optimum is on the boundary.
+fn cost(rng: &mut Rng) -> SeparableCost<3> {
+    let ext = RotatedExtents {
+        x_max: 10.0,
+        x_min: -10.0,
+        y_max: 5.0,
+        y_min: -5.0,
+        center_of_gravity: DVec3::new(0.0, 0.0, 3.0),
+    };
+    let t = rng.range(0.0, std::f64::consts::TAU);
+    let reference = DVec3::new(120.0 * t.cos(), 120.0 * t.sin(), rng.range(-80.0, 0.0));
+    stacking_cost(0.7, &ext, reference).expect("cost")
+}
+
+/// On-CPU time of the current thread in nanoseconds (first field of `/proc/thread-self/schedstat`).
+fn thread_cpu_ns() -> u64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next().and_then(|x| x.parse().ok()))
+        .unwrap_or(0)
+}
+
+/// Median on-CPU time per call of `f` (nanoseconds) over 11 batches of about 100 ms each.
+///
+/// `/proc/thread-self/schedstat` of a running thread advances in scheduler ticks (a few ms), so it cannot time
+/// single calls as a criterion measurement; batches of ~100 ms keep the tick error below a few per cent.
+fn cpu_median_ns(mut f: impl FnMut()) -> f64 {
+    let t0 = thread_cpu_ns();
+    let mut calls = 0u64;
+    while thread_cpu_ns() - t0 < 20_000_000 {
+        f();
+        calls += 1;
+    }
+    let per_batch = (calls * 5).max(1);
+    let mut samples: Vec<f64> = (0..11)
+        .map(|_| {
+            let t = thread_cpu_ns();
+            for _ in 0..per_batch {
+                f();
+            }
+            (thread_cpu_ns() - t) as f64 / per_batch as f64
+        })
+        .collect();
+    samples.sort_by(f64::total_cmp);
+    samples[5]
+}
+
+fn qp(c: &mut Criterion, name: &str) {
+    let mut group = c.benchmark_group(format!("qp_{name}"));
+    for m in [6usize, 16, 32, 64] {
+        let mut rng = Rng(m as u64);
+        let cases: Vec<(Cell<3>, SeparableCost<3>)> = (0..32).map(|_| (cell(&mut rng, m), cost(&mut rng))).collect();
+        let mut i = 0;
+        group.bench_function(BenchmarkId::new("exact", m), |b| {
+            b.iter(|| {
+                i = (i + 1) % cases.len();
+                let (cell, cost) = &cases[i];
+                black_box(minimize(black_box(cell), black_box(cost)).expect("exact"))
+            })
+        });
+        let mut i = 0;
+        group.bench_function(BenchmarkId::new("clarabel", m), |b| {
+            b.iter(|| {
+                i = (i + 1) % cases.len();
+                let (cell, cost) = &cases[i];
+                black_box(minimize_clarabel(black_box(cell), black_box(cost)).expect("clarabel"))
+            })
+        });
+    }
+    group.finish();
+}
+
+fn subtraction(c: &mut Criterion, name: &str) {
+    let mut group = c.benchmark_group(format!("subtract_{name}"));
+    let mut rng = Rng(99);
+    let cases: Vec<(Cell<3>, Obstacle<3>)> = (0..16)
+        .map(|k| {
+            let cell = cell(&mut rng, 10);
+            let centre = DVec3::new(rng.range(-30.0, 30.0), rng.range(-30.0, 30.0), rng.range(-30.0, 30.0));
+            let pts: Vec<DVec3> = (0..12)
+                .map(|_| {
+                    let u = rng.unit();
+                    centre + DVec3::from_array(u) * rng.range(10.0, 25.0)
+                })
+                .collect();
+            let hull = convex_hull(&pts).expect("hull");
+            (cell, Obstacle::from_polytope(k, &hull.polytope).expect("obstacle"))
+        })
+        .collect();
+    for (name, remove_redundant) in [("with_redundancy_removal", true), ("plain", false)] {
+        let opts = SubtractOptions { clearance: 0.5, remove_redundant };
+        let mut i = 0;
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                i = (i + 1) % cases.len();
+                let (cell, obstacle) = &cases[i];
+                black_box(subtract(black_box(cell), black_box(obstacle), opts).expect("subtract"))
+            })
+        });
+    }
+    group.finish();
+}
+
+fn wall(c: &mut Criterion) {
+    qp(c, "wall");
+    subtraction(c, "wall");
+}
+
+/// CPU-time medians of the same cases, printed (not a criterion benchmark: see [`cpu_median_ns`]).
+#[allow(clippy::print_stdout)]
+fn cpu(_c: &mut Criterion) {
+    for m in [6usize, 16, 32, 64] {
+        let mut rng = Rng(m as u64);
+        let cases: Vec<(Cell<3>, SeparableCost<3>)> = (0..32).map(|_| (cell(&mut rng, m), cost(&mut rng))).collect();
+        let mut i = 0;
+        let exact = cpu_median_ns(|| {
+            i = (i + 1) % cases.len();
+            black_box(minimize(black_box(&cases[i].0), black_box(&cases[i].1)).expect("exact"));
+        });
+        let clarabel = cpu_median_ns(|| {
+            i = (i + 1) % cases.len();
+            black_box(minimize_clarabel(black_box(&cases[i].0), black_box(&cases[i].1)).expect("clarabel"));
+        });
+        println!("cpu qp m={m}: exact {:.0} ns, clarabel {:.0} ns, ratio {:.0}x", exact, clarabel, clarabel / exact);
+    }
+}
+
+criterion_group!(wall_clock, wall, cpu);
+criterion_main!(wall_clock);

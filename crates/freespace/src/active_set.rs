@@ -238,7 +238,7 @@ pub(crate) struct Problem<'a> {
 #[derive(Debug, Clone, Copy)]
 pub(crate) enum Outcome {
     /// The lexicographic optimum with its working set and the `f`-stage multipliers (in working-set order).
-    Optimal { point: V4, working: WorkSet, multipliers: V4 },
+    Optimal { point: V4, working: WorkSet, multipliers: V4, iterations: usize },
     /// A ray along which the objective (stage 0) or a tie-break coordinate (stage k >= 1) decreases without bound.
     Unbounded { point: V4, stage: usize },
 }
@@ -269,7 +269,16 @@ impl Subspace {
         for &j in w.as_slice() {
             rows.try_add(&prob.rows[j], RANK_TOL);
         }
-        let null = rows.complement(n);
+        let null = if rows.len == 0 {
+            let mut id = Basis::new();
+            for i in 0..n {
+                id.v[i] = unit(i);
+            }
+            id.len = n;
+            id
+        } else {
+            rows.complement(n)
+        };
         let r = null.len;
         // rows of the null-space basis matrix restricted to the curved coordinates, in t-space
         let mut curved_t = Basis::new();
@@ -507,7 +516,9 @@ impl Problem<'_> {
                             last_dropped = Some(w.idx[k]);
                             w.remove_at(k);
                         }
-                        None => return Ok(Outcome::Optimal { point: p, working: w, multipliers }),
+                        None => {
+                            return Ok(Outcome::Optimal { point: p, working: w, multipliers, iterations: iter + 1 });
+                        }
                     }
                 }
             }

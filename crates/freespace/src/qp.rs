@@ -33,6 +33,8 @@ pub struct QpSolution<const D: usize> {
     pub multipliers: Vec<f64>,
     /// All inequalities within the cell's tolerance of equality at `point`, sorted.
     pub tight: Vec<usize>,
+    /// Active-set iterations (0 for the clarabel path).
+    pub iterations: usize,
 }
 
 /// Why a QP has no answer.
@@ -99,7 +101,7 @@ pub fn minimize<const D: usize>(cell: &Cell<D>, cost: &impl SeparableQuadratic<D
         length_scale: cell.length_scale(),
     };
     match prob.solve(to_v4(&start))? {
-        Outcome::Optimal { point, working, multipliers } => {
+        Outcome::Optimal { point, working, multipliers, iterations } => {
             let p: [f64; D] = from_v4(&point);
             let mut pairs: Vec<(usize, f64)> =
                 working.as_slice().iter().copied().zip(multipliers.iter().copied()).collect();
@@ -110,6 +112,7 @@ pub fn minimize<const D: usize>(cell: &Cell<D>, cost: &impl SeparableQuadratic<D
                 active: pairs.iter().map(|x| x.0).collect(),
                 multipliers: pairs.iter().map(|x| x.1).collect(),
                 tight: tight_set(cell, &p),
+                iterations,
             };
             verify_kkt(cell, cost, &sol)?;
             Ok(sol)
@@ -181,7 +184,14 @@ pub fn minimize_clarabel<const D: usize>(
     let mut p = [0.0; D];
     p.copy_from_slice(&x[..D]);
     let tight = tight_set(cell, &p);
-    Ok(QpSolution { point: p, cost: cost.evaluate(&p), active: tight.clone(), multipliers: Vec::new(), tight })
+    Ok(QpSolution {
+        point: p,
+        cost: cost.evaluate(&p),
+        active: tight.clone(),
+        multipliers: Vec::new(),
+        tight,
+        iterations: 0,
+    })
 }
 
 /// `min 1/2 sum h_i x_i^2 + g . x  s.t.  rows_j . x <= b_j` with clarabel; `Solved` only.
