@@ -280,6 +280,10 @@ impl Subspace {
             rows.complement(n)
         };
         let r = null.len;
+        if (0..n).all(|i| prob.h[i] > 0.0) {
+            // strictly convex: no flat directions, the whole null space is curved
+            return Self::with_bases(prob, Basis::new(), null);
+        }
         // rows of the null-space basis matrix restricted to the curved coordinates, in t-space
         let mut curved_t = Basis::new();
         for i in 0..n {
@@ -311,6 +315,11 @@ impl Subspace {
             curved.v[curved.len] = lift(t);
             curved.len += 1;
         }
+        Self::with_bases(prob, flat, curved)
+    }
+
+    fn with_bases(prob: &Problem<'_>, flat: Basis, curved: Basis) -> Self {
+        let n = prob.n;
         let mut chol = [[0.0; MAX_N]; MAX_N];
         for a in 0..curved.len {
             for b in 0..=a {
