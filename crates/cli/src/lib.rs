@@ -49,6 +49,10 @@ pub enum Command {
     Demo(cmd::demo::Args),
     /// Constant-structure orientation intervals of every convex pair, with the events that end them.
     Intervals(cmd::intervals::Args),
+    /// The translational c-space obstacle of every convex pair (JSON, OBJ or SVG slices).
+    Cspace(cmd::cspace::Args),
+    /// Interfering (penetrating / touching) component pairs of the moving part at a position.
+    Interference(cmd::interference::Args),
 }
 
 /// Runs the command line with the process arguments; returns the exit status.
@@ -64,6 +68,8 @@ pub fn main() -> ExitCode {
         Command::Part(c) => cmd::part::run(c),
         Command::Demo(a) => cmd::demo::run(a),
         Command::Intervals(a) => cmd::intervals::run(a),
+        Command::Cspace(a) => cmd::cspace::run(a),
+        Command::Interference(a) => cmd::interference::run(a),
     };
     match result {
         Ok(Outcome::Success) => ExitCode::SUCCESS,

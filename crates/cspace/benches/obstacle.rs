@@ -73,6 +73,7 @@ fn bench(c: &mut Criterion) {
     for (name, a, b, r) in &cases {
         let o = obstacle(a, *r, b).expect("obstacle");
         assert!(gauss_map_obstacle(a, *r, b).is_ok(), "{name}: the Gauss-map route must succeed");
+        #[allow(clippy::print_stderr)]
         eprintln!(
             "{name}: {} x {} vertices -> {} vertices, {} faces",
             a.vertices().len(),
@@ -83,6 +84,13 @@ fn bench(c: &mut Criterion) {
         let mut g = c.benchmark_group(*name);
         g.bench_function("gauss_map", |bn| bn.iter(|| obstacle(black_box(a), *r, black_box(b))));
         g.bench_function("exact_hull", |bn| bn.iter(|| obstacle_by_hull(black_box(a), *r, black_box(b))));
+        // the share of the assembly into a checked geom::ConvexPolytope (edge table, planes) in the gauss_map figure
+        let verts = o.polytope().vertices().to_vec();
+        let faces: Vec<Vec<usize>> = o.polytope().faces().iter().map(|f| f.vertices.clone()).collect();
+        let planes: Vec<stackplan_geom::Plane> = o.polytope().planes().copied().collect();
+        g.bench_function("polytope_assembly_only", |bn| {
+            bn.iter(|| ConvexPolytope::with_planes(verts.clone(), faces.clone(), planes.clone()))
+        });
         g.bench_function("parry_hull", |bn| bn.iter(|| parry_hull_route(black_box(a), *r, black_box(b))));
         g.finish();
     }

@@ -81,10 +81,10 @@ proptest! {
                         }
                         (e, h) => prop_assert!(false, "pair ({}, {}, {}): LP says {} (slack {}), found {:?}", mi, fp, fi, e, t, h),
                     }
-                    if expected == -1 && clearance > 0.0 && hit.is_none() {
-                        if let Some(d) = distance_between(a, r, p, &world_b) {
-                            prop_assert!(d >= clearance - 1e-6, "pair at distance {} < clearance missed", d);
-                        }
+                    if expected == -1 && clearance > 0.0 && hit.is_none()
+                        && let Some(d) = distance_between(a, r, p, &world_b)
+                    {
+                        prop_assert!(d >= clearance - 1e-6, "pair at distance {} < clearance missed", d);
                     }
                 }
             }

@@ -5,6 +5,7 @@
 //! focused crate, so library users can depend on `stackplan` alone or on the single crates they need.
 
 pub use stackplan_geom as geom;
+pub use stackplan_cspace as cspace;
 pub use stackplan_orient_interval as orient_interval;
 pub use stackplan_freespace as freespace;
 pub use stackplan_planner as planner;

@@ -1,0 +1,324 @@
+//! `stackplan cspace MOVING FIXED [--fixed-pose POSE.json] [--theta-deg T] [--pair I,J] [--clearance MM] [--insertion]
+//! [--slice-z Z] [--json | --obj F | --svg F]`: the translational c-space obstacle of every convex pair ([A] App. B).
+//!
+//! Convention: the moving part's pose is the rotation about world z by `theta` applied to its file coordinates, then
+//! the translation `p`; `p` is in the obstacle of a pair iff `normal . p <= offset` for every face of that pair.
+
+use crate::Outcome;
+use crate::input::load_part_spec;
+use crate::output;
+use anyhow::Context;
+use serde::Serialize;
+use stackplan::cspace::minkowski::{FaceKind, Feature, Obstacle, obstacle};
+use stackplan::cspace::offset::{HalfSpaces, clearance, insertion, insertion_polytope, slice};
+use stackplan_geom::sheet_metal::Decomposition;
+use stackplan_geom::{ConvexPolytope, DMat3, DVec2, DVec3, Plane, Pose};
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// Arguments of `cspace`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The moving part (file or `example:NAME`).
+    pub moving: String,
+    /// The fixed part (file or `example:NAME`).
+    pub fixed: String,
+    /// Pose of the fixed part: JSON `{"position": [x, y, z], "rotation": [[row 0], [row 1], [row 2]]}`.
+    #[arg(long, value_name = "POSE.json")]
+    pub fixed_pose: Option<PathBuf>,
+    /// Rotation of the moving part about world z (degrees).
+    #[arg(long, default_value_t = 0.0)]
+    pub theta_deg: f64,
+    /// Only this pair: moving component I, fixed component J.
+    #[arg(long, value_name = "I,J")]
+    pub pair: Option<String>,
+    /// Grow every obstacle by this clearance (mm; mitred plane offset).
+    #[arg(long, value_name = "MM")]
+    pub clearance: Option<f64>,
+    /// Also give the insertion obstacles (positions from which straight-down insertion is blocked).
+    #[arg(long)]
+    pub insertion: bool,
+    /// Also give the slice of every obstacle at p_z = Z (a convex polygon); the SVG draws this slice (default 0).
+    #[arg(long, value_name = "Z")]
+    pub slice_z: Option<f64>,
+    /// Split concave sheet-metal faces by plain triangulation (the seed's component counts).
+    #[arg(long)]
+    pub triangulate: bool,
+    /// JSON on stdout.
+    #[arg(long, conflicts_with_all = ["obj", "svg"])]
+    pub json: bool,
+    /// Wavefront OBJ of the obstacles (insertion obstacles truncated 10% below the lowest obstacle with --insertion).
+    #[arg(long, value_name = "F", conflicts_with = "svg")]
+    pub obj: Option<PathBuf>,
+    /// SVG of the obstacles' slices at --slice-z (default 0); clearance and insertion are not drawn.
+    #[arg(long, value_name = "F")]
+    pub svg: Option<PathBuf>,
+}
+
+/// One face in the JSON.
+#[derive(Debug, Serialize)]
+pub struct FaceJson {
+    /// Unit outward normal.
+    pub normal: [f64; 3],
+    /// Offset: `normal . p <= offset` inside.
+    pub offset: f64,
+    /// Vertex indices, counter-clockwise seen from outside.
+    pub vertices: Vec<usize>,
+    /// `fixed_face`, `moving_face`, `edge_edge`, or a merged degenerate kind (`fixed_face_moving_edge`,
+    /// `moving_face_fixed_edge`, `face_face`).
+    pub kind: &'static str,
+    /// Generating feature of the fixed component: `{"feature": "vertex"|"edge"|"face", "index": k}`.
+    pub fixed_feature: Option<Feature>,
+    /// Generating feature of the moving component.
+    pub moving_feature: Option<Feature>,
+}
+
+/// A plane of an H-form in the JSON.
+#[derive(Debug, Serialize)]
+pub struct PlaneJson {
+    /// Unit normal.
+    pub normal: [f64; 3],
+    /// Offset.
+    pub offset: f64,
+}
+
+/// One convex pair in the JSON.
+#[derive(Debug, Serialize)]
+pub struct PairJson {
+    /// Component of the moving part.
+    pub moving_piece: usize,
+    /// Component of the fixed part.
+    pub fixed_piece: usize,
+    /// Obstacle vertices.
+    pub vertices: Vec<[f64; 3]>,
+    /// `[i, j]` per vertex: vertex `j` of the (placed) fixed component minus the rotated vertex `i` of the moving one.
+    pub vertex_pairs: Vec<[usize; 2]>,
+    /// Faces.
+    pub faces: Vec<FaceJson>,
+    /// Volume of the obstacle (mm^3).
+    pub volume: f64,
+    /// With `--clearance`: the grown obstacle's planes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub clearance_planes: Option<Vec<PlaneJson>>,
+    /// With `--insertion`: the insertion obstacle's planes (unbounded below).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub insertion_planes: Option<Vec<PlaneJson>>,
+    /// With `--slice-z`: the slice polygon `[[x, y], ...]`, counter-clockwise from above.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub slice: Option<Vec<[f64; 2]>>,
+}
+
+/// The whole output.
+#[derive(Debug, Serialize)]
+pub struct CspaceJson {
+    /// Rotation of the moving part about z (degrees).
+    pub theta_deg: f64,
+    /// Clearance used (mm), if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub clearance: Option<f64>,
+    /// Slice height, if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub slice_z: Option<f64>,
+    /// Per convex pair.
+    pub pairs: Vec<PairJson>,
+}
+
+fn parse_pair(s: &str) -> anyhow::Result<(usize, usize)> {
+    let (i, j) = s.split_once(',').with_context(|| format!("--pair expects I,J, got {s:?}"))?;
+    Ok((i.trim().parse().context("--pair: moving index")?, j.trim().parse().context("--pair: fixed index")?))
+}
+
+fn read_pose(path: &std::path::Path) -> anyhow::Result<(DMat3, DVec3)> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let record: stackplan_geom::pose::PoseRecord =
+        serde_json::from_str(&text).with_context(|| format!("parsing the pose in {}", path.display()))?;
+    let pose = Pose::try_from(record).with_context(|| format!("the pose in {}", path.display()))?;
+    Ok((pose.rotation, pose.position))
+}
+
+fn planes_json(h: &HalfSpaces) -> Vec<PlaneJson> {
+    h.planes.iter().map(plane_json).collect()
+}
+
+fn plane_json(p: &Plane) -> PlaneJson {
+    PlaneJson { normal: p.normal.to_array(), offset: p.offset }
+}
+
+/// The obstacles of the requested pairs: `(moving piece, fixed piece, obstacle)`.
+pub fn obstacles(args: &Args) -> anyhow::Result<Vec<(usize, usize, Obstacle)>> {
+    anyhow::ensure!(args.theta_deg.is_finite(), "--theta-deg must be finite");
+    let decomposition = if args.triangulate { Decomposition::Triangulation } else { Decomposition::ConvexMerge };
+    let moving = load_part_spec(&args.moving, decomposition, false)?;
+    let fixed = load_part_spec(&args.fixed, decomposition, false)?;
+    let (fixed_rotation, fixed_position) = match &args.fixed_pose {
+        Some(p) => read_pose(p)?,
+        None => (DMat3::IDENTITY, DVec3::ZERO),
+    };
+    let only = args.pair.as_deref().map(parse_pair).transpose()?;
+    if let Some((i, j)) = only {
+        anyhow::ensure!(
+            i < moving.components.len(),
+            "--pair: the moving part has {} components",
+            moving.components.len()
+        );
+        anyhow::ensure!(j < fixed.components.len(), "--pair: the fixed part has {} components", fixed.components.len());
+    }
+    let rotation = DMat3::from_rotation_z(args.theta_deg.to_radians());
+    let placed: Vec<ConvexPolytope> =
+        fixed.components.iter().map(|c| c.transformed(fixed_rotation, fixed_position)).collect();
+    let mut out = Vec::new();
+    for (i, a) in moving.components.iter().enumerate() {
+        for (j, b) in placed.iter().enumerate() {
+            if only.is_some_and(|o| o != (i, j)) {
+                continue;
+            }
+            let o =
+                obstacle(a, rotation, b).with_context(|| format!("obstacle of moving piece {i} / fixed piece {j}"))?;
+            out.push((i, j, o));
+        }
+    }
+    Ok(out)
+}
+
+fn pair_json(args: &Args, i: usize, j: usize, o: &Obstacle) -> PairJson {
+    let c = o.polytope();
+    let faces = c
+        .faces()
+        .iter()
+        .zip(o.face_kinds())
+        .map(|(f, k): (_, &FaceKind)| FaceJson {
+            normal: f.plane.normal.to_array(),
+            offset: f.plane.offset,
+            vertices: f.vertices.clone(),
+            kind: k.name(),
+            fixed_feature: k.fixed_feature(),
+            moving_feature: k.moving_feature(),
+        })
+        .collect();
+    PairJson {
+        moving_piece: i,
+        fixed_piece: j,
+        vertices: c.vertices().iter().map(|v| v.to_array()).collect(),
+        vertex_pairs: o.vertex_pairs().to_vec(),
+        faces,
+        volume: c.volume(),
+        clearance_planes: args.clearance.map(|d| planes_json(&clearance(o, d))),
+        insertion_planes: args.insertion.then(|| planes_json(&insertion(c))),
+        slice: args.slice_z.map(|z| slice(c, z).iter().map(|p| p.to_array()).collect()),
+    }
+}
+
+/// Runs `cspace`.
+pub fn run(args: &Args) -> anyhow::Result<Outcome> {
+    if let Some(d) = args.clearance {
+        anyhow::ensure!(d.is_finite() && d >= 0.0, "--clearance must be a non-negative number of mm");
+    }
+    let obstacles = obstacles(args)?;
+    if let Some(path) = &args.obj {
+        output::write_atomic(path, obj_text(args, &obstacles)?.as_bytes())?;
+        return Ok(Outcome::Success);
+    }
+    if let Some(path) = &args.svg {
+        output::write_atomic(path, svg_text(args, &obstacles).as_bytes())?;
+        return Ok(Outcome::Success);
+    }
+    let json = CspaceJson {
+        theta_deg: args.theta_deg,
+        clearance: args.clearance,
+        slice_z: args.slice_z,
+        pairs: obstacles.iter().map(|(i, j, o)| pair_json(args, *i, *j, o)).collect(),
+    };
+    if args.json {
+        output::print_json(&json)?;
+    } else {
+        let mut text = format!("theta = {} deg, {} convex pairs\n", args.theta_deg, json.pairs.len());
+        for p in &json.pairs {
+            let _ = writeln!(
+                text,
+                "moving {} / fixed {}: {} vertices, {} faces, volume {:.6}",
+                p.moving_piece,
+                p.fixed_piece,
+                p.vertices.len(),
+                p.faces.len(),
+                p.volume
+            );
+        }
+        output::print_text(&text)?;
+    }
+    Ok(Outcome::Success)
+}
+
+fn obj_text(args: &Args, obstacles: &[(usize, usize, Obstacle)]) -> anyhow::Result<String> {
+    let floor = obstacles
+        .iter()
+        .map(|(_, _, o)| {
+            let (lo, hi) = o.polytope().aabb();
+            lo.z - 0.1 * (hi.z - lo.z).max(1.0)
+        })
+        .fold(f64::INFINITY, f64::min);
+    let mut text = String::from("# stackplan c-space obstacles\n");
+    let mut base = 1;
+    for (i, j, o) in obstacles {
+        let truncated;
+        let poly = if args.insertion {
+            truncated = insertion_polytope(o.polytope(), floor).context("truncated insertion obstacle")?;
+            &truncated
+        } else {
+            o.polytope()
+        };
+        let _ = writeln!(text, "o pair_{i}_{j}");
+        for v in poly.vertices() {
+            let _ = writeln!(text, "v {} {} {}", v.x, v.y, v.z);
+        }
+        for f in poly.faces() {
+            let idx: Vec<String> = f.vertices.iter().map(|v| (v + base).to_string()).collect();
+            let _ = writeln!(text, "f {}", idx.join(" "));
+        }
+        base += poly.vertices().len();
+    }
+    Ok(text)
+}
+
+fn svg_text(args: &Args, obstacles: &[(usize, usize, Obstacle)]) -> String {
+    let z = args.slice_z.unwrap_or(0.0);
+    let polygons: Vec<(usize, usize, Vec<DVec2>)> =
+        obstacles.iter().map(|(i, j, o)| (*i, *j, slice(o.polytope(), z))).collect();
+    let mut lo = DVec2::splat(f64::INFINITY);
+    let mut hi = DVec2::splat(f64::NEG_INFINITY);
+    for (_, _, p) in &polygons {
+        for q in p {
+            lo = lo.min(*q);
+            hi = hi.max(*q);
+        }
+    }
+    if !lo.is_finite() {
+        lo = DVec2::ZERO;
+        hi = DVec2::ONE;
+    }
+    let size = (hi - lo).max(DVec2::splat(1e-9));
+    let margin = 0.05 * size.max_element();
+    let mut text = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"{} {} {} {}\">\n<title>c-space slices at p_z = {z}, \
+         theta = {} deg</title>\n<g transform=\"scale(1,-1)\">\n",
+        lo.x - margin,
+        -(hi.y + margin),
+        size.x + 2.0 * margin,
+        size.y + 2.0 * margin,
+        args.theta_deg
+    );
+    let stroke = 0.003 * size.max_element();
+    for (i, j, p) in &polygons {
+        if p.len() < 3 {
+            continue;
+        }
+        let pts: Vec<String> = p.iter().map(|q| format!("{},{}", q.x, q.y)).collect();
+        let _ = writeln!(
+            text,
+            "<polygon data-pair=\"{i},{j}\" points=\"{}\" fill=\"rgba(200,40,40,0.25)\" stroke=\"black\" \
+             stroke-width=\"{stroke}\"/>",
+            pts.join(" ")
+        );
+    }
+    text.push_str("</g>\n</svg>\n");
+    text
+}
