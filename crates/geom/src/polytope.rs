@@ -244,6 +244,18 @@ impl ConvexPolytope {
         Ok(p)
     }
 
+    /// The same topology (faces, edges) with new vertex coordinates and face planes, in O(V + F) without any
+    /// search: for computed polytopes whose structure is known to be unchanged (e.g. c-space obstacles extrapolated
+    /// within a constant-topology interval). `None` when the lengths do not match this polytope's.
+    pub fn with_geometry(&self, vertices: Vec<DVec3>, planes: Vec<Plane>) -> Option<Self> {
+        if vertices.len() != self.vertices.len() || planes.len() != self.faces.len() {
+            return None;
+        }
+        let faces =
+            self.faces.iter().zip(planes).map(|(f, plane)| Face { vertices: f.vertices.clone(), plane }).collect();
+        Some(Self { vertices, faces, edges: self.edges.clone(), face_edges: self.face_edges.clone() })
+    }
+
     /// The vertices.
     pub fn vertices(&self) -> &[DVec3] {
         &self.vertices
@@ -519,6 +531,18 @@ mod tests {
         dented[7] = DVec3::splat(0.6);
         let p = ConvexPolytope::new(dented, faces).expect("manifold");
         assert!(p.validate_exact().is_err());
+    }
+
+    #[test]
+    fn new_geometry_keeps_topology() {
+        let c = unit_cube();
+        let moved: Vec<DVec3> = c.vertices().iter().map(|v| *v * 2.0).collect();
+        let planes: Vec<Plane> = c.planes().map(|p| Plane { normal: p.normal, offset: p.offset * 2.0 }).collect();
+        let d = c.with_geometry(moved, planes).expect("same sizes");
+        assert_eq!(d.edges(), c.edges());
+        d.validate().expect("valid");
+        assert!((d.volume() - 8.0).abs() < 1e-12);
+        assert!(c.with_geometry(vec![DVec3::ZERO], Vec::new()).is_none());
     }
 
     #[test]
