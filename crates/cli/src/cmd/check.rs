@@ -1,0 +1,102 @@
+//! `stackplan check STACK.json [--mu MU] [--clearance MM] [--cup-diameter MM] [--json]`: interference, clearance,
+//! stability, grasp, insertion and removal of every part of a stack (crate `stackplan-stability`; JSON documented in
+//! `crates/stability/README.md`). Exit status 1 when a check fails.
+
+use crate::Outcome;
+use crate::output;
+use anyhow::Context;
+use serde::Serialize;
+use stackplan::stability::check::{CheckOptions, StackCheck, check_stack};
+use stackplan::stability::grasp::GraspOptions;
+use stackplan::stability::world::PlacedPart;
+use std::path::PathBuf;
+
+/// Arguments of `check`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The stack file (JSON: a part and its placements).
+    pub stack: PathBuf,
+    /// Coulomb friction coefficient.
+    #[arg(long, default_value_t = 0.5)]
+    pub mu: f64,
+    /// Required horizontal clearance between parts (mm); 0 disables the test.
+    #[arg(long, default_value_t = 0.0)]
+    pub clearance: f64,
+    /// Suction cup diameter (mm).
+    #[arg(long, default_value_t = 30.0)]
+    pub cup_diameter: f64,
+    /// Contact tolerance (mm) instead of the policy's 1e-9 x stack size (for stacks with rounded coordinates).
+    #[arg(long)]
+    pub contact_tolerance: Option<f64>,
+    /// Horizontal directions sampled for the robustness margins.
+    #[arg(long, default_value_t = 8)]
+    pub margin_directions: usize,
+    /// JSON output.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The JSON of `check --json`.
+#[derive(Debug, Serialize)]
+pub struct CheckJson {
+    /// The stack file.
+    pub stack_file: String,
+    /// Options used.
+    pub options: CheckOptions,
+    /// The report.
+    #[serde(flatten)]
+    pub report: StackCheck,
+}
+
+/// Runs `check`.
+pub fn run(args: &Args) -> anyhow::Result<Outcome> {
+    let file = stackplan::geom::io::stack::read_stack(&args.stack)
+        .with_context(|| format!("reading the stack {}", args.stack.display()))?;
+    let stack: Vec<PlacedPart<'_>> = file
+        .placements
+        .iter()
+        .map(|pose| PlacedPart { part: &file.part, rotation: pose.rotation, position: pose.position })
+        .collect();
+    let options = CheckOptions {
+        mu: args.mu,
+        clearance: args.clearance,
+        grasp: GraspOptions { cup_diameter: args.cup_diameter, ..GraspOptions::default() },
+        margin_directions: args.margin_directions,
+        contact_tolerance: args.contact_tolerance,
+        prefix_stability: true,
+    };
+    let report = check_stack(&stack, &options)?;
+    let ok = report.ok;
+    if args.json {
+        output::print_json(&CheckJson { stack_file: args.stack.display().to_string(), options, report })?;
+    } else {
+        let mut text = format!(
+            "stack {}: {} parts, {}\n  part  interference  clearance  stable  margin  stack_stable  grasp_radius  insertable  removable  ok\n",
+            args.stack.display(),
+            report.parts.len(),
+            if ok { "all checks pass" } else { "CHECKS FAILED" }
+        );
+        for p in &report.parts {
+            text.push_str(&format!(
+                "  {:>4}  {:>12.6}  {:>9}  {:>6}  {:>6}  {:>12}  {:>12.3}  {:>10}  {:>9}  {}\n",
+                p.index,
+                p.interference,
+                p.clearance_met,
+                p.stable.is_stable(),
+                p.margin.map_or("-".to_string(), |m| format!("{m:.3}")),
+                p.stack_stable.is_stable(),
+                p.grasp_radius,
+                p.insertable,
+                p.removable,
+                p.ok
+            ));
+        }
+        text.push_str(&format!(
+            "  whole stack: {:?}, margin {}\n",
+            report.stack.verdict,
+            report.stack.margin.map_or("-".to_string(), |m| format!("{m:.3}"))
+        ));
+        output::print_text(&text)?;
+    }
+    Ok(if ok { Outcome::Success } else { Outcome::ChecksFailed })
+}
