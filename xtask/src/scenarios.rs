@@ -2,6 +2,11 @@
 //!
 //! * `part`: a part file (or built-in example) with a decomposition: component count, volume, centre of gravity,
 //!   bounding box, boundary face count.
+//! * `place`: one of the placement scenarios of [A] Figs. 15-17 (`"scenario"`: `channel`, `triangle`, `complex`;
+//!   built by `stackplan::planner::regress`): the best placement (theta, cost, position), nesting height, pairs
+//!   evaluated over the total.
+//! * `orient_intervals`: the constant-topology intervals and sweep counts of every convex pair of two parts over a
+//!   full turn (`stackplan::orient_interval::regress_summary`).
 
 use crate::regress::Fields;
 use anyhow::{Context, bail};
@@ -15,6 +20,8 @@ pub fn run(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
     let kind = scenario.get("kind").and_then(Value::as_str).context("scenario has no \"kind\"")?;
     match kind {
         "part" => part(scenario, dir),
+        "place" => place(scenario),
+        "orient_intervals" => orient_intervals(scenario, dir),
         other => bail!("unknown scenario kind {other:?}"),
     }
 }
@@ -45,5 +52,69 @@ fn part(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
     f.insert("bounding_box_max".into(), hi.to_array().to_vec().into());
     f.insert("boundary_faces".into(), p.boundary.len().into());
     f.insert("vertices".into(), p.vertex_count().into());
+    Ok(f)
+}
+
+fn place(scenario: &Value) -> anyhow::Result<Fields> {
+    use stackplan::planner::regress;
+    let name = scenario.get("scenario").and_then(Value::as_str).context("place scenario has no \"scenario\"")?;
+    let sc = regress::scenario(name)?.with_context(|| format!("unknown placement scenario {name:?}"))?;
+    let (_, report) = regress::run(&sc)?;
+    let mut f = Fields::new();
+    f.insert("stack_parts".into(), report.stack_parts.into());
+    f.insert("found".into(), report.placement.is_some().into());
+    if let Some(p) = &report.placement {
+        f.insert("theta_deg".into(), p.theta_deg.into());
+        f.insert("cost".into(), p.cost.into());
+        f.insert("position".into(), p.position.to_vec().into());
+        f.insert("resting_pose".into(), p.resting_pose.into());
+        f.insert("contacts".into(), p.contacts.len().into());
+    }
+    if let Some(h) = report.height_above_previous {
+        f.insert("height_above_previous".into(), h.into());
+    }
+    f.insert("part_height".into(), report.part_height.into());
+    f.insert("pairs_evaluated".into(), report.stats.pairs_evaluated.into());
+    f.insert("total_pairs".into(), report.stats.total_pairs.into());
+    f.insert("obstacles_constructed".into(), report.stats.obstacles_constructed.into());
+    if let Some((e, t)) = report.seed_pairs {
+        f.insert("info_seed_fraction_evaluated".into(), (e as f64 / t as f64).into());
+    }
+    f.insert("info_fraction_evaluated".into(), report.fraction_evaluated.into());
+    Ok(f)
+}
+
+fn orient_intervals(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
+    let moving = load_part(scenario, "moving", dir)?;
+    let fixed = load_part(scenario, "fixed", dir)?;
+    let pose = scenario.get("fixed_pose");
+    let position = pose
+        .and_then(|p| p.get("position"))
+        .map(|v| serde_json::from_value::<[f64; 3]>(v.clone()))
+        .transpose()?
+        .unwrap_or([0.0; 3]);
+    let rows = pose
+        .and_then(|p| p.get("rotation"))
+        .map(|v| serde_json::from_value::<[[f64; 3]; 3]>(v.clone()))
+        .transpose()?
+        .unwrap_or([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+    let rotation = stackplan_geom::DMat3::from_cols_array_2d(&rows).transpose();
+    let step = scenario.get("step_deg").and_then(Value::as_f64).unwrap_or(1.0);
+    let summary = stackplan::orient_interval::regress_summary(
+        &moving,
+        &fixed,
+        (rotation, stackplan_geom::DVec3::from_array(position)),
+        step,
+    );
+    let mut f = Fields::new();
+    if let Some(Value::Object(totals)) = summary.get("totals") {
+        for (k, v) in totals {
+            f.insert(format!("total_{k}"), v.clone());
+        }
+    }
+    if let Some(Value::Array(pairs)) = summary.get("pairs") {
+        let intervals: Vec<Value> = pairs.iter().map(|p| p.get("intervals").cloned().unwrap_or(Value::Null)).collect();
+        f.insert("intervals_per_pair".into(), intervals.into());
+    }
     Ok(f)
 }
