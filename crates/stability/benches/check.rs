@@ -1,5 +1,5 @@
-//! Benchmarks: the whole-stack check of 15 parts (boxes staggered in a brick pattern, and the built-in example
-//! parts in their lowest resting pose when they exist), and one equilibrium solve for an added part.
+//! Benchmarks: the whole-stack check of 15 parts (boxes staggered in a brick pattern), the contact analysis, and
+//! equilibrium solves for one added part and for the whole stack.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{DMat3, DVec3};
