@@ -1,0 +1,102 @@
+//! `stackplan contacts MOVING FIXED --t-min X,Y,Z,RX,RY,RZ --t-max ... [--offset X,Y,Z] [--seed S]
+//! [--population P] [--generations G] [--json] [--dot F]`: the assembly contact state graph of the moving part
+//! against the fixed part within box bounds on `t = (x, y, z, rx, ry, rz)` ([P] Pan & Schimmels 2004). Angles in
+//! the bounds are in degrees; the moving part's own origin is its reference point, `R = Rz Ry Rx`.
+
+use crate::Outcome;
+use crate::input::load_part_spec;
+use crate::output;
+use anyhow::Context;
+use stackplan::contact_states::acsg::{AcsgSettings, generate};
+use stackplan::contact_states::criteria::ContactPart;
+use stackplan::contact_states::ga::GaSettings;
+use stackplan::contact_states::pose::ConfigBox;
+use stackplan_geom::sheet_metal::Decomposition;
+use stackplan_geom::{DMat3, DVec3, Part, PartOrigin};
+use std::path::PathBuf;
+
+/// Arguments of `contacts`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The moving part B (file or `example:NAME`).
+    pub moving: String,
+    /// The fixed part A (file or `example:NAME`).
+    pub fixed: String,
+    /// Lower bounds `X,Y,Z,RX,RY,RZ` (mm, degrees).
+    #[arg(long, value_name = "X,Y,Z,RX,RY,RZ", allow_hyphen_values = true)]
+    pub t_min: String,
+    /// Upper bounds `X,Y,Z,RX,RY,RZ` (mm, degrees).
+    #[arg(long, value_name = "X,Y,Z,RX,RY,RZ", allow_hyphen_values = true)]
+    pub t_max: String,
+    /// Translation applied to the fixed part first, to express it in the moving part's nominal frame (mm).
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    pub offset: Option<String>,
+    /// GA seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// GA population.
+    #[arg(long, default_value_t = GaSettings::default().population)]
+    pub population: usize,
+    /// GA generations.
+    #[arg(long, default_value_t = GaSettings::default().generations)]
+    pub generations: usize,
+    /// Split concave sheet-metal faces by plain triangulation.
+    #[arg(long)]
+    pub triangulate: bool,
+    /// The whole graph as JSON on stdout (see crates/contact-states/README.md).
+    #[arg(long)]
+    pub json: bool,
+    /// Write the graph in Graphviz DOT to this file.
+    #[arg(long, value_name = "FILE")]
+    pub dot: Option<PathBuf>,
+}
+
+fn parse_list(s: &str, n: usize, what: &str) -> anyhow::Result<Vec<f64>> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("{what} must be {n} comma-separated numbers, got {s:?}"))?;
+    anyhow::ensure!(v.len() == n && v.iter().all(|x| x.is_finite()), "{what} must be {n} finite numbers, got {s:?}");
+    Ok(v)
+}
+
+fn config(s: &str, what: &str) -> anyhow::Result<[f64; 6]> {
+    let v = parse_list(s, 6, what)?;
+    Ok([v[0], v[1], v[2], v[3].to_radians(), v[4].to_radians(), v[5].to_radians()])
+}
+
+/// Runs the command.
+pub fn run(args: &Args) -> anyhow::Result<Outcome> {
+    anyhow::ensure!(args.population >= 4, "--population must be at least 4");
+    let bounds = ConfigBox::new(config(&args.t_min, "--t-min")?, config(&args.t_max, "--t-max")?)?;
+    let decomposition = if args.triangulate { Decomposition::Triangulation } else { Decomposition::ConvexMerge };
+    let moving = load_part_spec(&args.moving, decomposition, false)?;
+    let mut fixed: Part = load_part_spec(&args.fixed, decomposition, false)?;
+    if let Some(o) = &args.offset {
+        let v = parse_list(o, 3, "--offset")?;
+        let shift = DVec3::new(v[0], v[1], v[2]);
+        let components = fixed.components.iter().map(|c| c.transformed(DMat3::IDENTITY, shift)).collect();
+        fixed = Part::from_components(fixed.name.clone(), components, fixed.density, PartOrigin::ConvexPieces)?;
+    }
+    let moving = ContactPart::from_part(&moving).with_context(|| format!("surface of {}", args.moving))?;
+    let fixed = ContactPart::from_part(&fixed).with_context(|| format!("surface of {}", args.fixed))?;
+    let settings = AcsgSettings {
+        ga: GaSettings { population: args.population, generations: args.generations, seed: args.seed, ..GaSettings::default() },
+        ..AcsgSettings::default()
+    };
+    let graph = generate(&fixed, &moving, bounds, settings);
+    if let Some(path) = &args.dot {
+        output::write_atomic(path, graph.to_dot().as_bytes())?;
+    }
+    if args.json {
+        output::print_json(&graph)?;
+    } else {
+        let per_level = graph.counts_per_level();
+        let total: usize = per_level.iter().sum();
+        let mut text = format!("{total} feasible contact states; per level (1..): {:?}\n", &per_level[1.min(per_level.len())..]);
+        text.push_str(&graph.extremal_table());
+        output::print_text(&text)?;
+    }
+    Ok(Outcome::Success)
+}
