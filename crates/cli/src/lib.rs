@@ -47,34 +47,41 @@ pub enum Command {
     Part(cmd::part::PartCommand),
     /// The built-in examples described and drawn under out/ (the README's first command).
     Demo(cmd::demo::Args),
+    /// The best interference-free placements of one part in a stack.
+    Place(cmd::place::Args),
     /// Constant-structure orientation intervals of every convex pair, with the events that end them.
     Intervals(cmd::intervals::Args),
     /// The translational c-space obstacle of every convex pair (JSON, OBJ or SVG slices).
     Cspace(cmd::cspace::Args),
     /// Interfering (penetrating / touching) component pairs of the moving part at a position.
     Interference(cmd::interference::Args),
+    /// Interference, clearance, stability, grasp, insertion and removal of every part of a stack (exit 1 on failure).
+    Check(cmd::check::Args),
 }
 
 /// Runs the command line with the process arguments; returns the exit status.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     init_logging(cli.verbose, cli.quiet);
-    if let Some(n) = cli.threads {
-        if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build_global() {
-            tracing::warn!("could not set the thread count: {e}");
-        }
+    if let Some(n) = cli.threads
+        && let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build_global()
+    {
+        tracing::warn!("could not set the thread count: {e}");
     }
     let result = match &cli.command {
         Command::Part(c) => cmd::part::run(c),
         Command::Demo(a) => cmd::demo::run(a),
+        Command::Place(a) => cmd::place::run(a),
         Command::Intervals(a) => cmd::intervals::run(a),
         Command::Cspace(a) => cmd::cspace::run(a),
         Command::Interference(a) => cmd::interference::run(a),
+        Command::Check(a) => cmd::check::run(a),
     };
     match result {
         Ok(Outcome::Success) => ExitCode::SUCCESS,
         Ok(Outcome::ChecksFailed) => ExitCode::from(1),
         Err(e) => {
+            // the one place where the program writes errors for people
             #[allow(clippy::print_stderr)]
             {
                 eprintln!("error: {e:#}");

@@ -6,6 +6,7 @@
 
 pub use stackplan_geom as geom;
 pub use stackplan_cspace as cspace;
-pub use stackplan_orient_interval as orient_interval;
 pub use stackplan_freespace as freespace;
 pub use stackplan_planner as planner;
+pub use stackplan_orient_interval as orient_interval;
+pub use stackplan_stability as stability;

@@ -1,7 +1,10 @@
 //! One module per subcommand.
 
+pub mod check;
 pub mod cspace;
 pub mod demo;
 pub mod interference;
 pub mod intervals;
 pub mod part;
+pub mod place;
+pub mod poses;

@@ -17,6 +17,8 @@ pub enum PartCommand {
     Info(InfoArgs),
     /// Writes the part as binary glTF, OBJ or STL.
     Export(ExportArgs),
+    /// Stable resting poses with margins and suction-grasp faces.
+    Poses(super::poses::PosesArgs),
 }
 
 /// Arguments of `part info`.
@@ -53,6 +55,7 @@ pub fn run(cmd: &PartCommand) -> anyhow::Result<Outcome> {
     match cmd {
         PartCommand::Info(a) => info(a),
         PartCommand::Export(a) => export(a),
+        PartCommand::Poses(a) => super::poses::run_poses(a),
     }
 }
 

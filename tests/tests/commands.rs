@@ -1,0 +1,102 @@
+//! `cspace`, `interference`, `place` and `check` end to end, on unit cubes where every answer is known by hand.
+
+mod common;
+use common::*;
+use serde_json::Value;
+
+fn json(o: &std::process::Output) -> Value {
+    assert!(o.status.code().is_some(), "terminated by a signal");
+    serde_json::from_str(&stdout(o)).unwrap_or_else(|e| panic!("not JSON ({e}): {}\n{}", stdout(o), stderr(o)))
+}
+
+#[test]
+fn cspace_of_two_unit_cubes_is_the_cube_of_side_two() {
+    let o = run(&["cspace", "example:cube", "example:cube", "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v = json(&o);
+    let pair = &v["pairs"][0];
+    let faces = pair["faces"].as_array().expect("faces");
+    assert_eq!(faces.len(), 6);
+    // documented convention: p is in the obstacle iff normal . p <= offset for every face
+    let inside = |p: [f64; 3]| {
+        faces.iter().all(|f| {
+            let n = &f["normal"];
+            let d = f["offset"].as_f64().expect("offset");
+            (0..3).map(|k| n[k].as_f64().expect("n") * p[k]).sum::<f64>() <= d + 1e-12
+        })
+    };
+    assert!(inside([0.0, 0.0, 0.0]));
+    assert!(inside([0.99, -0.99, 0.5]));
+    assert!(!inside([1.01, 0.0, 0.0]));
+    assert!((pair["volume"].as_f64().expect("volume") - 8.0).abs() < 1e-9);
+}
+
+#[test]
+fn interference_reports_penetrating_touching_and_free() {
+    let case = |pos: &str| {
+        let o = run(&["interference", "example:cube", "example:cube", "--position", pos, "--json"]);
+        assert!(o.status.code().is_some_and(|c| c == 0 || c == 1), "{}", stderr(&o));
+        json(&o)
+    };
+    let v = case("0,0,0.5");
+    assert_eq!(v["penetrating"], 1);
+    let v = case("0,0,1");
+    assert_eq!(v["penetrating"], 0);
+    assert_eq!(v["touching"], 1);
+    let v = case("0,0,2");
+    assert_eq!(v["penetrating"], 0);
+    assert_eq!(v["touching"], 0);
+}
+
+fn write_stack(dir: &std::path::Path, positions: &[[f64; 3]]) -> std::path::PathBuf {
+    let placements: Vec<Value> = positions
+        .iter()
+        .map(|p| serde_json::json!({"position": p, "rotation": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]}))
+        .collect();
+    let stack = serde_json::json!({"part": fixture("cube").to_str().expect("utf-8"), "placements": placements});
+    let path = dir.join("stack.json");
+    std::fs::write(&path, serde_json::to_string_pretty(&stack).expect("json")).expect("write");
+    path
+}
+
+#[test]
+fn place_puts_a_cube_on_a_cube_when_floor_space_is_expensive() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let stack = write_stack(dir.path(), &[[0.0, 0.0, 0.0]]);
+    let cube = fixture("cube");
+    // a 1 x 1 floor: the only free place is on top of the first cube
+    let o = run(&[
+        "place",
+        cube.to_str().expect("utf-8"),
+        "--stack",
+        stack.to_str().expect("utf-8"),
+        "--floor",
+        "0,0,1,1",
+        "--height",
+        "5",
+        "--w",
+        "0.5",
+        "--dtheta-deg",
+        "90",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v = json(&o);
+    let p = &v["placements"][0]["position"];
+    let z = p[2].as_f64().expect("z");
+    assert!((z - 1.0).abs() < 1e-6, "the cube goes on top: {v}");
+}
+
+#[test]
+fn check_accepts_a_column_and_rejects_an_overlap() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let stack = write_stack(dir.path(), &[[0.0, 0.0, 0.0], [0.0, 0.0, 1.0]]);
+    let o = run(&["check", stack.to_str().expect("utf-8"), "--cup-diameter", "0.5", "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}\n{}", stdout(&o), stderr(&o));
+    let stack = write_stack(dir.path(), &[[0.0, 0.0, 0.0], [0.0, 0.0, 0.5]]);
+    let o = run(&["check", stack.to_str().expect("utf-8"), "--cup-diameter", "0.5", "--json"]);
+    assert_eq!(o.status.code(), Some(1), "an interfering stack fails the check: {}", stdout(&o));
+    let o = run(&["check", "no/such/stack.json"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("no/such/stack.json"), "{}", stderr(&o));
+}
