@@ -34,8 +34,9 @@ pub fn load_part(args: &PartArgs) -> anyhow::Result<Part> {
 /// Reads a part from a path or `example:NAME`.
 pub fn load_part_spec(spec: &str, decomposition: Decomposition, decompose_mesh: bool) -> anyhow::Result<Part> {
     if let Some(name) = spec.strip_prefix("example:") {
-        return stackplan_geom::examples::part_by_name(name, decomposition)
-            .with_context(|| format!("no built-in example named {name:?} (try channel, triangle, complex, cube, l-corner, block)"));
+        return stackplan_geom::examples::part_by_name(name, decomposition).with_context(|| {
+            format!("no built-in example named {name:?} (try channel, triangle, complex, cube, l-corner, block)")
+        });
     }
     let options = stackplan_geom::io::ReadOptions { decomposition, decompose_mesh, ..Default::default() };
     Ok(stackplan_geom::io::read_part(std::path::Path::new(spec), &options)?)

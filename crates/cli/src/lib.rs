@@ -57,6 +57,8 @@ pub enum Command {
     Interference(cmd::interference::Args),
     /// Interference, clearance, stability, grasp, insertion and removal of every part of a stack (exit 1 on failure).
     Check(cmd::check::Args),
+    /// Assembly contact states of two parts within bounded misalignment, with their extremal configurations.
+    Contacts(cmd::contacts::Args),
 }
 
 /// Runs the command line with the process arguments; returns the exit status.
@@ -76,6 +78,7 @@ pub fn main() -> ExitCode {
         Command::Cspace(a) => cmd::cspace::run(a),
         Command::Interference(a) => cmd::interference::run(a),
         Command::Check(a) => cmd::check::run(a),
+        Command::Contacts(a) => cmd::contacts::run(a),
     };
     match result {
         Ok(Outcome::Success) => ExitCode::SUCCESS,

@@ -148,7 +148,8 @@ fn layout(scene: &Scene) -> Layout {
         let frame = Frame::new(view);
         let mut lo = DVec2::splat(f64::INFINITY);
         let mut hi = DVec2::splat(f64::NEG_INFINITY);
-        let all = scene.solids.iter().flat_map(|s| s.polytope.vertices().iter().copied()).chain(scene.floor.iter().copied());
+        let all =
+            scene.solids.iter().flat_map(|s| s.polytope.vertices().iter().copied()).chain(scene.floor.iter().copied());
         for p in all {
             let q = frame.project(p);
             lo = lo.min(q);
@@ -256,7 +257,8 @@ pub fn png(scene: &Scene, scale: f64) -> anyhow::Result<Vec<u8>> {
     use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Stroke, Transform};
     let lay = layout(scene);
     let (w, h) = ((lay.width * scale).ceil() as u32, (lay.height * scale).ceil() as u32);
-    let mut pixmap = Pixmap::new(w.max(1), h.max(1)).ok_or_else(|| anyhow::anyhow!("cannot allocate a {w}x{h} image"))?;
+    let mut pixmap =
+        Pixmap::new(w.max(1), h.max(1)).ok_or_else(|| anyhow::anyhow!("cannot allocate a {w}x{h} image"))?;
     pixmap.fill(Color::WHITE);
     let t = Transform::from_scale(scale as f32, scale as f32);
     let polygon = |pts: &[(f64, f64)]| {

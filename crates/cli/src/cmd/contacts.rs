@@ -82,7 +82,12 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let moving = ContactPart::from_part(&moving).with_context(|| format!("surface of {}", args.moving))?;
     let fixed = ContactPart::from_part(&fixed).with_context(|| format!("surface of {}", args.fixed))?;
     let settings = AcsgSettings {
-        ga: GaSettings { population: args.population, generations: args.generations, seed: args.seed, ..GaSettings::default() },
+        ga: GaSettings {
+            population: args.population,
+            generations: args.generations,
+            seed: args.seed,
+            ..GaSettings::default()
+        },
         ..AcsgSettings::default()
     };
     let graph = generate(&fixed, &moving, bounds, settings);
@@ -94,7 +99,8 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     } else {
         let per_level = graph.counts_per_level();
         let total: usize = per_level.iter().sum();
-        let mut text = format!("{total} feasible contact states; per level (1..): {:?}\n", &per_level[1.min(per_level.len())..]);
+        let mut text =
+            format!("{total} feasible contact states; per level (1..): {:?}\n", &per_level[1.min(per_level.len())..]);
         text.push_str(&graph.extremal_table());
         output::print_text(&text)?;
     }

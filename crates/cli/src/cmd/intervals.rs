@@ -103,7 +103,11 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     };
     let only = args.pair.as_deref().map(parse_pair).transpose()?;
     if let Some((i, j)) = only {
-        anyhow::ensure!(i < moving.components.len(), "--pair: the moving part has {} components", moving.components.len());
+        anyhow::ensure!(
+            i < moving.components.len(),
+            "--pair: the moving part has {} components",
+            moving.components.len()
+        );
         anyhow::ensure!(j < fixed.components.len(), "--pair: the fixed part has {} components", fixed.components.len());
     }
     anyhow::ensure!(args.from_deg <= args.to_deg, "--from-deg must not exceed --to-deg");
@@ -138,10 +142,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     } else {
         let mut text = String::new();
         for p in &out.pairs {
-            text.push_str(&format!(
-                "pair moving {} / fixed {}: {} events\n",
-                p.moving_piece, p.fixed_piece, p.events
-            ));
+            text.push_str(&format!("pair moving {} / fixed {}: {} events\n", p.moving_piece, p.fixed_piece, p.events));
             for t in p.intervals.iter().filter(|t| !t.degenerate) {
                 let kind = t.event.as_ref().and_then(|e| e["kind"].as_str()).unwrap_or("none");
                 text.push_str(&format!("  [{:10.6}, {:10.6}) deg  ends by {kind}\n", t.start_deg, t.end_deg));

@@ -1,6 +1,7 @@
 //! One module per subcommand.
 
 pub mod check;
+pub mod contacts;
 pub mod cspace;
 pub mod demo;
 pub mod interference;

@@ -87,7 +87,8 @@ pub fn run_poses(args: &PosesArgs) -> anyhow::Result<Outcome> {
     if args.json {
         output::print_json(&out)?;
     } else {
-        let mut text = format!("part {}: {} stable resting poses (cup {} mm)\n", out.part, out.poses.len(), out.cup_diameter);
+        let mut text =
+            format!("part {}: {} stable resting poses (cup {} mm)\n", out.part, out.poses.len(), out.cup_diameter);
         text.push_str("  face   phi_deg   psi_deg  cg_height     margin  grasp_radius  graspable\n");
         for p in &out.poses {
             let radius = p.grasp_faces.first().map_or(0.0, |f| f.inscribed_radius);
