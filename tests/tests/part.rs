@@ -13,7 +13,8 @@ fn part_info_json_describes_the_fixture() {
         assert_eq!(v["components"], components, "{name}");
         assert_eq!(v["pieces"].as_array().map(Vec::len), Some(components));
         let volume = v["volume"].as_f64().expect("volume");
-        let pieces: f64 = v["pieces"].as_array().expect("pieces").iter().map(|p| p["volume"].as_f64().expect("v")).sum();
+        let pieces: f64 =
+            v["pieces"].as_array().expect("pieces").iter().map(|p| p["volume"].as_f64().expect("v")).sum();
         assert!((volume - pieces).abs() <= 1e-9 * volume, "{name}: {volume} vs {pieces}");
         let lo = &v["bounding_box"][0];
         let hi = &v["bounding_box"][1];

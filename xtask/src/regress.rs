@@ -103,7 +103,9 @@ pub fn run(root: &Path, bless: bool, filter: Option<&str>) -> anyhow::Result<boo
             continue;
         }
         let golden: Map<String, Value> = match std::fs::read_to_string(&golden_path) {
-            Ok(t) => serde_json::from_str(&t).with_context(|| format!("{} is not valid JSON", golden_path.display()))?,
+            Ok(t) => {
+                serde_json::from_str(&t).with_context(|| format!("{} is not valid JSON", golden_path.display()))?
+            }
             Err(_) => {
                 println!("{name:<34} {:<28} {:<40} {:<40} NO GOLDEN (run with --bless)", "-", "-", "-");
                 all_ok = false;
@@ -132,7 +134,10 @@ pub fn run(root: &Path, bless: bool, filter: Option<&str>) -> anyhow::Result<boo
         }
     }
     if !bless {
-        println!("{}", if all_ok { "regress: all scenarios match their goldens" } else { "regress: DIFFERENCES FOUND" });
+        println!(
+            "{}",
+            if all_ok { "regress: all scenarios match their goldens" } else { "regress: DIFFERENCES FOUND" }
+        );
     }
     Ok(all_ok)
 }
