@@ -8,7 +8,7 @@
 //! One ACSG is generated (GA population 30, 20 generations, polish 800 for test time; about 12 s in the test
 //! profile) and checked:
 //! * regression: the number of feasible states per level is printed with the Table I-style extremal table (recorded
-//!   in BENCHMARKS.md: seed 2004 gives [0, 34, 119, 98, 40, 26, 5, 3], 325 states, against the seed's 63 for its own
+//!   in docs/benchmarks.md: seed 2004 gives [0, 34, 119, 98, 40, 26, 5, 3], 325 states, against the seed's 63 for its own
 //!   geometry); every feasible state's witness is in the box and below the threshold;
 //! * independent sampling: random configurations in the box, pushed along random 6-D directions to first contact
 //!   (bisection on the penetration measure), classified by the PCs whose criteria vanish (tolerance 1e-6 L); every

@@ -238,7 +238,7 @@ fn touching_is_one() {
     assert!((s - 1.0).abs() < 1e-9, "{s}");
 }
 
-/// The per-call benchmark figure of BENCHMARKS.md relies on this shape of problem: check the box pair case is exact.
+/// The per-call benchmark figure of docs/benchmarks.md relies on this shape of problem: check the box pair case is exact.
 #[test]
 fn box_pair_example() {
     let pts = |lo: DVec3, hi: DVec3| -> Vec<DVec3> {

@@ -1,6 +1,6 @@
 //! Tightness and conservativeness of the reported intervals: `reported / true` forward length from random angles,
 //! the true end found by sampling the from-scratch structure every 0.25 degree and bisecting the first change (test
-//! only). The reported end must never lie after the true end; the distribution is printed (BENCHMARKS.md).
+//! only). The reported end must never lie after the true end; the distribution is printed (docs/benchmarks.md).
 
 mod common;
 

@@ -1,6 +1,6 @@
 //! Rough per-call timing of extrapolation vs construction on the example parts' component pairs, in the test
 //! profile (our crates at opt-level 1, dependencies at 3; the criterion bench in benches/ is the release figure).
-//! Asserts only that extrapolating the geometry is cheaper than building; prints the ratios for BENCHMARKS.md.
+//! Asserts only that extrapolating the geometry is cheaper than building; prints the ratios for docs/benchmarks.md.
 
 use stackplan_cspace::minkowski::obstacle;
 use stackplan_geom::examples;
