@@ -632,7 +632,8 @@ fn planar_sum(is: &[usize], js: &[usize], ra: &[DVec3], bv: &[DVec3], normal: DV
     let lin = RELATIVE * (hi.0 - lo.0).hypot(hi.1 - lo.1);
     let mut unique: Vec<(f64, f64, [usize; 2])> = Vec::with_capacity(pts.len());
     for p in pts {
-        if !unique.iter().any(|q| (p.0 - q.0).hypot(p.1 - q.1) <= lin) {
+        let lin_sq = lin * lin;
+        if !unique.iter().any(|q| (p.0 - q.0) * (p.0 - q.0) + (p.1 - q.1) * (p.1 - q.1) <= lin_sq) {
             unique.push(p);
         }
     }
@@ -642,7 +643,7 @@ fn planar_sum(is: &[usize], js: &[usize], ra: &[DVec3], bv: &[DVec3], normal: DV
     let turns_left = |o: &(f64, f64, [usize; 2]), a: &(f64, f64, [usize; 2]), b: &(f64, f64, [usize; 2])| {
         let (ax, ay, bx, by) = (a.0 - o.0, a.1 - o.1, b.0 - o.0, b.1 - o.1);
         // o -> a -> b turns left and a is farther than `lin` from the line o -> b
-        ax * by - ay * bx > lin * bx.hypot(by)
+        ax * by - ay * bx > lin * (bx * bx + by * by).sqrt()
     };
     // the chain itself uses the exact orientation predicate (a tolerance inside the chain loses corners when nearly
     // collinear points come in non-monotone order); near-collinear corners are removed afterwards
