@@ -100,3 +100,40 @@ fn check_accepts_a_column_and_rejects_an_overlap() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("no/such/stack.json"), "{}", stderr(&o));
 }
+
+#[test]
+fn plan_writes_every_output_and_check_accepts_the_plan() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let o = run_in(dir.path(), &["plan", "example:channel", "--count", "4", "--dtheta-deg", "30", "--out", "p"]);
+    assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
+    for f in ["plan.json", "stack.svg", "stack.png", "stack.glb", "report.html"] {
+        let path = dir.path().join("p").join(f);
+        assert!(path.metadata().is_ok_and(|m| m.len() > 0), "{f} is missing or empty");
+    }
+    let plan: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("p/plan.json")).expect("plan")).expect("JSON");
+    assert_eq!(plan["placements"].as_array().map(Vec::len), Some(4));
+    assert_eq!(plan["plan"]["placed"], 4);
+    // the plan file is a stack file: check reads it and every part passes
+    let o = run_in(dir.path(), &["check", "p/plan.json", "--cup-diameter", "10", "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
+    let html = std::fs::read_to_string(dir.path().join("p/report.html")).expect("html");
+    assert!(html.contains("<table id=\"parts\">") && html.contains("stack.png"));
+}
+
+#[test]
+fn plan_rejects_bad_requests_without_writing_anything() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let cases: [&[&str]; 4] = [
+        &["plan", "example:channel", "--count", "0", "--out", "x"],
+        &["plan", "example:channel", "--w", "1.5", "--out", "x"],
+        &["plan", "no/such/part.json", "--out", "x"],
+        &["plan", "example:channel", "--floor", "0,0,50,50", "--out", "x"],
+    ];
+    for args in cases {
+        let o = run_in(dir.path(), args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).starts_with("error:"), "{args:?}: {}", stderr(&o));
+        assert!(!dir.path().join("x").join("plan.json").exists(), "{args:?} wrote a partial plan");
+    }
+}

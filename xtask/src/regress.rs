@@ -38,10 +38,11 @@ fn tolerances(scenario: &Value) -> BTreeMap<String, Tol> {
 fn same(golden: &Value, actual: &Value, tol: Tol) -> bool {
     match (golden, actual) {
         (Value::Number(g), Value::Number(a)) => {
-            if let (Some(g), Some(a)) = (g.as_i64(), a.as_i64()) {
-                if tol.rel == DEFAULT_TOL.rel && tol.abs == DEFAULT_TOL.abs {
-                    return g == a;
-                }
+            if let (Some(g), Some(a)) = (g.as_i64(), a.as_i64())
+                && tol.rel == DEFAULT_TOL.rel
+                && tol.abs == DEFAULT_TOL.abs
+            {
+                return g == a;
             }
             match (g.as_f64(), a.as_f64()) {
                 (Some(g), Some(a)) => (g - a).abs() <= tol.abs.max(tol.rel * g.abs()),

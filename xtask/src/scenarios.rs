@@ -38,7 +38,7 @@ fn decomposition(scenario: &Value) -> anyhow::Result<Decomposition> {
 pub fn load_part(scenario: &Value, key: &str, dir: &Path) -> anyhow::Result<Part> {
     let rel = scenario.get(key).and_then(Value::as_str).with_context(|| format!("scenario has no {key:?}"))?;
     let options = stackplan_geom::io::ReadOptions { decomposition: decomposition(scenario)?, ..Default::default() };
-    Ok(stackplan_geom::io::read_part(&dir.join(rel), &options)?)
+    Ok(stackplan_geom::io::read_part(dir.join(rel), &options)?)
 }
 
 fn part(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {

@@ -45,7 +45,9 @@ pub enum Command {
     /// Information about a part, and export to other formats.
     #[command(subcommand)]
     Part(cmd::part::PartCommand),
-    /// The built-in examples described and drawn under out/ (the README's first command).
+    /// A stacking plan for N identical parts, with pictures, a 3-D model and a report (default: 15 Triangle parts).
+    Plan(cmd::plan::Args),
+    /// The built-in example parts described and drawn under out/.
     Demo(cmd::demo::Args),
     /// The best interference-free placements of one part in a stack.
     Place(cmd::place::Args),
@@ -72,6 +74,7 @@ pub fn main() -> ExitCode {
     }
     let result = match &cli.command {
         Command::Part(c) => cmd::part::run(c),
+        Command::Plan(a) => cmd::plan::run(a),
         Command::Demo(a) => cmd::demo::run(a),
         Command::Place(a) => cmd::place::run(a),
         Command::Intervals(a) => cmd::intervals::run(a),

@@ -290,6 +290,12 @@ pub fn png(scene: &Scene, scale: f64) -> anyhow::Result<Vec<u8>> {
         }
         for f in &faces {
             let pts: Vec<(f64, f64)> = f.points.iter().map(|q| to_screen(panel, *q)).collect();
+            let area2: f64 = (0..pts.len())
+                .map(|k| pts[k].0 * pts[(k + 1) % pts.len()].1 - pts[(k + 1) % pts.len()].0 * pts[k].1)
+                .sum();
+            if area2.abs() < 1e-6 {
+                continue; // seen edge-on: nothing to fill
+            }
             if let Some(path) = polygon(&pts) {
                 let mut paint = Paint::default();
                 paint.set_color_rgba8(f.fill[0], f.fill[1], f.fill[2], 255);

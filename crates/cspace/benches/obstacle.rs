@@ -1,6 +1,8 @@
 //! Obstacle construction: Gauss-map overlay (the library route) vs the exact-predicate hull of the `nA * nB`
 //! differences vs parry3d-f64's hull of the same differences, in the same run; and the convex-pair interference test.
 
+#![allow(clippy::print_stderr)] // a benchmark program reports the case sizes on stderr
+
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{DMat3, DVec3};
 use stackplan_cspace::interference::{PlacedConvex, classify_pair};
@@ -73,7 +75,6 @@ fn bench(c: &mut Criterion) {
     for (name, a, b, r) in &cases {
         let o = obstacle(a, *r, b).expect("obstacle");
         assert!(gauss_map_obstacle(a, *r, b).is_ok(), "{name}: the Gauss-map route must succeed");
-        #[allow(clippy::print_stderr)]
         eprintln!(
             "{name}: {} x {} vertices -> {} vertices, {} faces",
             a.vertices().len(),

@@ -159,6 +159,7 @@ pub fn candidates(
     sweep: Option<&SweepAxes>,
     p: DVec3,
     clearance: f64,
+    horizontal_clearance: bool,
     tol: f64,
     counts: &mut DetectCounts,
 ) -> Vec<Candidate> {
@@ -174,6 +175,14 @@ pub fn candidates(
                 continue;
             }
             counts.narrow_phase += 1;
+            if horizontal_clearance && clearance > 0.0 {
+                let slack = horizontal_slack(&moved, &fixed.placed, clearance);
+                if slack >= -tol {
+                    continue;
+                }
+                out.push(Candidate { moving: mi, fixed: fi, violation: -slack });
+                continue;
+            }
             let violation = match classify_pair(&moved, &fixed.placed, tol, clearance) {
                 PairContact::Penetrating { depth } => depth + clearance,
                 PairContact::Touching { gap } if clearance > tol => clearance - gap,
@@ -185,4 +194,36 @@ pub fn candidates(
     }
     out.sort_by(|a, b| b.violation.total_cmp(&a.violation).then(a.moving.cmp(&b.moving)).then(a.fixed.cmp(&b.fixed)));
     out
+}
+
+/// Horizontal clearance of a convex pair: the largest, over the separating axes `u` (face normals of both, edge
+/// cross products), of `gap_u - clearance |u_xy|`. Non-negative iff the pair stays apart when one of them is moved
+/// horizontally by at most `clearance` (up to the mitring of the axis set); negative values measure the violation.
+pub fn horizontal_slack(a: &PlacedConvex, b: &PlacedConvex, clearance: f64) -> f64 {
+    let project = |vs: &[DVec3], u: DVec3| {
+        vs.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            let x = u.dot(*v);
+            (lo.min(x), hi.max(x))
+        })
+    };
+    let mut best = f64::NEG_INFINITY;
+    let mut test = |u: DVec3| {
+        let (a_lo, a_hi) = project(&a.vertices, u);
+        let (b_lo, b_hi) = project(&b.vertices, u);
+        let gap = (b_lo - a_hi).max(a_lo - b_hi);
+        best = best.max(gap - clearance * (1.0 - u.z * u.z).max(0.0).sqrt());
+    };
+    for &u in a.normal_axes.iter().chain(&b.normal_axes) {
+        test(u);
+    }
+    for &da in &a.edge_directions {
+        for &db in &b.edge_directions {
+            let c = da.cross(db);
+            let len2 = c.length_squared();
+            if len2 > 1e-18 {
+                test(c / len2.sqrt());
+            }
+        }
+    }
+    best
 }

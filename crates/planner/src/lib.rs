@@ -12,7 +12,9 @@
 //! * [`qp`]: the QP on a free-space cell with its active constraints;
 //! * [`search`]: the best-first search and its statistics ([A] Tables I-II);
 //! * [`reference`]: the brute-force reference (complete obstacles, complete free space) used by the tests;
-//! * [`regress`]: the scenarios of [A] Figs. 15-17 for `cargo xtask regress`.
+//! * [`regress`]: the scenarios of [A] Figs. 15-17 for `cargo xtask regress`;
+//! * [`stack_plan`]: the stacking planner for n identical parts ([A] II-B): placement, then stability, grasp and
+//!   insertion checks, in the seed's two stages.
 
 pub mod detect;
 pub mod obstacles;
@@ -22,7 +24,9 @@ pub mod reference;
 pub mod regress;
 pub mod request;
 pub mod search;
+pub mod stack_plan;
 pub mod symmetry;
 
 pub use request::{Cost, FloorVolume, PlacementError, PlacementRequest, StackPart, thetas_with_step, uniform_thetas};
 pub use search::{Contact, NoPlacement, Placement, PlacementResult, PlacementStats, place, place_with_cache};
+pub use stack_plan::{Plan, PlanError, PlanOptions, PlannedPart, plan_stack};

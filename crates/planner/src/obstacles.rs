@@ -68,6 +68,7 @@ impl DerivedObstacle {
         fixed: usize,
         cache: &ObstacleCache,
         clearance: f64,
+        horizontal_clearance: bool,
         with_insertion: bool,
     ) -> Result<Self, String> {
         let sc = &scene.components[fixed];
@@ -92,7 +93,12 @@ impl DerivedObstacle {
         };
         if clearance > 0.0 {
             for p in &mut planes {
-                p.offset += clearance;
+                // support function of the growth set: the ball (clearance) or the horizontal disc (clearance |n_xy|)
+                p.offset += if horizontal_clearance {
+                    clearance * (1.0 - p.normal.z * p.normal.z).max(0.0).sqrt()
+                } else {
+                    clearance
+                };
             }
         }
         Ok(Self { orientation: orientation.index, moving, fixed, planes, origins })

@@ -49,8 +49,17 @@ pub fn complete_optimum(request: &PlacementRequest<'_>) -> Result<Option<(f64, u
         let mut cells = vec![root];
         for mi in 0..part.components.len() {
             for fi in 0..scene.components.len() {
-                let ob =
-                    DerivedObstacle::build(part, &o, mi, &scene, fi, &cache, request.clearance, request.insertion)?;
+                let ob = DerivedObstacle::build(
+                    part,
+                    &o,
+                    mi,
+                    &scene,
+                    fi,
+                    &cache,
+                    request.clearance,
+                    request.horizontal_clearance,
+                    request.insertion,
+                )?;
                 let interior: Vec<Halfspace<3>> = ob
                     .planes
                     .iter()

@@ -93,6 +93,11 @@ pub struct PlacementRequest<'a> {
     pub fixed_z: Option<f64>,
     /// Minimum distance between the new part's components and the stack's (mm); obstacles grown by it ([A] eq. 10-11).
     pub clearance: f64,
+    /// Measure the clearance in the horizontal plane only ([A] VII-B: "the parts are separated in the plane by at
+    /// least 5 mm"): each obstacle is grown by a horizontal disc of radius `clearance` (face offsets
+    /// `clearance |n_xy|`, mitred), so a part may rest on another while keeping `clearance` sideways. `false`: the
+    /// distance in space (every face offset by `clearance`).
+    pub horizontal_clearance: bool,
     /// The cost.
     pub cost: Cost,
     /// Require the final position to be reachable by a straight vertical descent from above (insertion obstacles).
@@ -132,6 +137,7 @@ impl<'a> PlacementRequest<'a> {
             floor,
             fixed_z: None,
             clearance: 0.0,
+            horizontal_clearance: false,
             cost: Cost::Stacking { w: 0.5, origin },
             insertion: false,
             k: 1,

@@ -468,6 +468,7 @@ impl Search<'_, '_> {
                 self.sweeps[node.orientation].as_ref(),
                 p,
                 clearance,
+                self.request.horizontal_clearance,
                 tol,
                 &mut counts,
             );
@@ -539,6 +540,7 @@ impl Search<'_, '_> {
             fixed,
             self.cache,
             self.request.clearance,
+            self.request.horizontal_clearance,
             self.request.insertion,
         )
         .map_err(|reason| {

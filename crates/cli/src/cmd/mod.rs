@@ -8,4 +8,5 @@ pub mod interference;
 pub mod intervals;
 pub mod part;
 pub mod place;
+pub mod plan;
 pub mod poses;

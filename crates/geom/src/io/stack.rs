@@ -9,7 +9,8 @@
 //! object (the part JSON of [`super::json`]). A placement maps a point `v` of the part file's coordinates to the world
 //! point `rotation . v + position`, the rotation given by rows (`rotation[i][j]` is row `i`, column `j`); it must be
 //! a proper rotation ([`Pose::check`]). Placements may carry extra keys (cost, theta, contacts...), which are kept in
-//! [`StackFile::extras`] and written back; unknown top-level keys are rejected. O(file size) plus reading the part.
+//! [`StackFile::extras`] and written back; a top-level `plan` object (the summary of a plan file written by
+//! `stackplan plan`) is accepted and ignored; other unknown top-level keys are rejected. O(file size) plus reading the part.
 
 use super::json::{PartRecord, json_error, part_from_record, part_json_value_string};
 use super::{IoError, Place, ReadOptions, check_coordinate};
@@ -46,6 +47,9 @@ pub enum StackPart<'a> {
 struct StackRecord {
     part: Value,
     placements: Vec<PlacementRecord>,
+    /// The summary a plan file (`stackplan plan`) carries beside its placements; not part of the stack.
+    #[serde(default, rename = "plan")]
+    _plan: Option<Value>,
 }
 
 #[derive(Debug, Deserialize)]

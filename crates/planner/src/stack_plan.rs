@@ -1,0 +1,503 @@
+//! The stacking planner for n identical parts ([A] section II-B, "generate and test"; DESIGN.md sections 6-7).
+//!
+//! Parts are added one at a time; the parts already placed never move. For each new part:
+//!
+//! 1. candidate orientations: the part's stable resting poses that present an upward face holding the suction cup
+//!    ([`stackplan_stability::resting_poses`], [`stackplan_stability::grasp`]; at most
+//!    [`PlanOptions::max_resting_poses`], lowest c.g. first) x the discrete theta set;
+//! 2. the best-first placement search ([`crate::search::place`]) returns up to [`PlanOptions::candidates`]
+//!    interference-free positions sorted by the part's term of cost (1), one per free-space cell; with
+//!    `insertion` every candidate can be lowered straight down into place (insertion obstacles);
+//! 3. the candidates are tested in cost order with [`stackplan_stability::check::check_stack`] on the stack plus the
+//!    candidate: the new part statically stable on its supports (friction cones), the whole stack stable, a suction
+//!    face for the cup, insertable from above; the first that passes is taken;
+//! 4. the seed's two stages: stage 1 searches within the stack's current floor footprint (its bounding rectangle
+//!    grown by `nest_allowance`, clipped to the floor), so the stack's bounding box is not enlarged, or only
+//!    slightly to nest; stage 2 searches the whole floor. Stage 1's part is taken unless stage 2's is strictly
+//!    cheaper (the seed takes stage 1 whenever it succeeds; with `w = 0` that would stack parts on top of each other
+//!    instead of spreading them on the floor as its own Fig. 2 shows, so here the footprint limit breaks ties and
+//!    near-ties of cost (1) in favour of a compact stack, and never overrides the cost).
+//!
+//! A part that fits nowhere ends the plan with the reason; the plan keeps the parts placed so far.
+//! Cost: O(n) placements, each the search of [`crate::search`] plus at most `candidates` stack checks.
+
+use crate::request::{Cost, FloorVolume, PlacementError, PlacementRequest, StackPart, thetas_with_step};
+use crate::search::{Contact, NoPlacement, Placement, place_with_cache};
+use glam::{DMat3, DVec2, DVec3};
+use serde::{Deserialize, Serialize};
+use stackplan_cspace::cache::ObstacleCache;
+use stackplan_geom::{Part, Pose};
+use stackplan_stability::check::{CheckOptions, check_stack};
+use stackplan_stability::grasp::{GraspOptions, grasp_faces, is_graspable};
+use stackplan_stability::world::PlacedPart;
+
+/// Options of a stacking plan.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlanOptions {
+    /// Number of parts to stack (at least 1).
+    pub count: usize,
+    /// Floor volume `Sigma` (floor polygon x [0, max height]).
+    pub floor: FloorVolume,
+    /// Weight `w` of cost (1) in `[0, 1]`.
+    pub w: f64,
+    /// `(x0, y0, z0)` of cost (1); `None`: the floor polygon's centroid at `z0 = 0`.
+    pub origin: Option<DVec3>,
+    /// Horizontal clearance between parts (mm), for the robot's positioning error ([A] eq. 10-11; "separated in the
+    /// plane by at least 5 mm", [A] VII-B); parts may still rest on each other.
+    pub clearance: f64,
+    /// Step of the discrete rotation about z (radians).
+    pub dtheta: f64,
+    /// Coulomb friction coefficient for the stability check.
+    pub mu: f64,
+    /// Suction cup diameter (mm).
+    pub cup_diameter: f64,
+    /// Require top-down insertion (insertion obstacles in the search, and the check).
+    pub insertion: bool,
+    /// Interference-free candidates per part and stage, tested in cost order.
+    pub candidates: usize,
+    /// Resting poses considered (lowest c.g. first).
+    pub max_resting_poses: usize,
+    /// How far stage 1 may grow the stack's footprint to nest a part (mm).
+    pub nest_allowance: f64,
+}
+
+impl PlanOptions {
+    /// Defaults of the seed's examples: w = 0.5, 5 mm clearance, 1-degree steps, mu = 0.5, 10 mm cup, insertion,
+    /// 8 candidates, 3 resting poses, 5 mm nesting allowance.
+    pub fn new(count: usize, floor: FloorVolume) -> Self {
+        Self {
+            count,
+            floor,
+            w: 0.5,
+            origin: None,
+            clearance: 5.0,
+            dtheta: 1f64.to_radians(),
+            mu: 0.5,
+            cup_diameter: 10.0,
+            insertion: true,
+            candidates: 8,
+            max_resting_poses: 3,
+            nest_allowance: 5.0,
+        }
+    }
+}
+
+/// One planned part.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlannedPart {
+    /// Position of the part (world vertex = rotation . v + position).
+    pub position: [f64; 3],
+    /// Rotation matrix rows.
+    pub rotation: [[f64; 3]; 3],
+    /// Order in the stack (0 = first placed).
+    pub index: usize,
+    /// Angle about z (degrees).
+    pub theta_deg: f64,
+    /// Index of the resting pose (into [`Plan::resting_poses`]).
+    pub resting_pose: usize,
+    /// Stage that placed it: 1 (within the stack's footprint) or 2 (the whole floor).
+    pub stage: u8,
+    /// The part's term of cost (1).
+    pub cost: f64,
+    /// Contacts named by the active constraints at the optimum.
+    pub contacts: Vec<Contact>,
+    /// Interference-free candidates tested before this one passed (0 = the cheapest passed).
+    pub rejected_candidates: usize,
+    /// Height of the c.g. (mm).
+    pub cg_height: f64,
+    /// Robustness margin of the finished stack for this part (largest horizontal load factor resisted), if computed.
+    pub stability_margin: Option<f64>,
+    /// Radius of the largest suction disc on its grasp face (mm).
+    pub grasp_radius: f64,
+}
+
+/// Counters and timings of a plan.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct PlanStats {
+    /// Placement searches run (parts x stages tried).
+    pub searches: usize,
+    /// Interference-free candidates checked for stability, grasp and insertion.
+    pub candidates_checked: usize,
+    /// Component pairs whose obstacle was built, over all searches.
+    pub pairs_evaluated: u64,
+    /// Obstacles constructed (cache misses).
+    pub obstacles_constructed: u64,
+    /// Seconds in the placement searches.
+    pub seconds_search: f64,
+    /// Seconds in the stack checks.
+    pub seconds_checks: f64,
+}
+
+/// A stacking plan.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Plan {
+    /// The options it was made with.
+    pub options: PlanOptions,
+    /// Resting-pose rotations considered (rows), in the order `resting_pose` indexes.
+    pub resting_poses: Vec<[[f64; 3]; 3]>,
+    /// The placed parts in stacking order.
+    pub parts: Vec<PlannedPart>,
+    /// Why the plan ended early (`None` when all `count` parts were placed).
+    pub stopped: Option<String>,
+    /// Sum of the parts' cost terms (cost (1) of the whole stack).
+    pub total_cost: f64,
+    /// Floor footprint of the stack `[[x_min, y_min], [x_max, y_max]]`.
+    pub footprint: [[f64; 2]; 2],
+    /// Height of the stack's top (mm).
+    pub height: f64,
+    /// Whether the finished stack passed the whole-stack check.
+    pub stack_stable: bool,
+    /// Counters and timings.
+    pub stats: PlanStats,
+}
+
+/// Why no plan could be made at all.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PlanError {
+    /// A bad option.
+    #[error("{0}")]
+    BadOption(String),
+    /// The part has no stable resting pose.
+    #[error("the part has no stable resting pose: {0}")]
+    NoRestingPose(String),
+    /// The placement search failed.
+    #[error(transparent)]
+    Placement(#[from] PlacementError),
+    /// The stability check failed to run.
+    #[error("stability check: {0}")]
+    Check(String),
+}
+
+fn rows(m: DMat3) -> [[f64; 3]; 3] {
+    m.transpose().to_cols_array_2d()
+}
+
+/// The floor polygon clipped to a rectangle (Sutherland-Hodgman; both convex, so the result is convex).
+fn clip_to_rectangle(poly: &[DVec2], lo: DVec2, hi: DVec2) -> Vec<DVec2> {
+    let mut out = poly.to_vec();
+    let edges: [(DVec2, f64); 4] = [(DVec2::X, hi.x), (DVec2::NEG_X, -lo.x), (DVec2::Y, hi.y), (DVec2::NEG_Y, -lo.y)];
+    for (n, d) in edges {
+        if out.is_empty() {
+            break;
+        }
+        let input = std::mem::take(&mut out);
+        for k in 0..input.len() {
+            let (a, b) = (input[k], input[(k + 1) % input.len()]);
+            let (da, db) = (n.dot(a) - d, n.dot(b) - d);
+            if da <= 0.0 {
+                out.push(a);
+            }
+            if (da < 0.0) != (db < 0.0) && da != db {
+                out.push(a + (b - a) * (da / (da - db)));
+            }
+        }
+    }
+    out
+}
+
+/// Plans a stack of `options.count` copies of `part`. See the module documentation.
+pub fn plan_stack(part: &Part, options: &PlanOptions) -> Result<Plan, PlanError> {
+    plan_stack_with_progress(part, options, &mut |_, _| {})
+}
+
+/// [`plan_stack`] calling `progress(parts placed, count)` after every part.
+pub fn plan_stack_with_progress(
+    part: &Part,
+    options: &PlanOptions,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Plan, PlanError> {
+    if options.count == 0 {
+        return Err(PlanError::BadOption("the number of parts must be at least 1".into()));
+    }
+    if !(options.candidates >= 1 && options.max_resting_poses >= 1) {
+        return Err(PlanError::BadOption("candidates and max_resting_poses must be at least 1".into()));
+    }
+    if !(options.cup_diameter > 0.0 && options.cup_diameter.is_finite()) {
+        return Err(PlanError::BadOption(format!("the cup diameter must be positive, got {}", options.cup_diameter)));
+    }
+    if !(options.mu >= 0.0 && options.mu.is_finite()) {
+        return Err(PlanError::BadOption(format!("mu must be non-negative and finite, got {}", options.mu)));
+    }
+    if !(options.nest_allowance >= 0.0 && options.nest_allowance.is_finite()) {
+        return Err(PlanError::BadOption("the nesting allowance must be non-negative and finite".into()));
+    }
+    let thetas = thetas_with_step(options.dtheta);
+    let poses =
+        stackplan_stability::resting_poses::resting_poses(part).map_err(|e| PlanError::NoRestingPose(e.to_string()))?;
+    if poses.is_empty() {
+        return Err(PlanError::NoRestingPose("no face of the hull holds the c.g. strictly inside".into()));
+    }
+    // candidate orientations: resting poses that present a suction face for the cup ([A] II-B condition 3)
+    let grasp = GraspOptions { cup_diameter: options.cup_diameter, ..GraspOptions::default() };
+    let rests: Vec<DMat3> = poses
+        .iter()
+        .filter(|p| is_graspable(&grasp_faces(part, p.rotation, p.position, &grasp), &grasp))
+        .take(options.max_resting_poses)
+        .map(|p| p.rotation)
+        .collect();
+    if rests.is_empty() {
+        return Err(PlanError::NoRestingPose(format!(
+            "none of the {} stable resting poses presents an upward face that holds a {} mm suction cup",
+            poses.len(),
+            options.cup_diameter
+        )));
+    }
+    let origin = options.origin.unwrap_or_else(|| options.floor.centre());
+    let check_options = CheckOptions {
+        mu: options.mu,
+        clearance: 0.0,
+        grasp: grasp.clone(),
+        margin_directions: 0,
+        contact_tolerance: None,
+        prefix_stability: false,
+    };
+    let cache = ObstacleCache::new();
+    let mut placed: Vec<Pose> = Vec::new();
+    let mut planned: Vec<PlannedPart> = Vec::new();
+    let mut stats = PlanStats::default();
+    let mut stopped = None;
+    'parts: for index in 0..options.count {
+        let stack: Vec<StackPart<'_>> = placed.iter().map(|&pose| StackPart { part, pose }).collect();
+        // stage 1: within the stack's footprint (grown by the nesting allowance); stage 2: the whole floor
+        let mut stages: Vec<(u8, FloorVolume)> = Vec::new();
+        if !placed.is_empty() {
+            let (lo, hi) = footprint(part, &placed);
+            let a = DVec2::splat(options.nest_allowance);
+            let polygon = clip_to_rectangle(&options.floor.polygon, lo - a, hi + a);
+            if polygon.len() >= 3 {
+                stages.push((1, FloorVolume { polygon, height: options.floor.height }));
+            }
+        }
+        stages.push((2, options.floor.clone()));
+        let mut last_reason = String::from("no interference-free position");
+        // the first acceptable candidate of each stage: (stage, candidate, rejected before it, grasp radius)
+        let mut accepted: Vec<(u8, Placement, usize, f64)> = Vec::new();
+        for (stage, floor) in stages {
+            let mut request = PlacementRequest::new(part, stack.clone(), floor);
+            request.resting_rotations = rests.clone();
+            request.thetas = thetas.clone();
+            request.clearance = options.clearance;
+            request.horizontal_clearance = true;
+            request.cost = Cost::Stacking { w: options.w, origin };
+            request.insertion = options.insertion;
+            request.k = options.candidates;
+            let started = std::time::Instant::now();
+            let result = match place_with_cache(&request, &cache) {
+                Ok(r) => r,
+                // stage 1's clipped floor may be malformed (a sliver): fall through to stage 2
+                Err(PlacementError::BadFloor(msg)) if stage == 1 => {
+                    tracing::debug!(index, "stage 1 floor rejected: {msg}");
+                    continue;
+                }
+                Err(e) => return Err(e.into()),
+            };
+            stats.seconds_search += started.elapsed().as_secs_f64();
+            stats.searches += 1;
+            stats.pairs_evaluated += result.stats.pairs_evaluated;
+            stats.obstacles_constructed += result.stats.obstacles_constructed;
+            if result.placements.is_empty() {
+                last_reason = match result.exhausted {
+                    Some(NoPlacement::EmptyOmega) => "the floor volume is too small for the part".into(),
+                    _ => "no interference-free position inside the floor volume".into(),
+                };
+                continue;
+            }
+            let started = std::time::Instant::now();
+            for (rejected, candidate) in result.placements.iter().enumerate() {
+                stats.candidates_checked += 1;
+                match accept(part, &placed, candidate, &check_options)? {
+                    Ok(grasp_radius) => {
+                        accepted.push((stage, candidate.clone(), rejected, grasp_radius));
+                        break;
+                    }
+                    Err(reason) => last_reason = reason,
+                }
+            }
+            stats.seconds_checks += started.elapsed().as_secs_f64();
+        }
+        // stage 1 (compact) wins unless stage 2 is strictly cheaper: ties and near-ties keep the stack compact
+        let best = accepted.iter().min_by(|a, b| {
+            let (ca, cb) = (a.1.cost, b.1.cost);
+            let tie = (ca - cb).abs() <= 1e-9 * (1.0 + ca.abs().max(cb.abs()));
+            if tie { a.0.cmp(&b.0) } else { ca.total_cmp(&cb) }
+        });
+        if let Some((stage, candidate, rejected, grasp_radius)) = best.cloned() {
+            let pose = candidate.pose();
+            placed.push(pose);
+            planned.push(PlannedPart {
+                position: candidate.position,
+                rotation: candidate.rotation,
+                index,
+                theta_deg: candidate.theta_deg,
+                resting_pose: candidate.resting_pose,
+                stage,
+                cost: candidate.cost,
+                contacts: candidate.contacts.clone(),
+                rejected_candidates: rejected,
+                cg_height: pose.apply(part.mass.center_of_gravity).z,
+                stability_margin: None,
+                grasp_radius,
+            });
+            progress(planned.len(), options.count);
+            tracing::info!(index, stage, cost = candidate.cost, "placed part");
+            continue 'parts;
+        }
+        stopped = Some(format!("part {} of {} could not be placed: {last_reason}", index + 1, options.count));
+        break;
+    }
+    // the finished stack, checked once with robustness margins
+    let started = std::time::Instant::now();
+    let world: Vec<PlacedPart<'_>> =
+        placed.iter().map(|p| PlacedPart { part, rotation: p.rotation, position: p.position }).collect();
+    let final_check =
+        check_stack(&world, &CheckOptions { margin_directions: 8, prefix_stability: true, ..check_options })
+            .map_err(|e| PlanError::Check(e.to_string()))?;
+    stats.seconds_checks += started.elapsed().as_secs_f64();
+    for (p, c) in planned.iter_mut().zip(&final_check.parts) {
+        p.stability_margin = c.margin;
+    }
+    let (lo, hi) = if placed.is_empty() { (DVec2::ZERO, DVec2::ZERO) } else { footprint(part, &placed) };
+    let height = placed.iter().flat_map(|p| part.all_vertices().map(move |v| p.apply(v).z)).fold(0.0f64, f64::max);
+    Ok(Plan {
+        options: options.clone(),
+        resting_poses: rests.iter().map(|r| rows(*r)).collect(),
+        total_cost: planned.iter().map(|p| p.cost).sum(),
+        parts: planned,
+        stopped,
+        footprint: [lo.to_array(), hi.to_array()],
+        height,
+        stack_stable: final_check.stack.verdict.is_stable(),
+        stats,
+    })
+}
+
+/// The xy bounding rectangle of the placed parts.
+fn footprint(part: &Part, placed: &[Pose]) -> (DVec2, DVec2) {
+    let mut lo = DVec2::splat(f64::INFINITY);
+    let mut hi = DVec2::splat(f64::NEG_INFINITY);
+    for p in placed {
+        for v in part.all_vertices() {
+            let w = p.apply(v).truncate();
+            lo = lo.min(w);
+            hi = hi.max(w);
+        }
+    }
+    (lo, hi)
+}
+
+/// Tests one candidate: `Ok(Ok(grasp radius))` when it passes, `Ok(Err(reason))` when it does not.
+fn accept(
+    part: &Part,
+    placed: &[Pose],
+    candidate: &Placement,
+    options: &CheckOptions,
+) -> Result<Result<f64, String>, PlanError> {
+    let pose = candidate.pose();
+    let mut world: Vec<PlacedPart<'_>> =
+        placed.iter().map(|p| PlacedPart { part, rotation: p.rotation, position: p.position }).collect();
+    world.push(PlacedPart { part, rotation: pose.rotation, position: pose.position });
+    let report = check_stack(&world, options).map_err(|e| PlanError::Check(e.to_string()))?;
+    let Some(new) = report.parts.last() else {
+        return Ok(Err("the stack check returned no part".into()));
+    };
+    let reason = if !new.stable.is_stable() {
+        "not stable on its supports"
+    } else if !report.stack.verdict.is_stable() {
+        "the stack would not be stable"
+    } else if !new.graspable {
+        "no suction face for the cup"
+    } else if !new.insertable {
+        "cannot be lowered straight down into place"
+    } else {
+        return Ok(Ok(new.grasp_radius));
+    };
+    Ok(Err(format!("the best interference-free positions were rejected (last: {reason})")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use stackplan_geom::convex_hull;
+    use stackplan_geom::part::PartOrigin;
+
+    fn block(x: f64, y: f64, z: f64) -> Part {
+        let pts: Vec<DVec3> = (0..8)
+            .map(|i| {
+                DVec3::new(
+                    if i & 1 == 0 { 0.0 } else { x },
+                    if i & 2 == 0 { 0.0 } else { y },
+                    if i & 4 == 0 { 0.0 } else { z },
+                )
+            })
+            .collect();
+        let hull = convex_hull(&pts).expect("box").polytope;
+        Part::from_components("block", vec![hull], 1.0, PartOrigin::ConvexPieces).expect("part")
+    }
+
+    fn options(count: usize, w: f64, floor: FloorVolume) -> PlanOptions {
+        PlanOptions {
+            w,
+            clearance: 0.0,
+            dtheta: 90f64.to_radians(),
+            cup_diameter: 10.0,
+            max_resting_poses: 1,
+            ..PlanOptions::new(count, floor)
+        }
+    }
+
+    #[test]
+    fn w_zero_spreads_on_the_floor_and_w_one_makes_a_column() {
+        let part = block(40.0, 40.0, 20.0);
+        let floor = FloorVolume::rectangle(0.0, 0.0, 400.0, 400.0, 500.0);
+        let flat = plan_stack(&part, &options(4, 0.0, floor.clone())).expect("plan");
+        assert_eq!(flat.parts.len(), 4, "{:?}", flat.stopped);
+        for p in &flat.parts {
+            assert!((p.cg_height - 10.0).abs() < 1e-6, "w = 0 keeps every part on the floor: {}", p.cg_height);
+        }
+        let column = plan_stack(&part, &options(4, 1.0, floor)).expect("plan");
+        assert_eq!(column.parts.len(), 4, "{:?}", column.stopped);
+        assert!((column.height - 80.0).abs() < 1e-6, "w = 1 stacks a column: height {}", column.height);
+        assert!(column.footprint[1][0] - column.footprint[0][0] <= 40.0 + 1e-6);
+        assert!(column.stack_stable);
+        // every plan is interference-free and passes the whole-stack check
+        for plan in [&flat, &column] {
+            let world: Vec<PlacedPart<'_>> = plan
+                .parts
+                .iter()
+                .map(|p| {
+                    let pose = Pose::from_rows(p.rotation, DVec3::from_array(p.position)).expect("a proper rotation");
+                    PlacedPart { part: &part, rotation: pose.rotation, position: pose.position }
+                })
+                .collect();
+            let report = check_stack(&world, &CheckOptions::default()).expect("check");
+            assert!(report.parts.iter().all(|c| c.interference <= 1e-6 && c.stable.is_stable()));
+        }
+    }
+
+    #[test]
+    fn a_floor_too_small_stops_the_plan_with_a_reason() {
+        let part = block(40.0, 40.0, 20.0);
+        let floor = FloorVolume::rectangle(0.0, 0.0, 50.0, 50.0, 50.0);
+        let plan = plan_stack(&part, &options(4, 0.0, floor)).expect("plan");
+        // two fit (one on the floor, one on top), the third exceeds the height
+        assert_eq!(plan.parts.len(), 2);
+        assert!(plan.stopped.as_deref().is_some_and(|s| s.contains("part 3 of 4")), "{:?}", plan.stopped);
+        let tiny = FloorVolume::rectangle(0.0, 0.0, 10.0, 10.0, 50.0);
+        let plan = plan_stack(&part, &options(1, 0.5, tiny)).expect("plan");
+        assert!(plan.parts.is_empty());
+        assert!(plan.stopped.as_deref().is_some_and(|s| s.contains("too small")), "{:?}", plan.stopped);
+        assert!(matches!(
+            plan_stack(&part, &options(0, 0.5, FloorVolume::rectangle(0.0, 0.0, 1.0, 1.0, 1.0))),
+            Err(PlanError::BadOption(_))
+        ));
+    }
+
+    #[test]
+    fn clipping_keeps_the_convex_intersection() {
+        let square = [DVec2::ZERO, DVec2::new(4.0, 0.0), DVec2::new(4.0, 4.0), DVec2::new(0.0, 4.0)];
+        let c = clip_to_rectangle(&square, DVec2::new(1.0, -1.0), DVec2::new(2.0, 5.0));
+        let area: f64 = (0..c.len()).map(|k| c[k].perp_dot(c[(k + 1) % c.len()])).sum::<f64>() / 2.0;
+        assert!((area - 4.0).abs() < 1e-12);
+        assert!(clip_to_rectangle(&square, DVec2::new(5.0, 5.0), DVec2::new(6.0, 6.0)).is_empty());
+    }
+}
