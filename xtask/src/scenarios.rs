@@ -5,6 +5,8 @@
 //! * `place`: one of the placement scenarios of [A] Figs. 15-17 (`"scenario"`: `channel`, `triangle`, `complex`;
 //!   built by `stackplan::planner::regress`): the best placement (theta, cost, position), nesting height, pairs
 //!   evaluated over the total.
+//! * `plan`: a stacking plan (`stackplan::planner::plan_stack`) of `count` parts at weight `w`: parts placed, height,
+//!   footprint, total cost, layers (distinct c.g. heights), whether every part passed and the whole stack is stable.
 //! * `orient_intervals`: the constant-topology intervals and sweep counts of every convex pair of two parts over a
 //!   full turn (`stackplan::orient_interval::regress_summary`).
 
@@ -21,6 +23,7 @@ pub fn run(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
     match kind {
         "part" => part(scenario, dir),
         "place" => place(scenario),
+        "plan" => plan(scenario, dir),
         "orient_intervals" => orient_intervals(scenario, dir),
         other => bail!("unknown scenario kind {other:?}"),
     }
@@ -116,5 +119,36 @@ fn orient_intervals(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
         let intervals: Vec<Value> = pairs.iter().map(|p| p.get("intervals").cloned().unwrap_or(Value::Null)).collect();
         f.insert("intervals_per_pair".into(), intervals.into());
     }
+    Ok(f)
+}
+
+fn plan(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
+    use stackplan::planner::{FloorVolume, PlanOptions, plan_stack};
+    let part = load_part(scenario, "part", dir)?;
+    let num = |k: &str| scenario.get(k).and_then(Value::as_f64);
+    let count = num("count").context("plan scenario has no \"count\"")? as usize;
+    let floor: [f64; 4] = serde_json::from_value(scenario.get("floor").cloned().context("no \"floor\"")?)?;
+    let height = num("height").context("plan scenario has no \"height\"")?;
+    let mut options = PlanOptions::new(count, FloorVolume::rectangle(floor[0], floor[1], floor[2], floor[3], height));
+    options.w = num("w").unwrap_or(0.5);
+    options.clearance = num("clearance").unwrap_or(5.0);
+    options.dtheta = num("dtheta_deg").unwrap_or(1.0).to_radians();
+    options.cup_diameter = num("cup_diameter").unwrap_or(options.cup_diameter);
+    let plan = plan_stack(&part, &options)?;
+    let mut layers: Vec<f64> = plan.parts.iter().map(|p| (p.cg_height * 1e6).round() / 1e6).collect();
+    layers.sort_by(f64::total_cmp);
+    layers.dedup();
+    let mut f = Fields::new();
+    f.insert("placed".into(), plan.parts.len().into());
+    f.insert("complete".into(), plan.stopped.is_none().into());
+    f.insert("height".into(), plan.height.into());
+    f.insert("footprint_x".into(), (plan.footprint[1][0] - plan.footprint[0][0]).into());
+    f.insert("footprint_y".into(), (plan.footprint[1][1] - plan.footprint[0][1]).into());
+    f.insert("total_cost".into(), plan.total_cost.into());
+    f.insert("layers".into(), layers.len().into());
+    f.insert("stack_stable".into(), plan.stack_stable.into());
+    f.insert("stage_1_parts".into(), plan.parts.iter().filter(|p| p.stage == 1).count().into());
+    f.insert("info_searches".into(), plan.stats.searches.into());
+    f.insert("info_pairs_evaluated".into(), plan.stats.pairs_evaluated.into());
     Ok(f)
 }
