@@ -460,10 +460,24 @@ impl ConvexPolytope {
 }
 
 fn plane_of(vertices: &[DVec3], face: &[usize]) -> Option<Plane> {
-    let n = newell_normal(face.iter().map(|&i| vertices[i]));
-    let len = n.length();
+    let mut n = newell_normal(face.iter().map(|&i| vertices[i]));
+    let mut len = n.length();
     if len.is_nan() || len <= 0.0 || !len.is_finite() {
-        return None;
+        // A sliver face (a few ulps wide, e.g. between nearly coincident computed points) can make Newell's sums
+        // cancel to zero. The cross products of consecutive edges of a convex counter-clockwise polygon all point
+        // outwards, and for such slivers one of them is still non-zero: take the largest.
+        let k = face.len();
+        n = (0..k)
+            .map(|i| {
+                let (a, b, c) = (vertices[face[i]], vertices[face[(i + 1) % k]], vertices[face[(i + 2) % k]]);
+                (b - a).cross(c - b)
+            })
+            .max_by(|x, y| x.length_squared().total_cmp(&y.length_squared()))
+            .unwrap_or(DVec3::ZERO);
+        len = n.length();
+        if len.is_nan() || len <= 0.0 || !len.is_finite() {
+            return None;
+        }
     }
     let normal = n / len;
     let offset = face.iter().map(|&i| normal.dot(vertices[i])).fold(f64::NEG_INFINITY, f64::max);
