@@ -2,7 +2,9 @@
 //!
 //! * `box_differences_64`: the 8 x 8 differences of two boxes (a c-space obstacle), full of exactly coplanar
 //!   clusters;
-//! * `random_400`: 400 uniformly random points in a cube.
+//! * `random_400`: 400 uniformly random points in a cube;
+//! * `disc_prism_800`: a 400-gon disc of radius 500 extruded 0.5 thick (sheet metal), where parry's hull is wrong
+//!   (it drops one face; see `tests/hull_props.rs`), timed for completeness.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use stackplan_geom::{DVec3, convex_hull};
@@ -37,8 +39,15 @@ fn bench(c: &mut Criterion) {
     let b = box_vertices(DVec3::new(-5.0, -5.0, 0.0), DVec3::new(60.0, 30.0, 2.0));
     let diffs: Vec<DVec3> = b.iter().flat_map(|vb| a.iter().map(move |va| *vb - *va)).collect();
     let random = random_points(400, 7);
+    let disc: Vec<DVec3> = (0..400)
+        .flat_map(|i| {
+            let a = i as f64 * std::f64::consts::TAU / 400.0;
+            let (x, y) = (500.0 * a.cos(), 500.0 * a.sin());
+            [DVec3::new(x, y, 0.0), DVec3::new(x, y, 0.5)]
+        })
+        .collect();
     let mut g = c.benchmark_group("hull");
-    for (name, pts) in [("box_differences_64", &diffs), ("random_400", &random)] {
+    for (name, pts) in [("box_differences_64", &diffs), ("random_400", &random), ("disc_prism_800", &disc)] {
         g.bench_function(format!("stackplan/{name}"), |bch| bch.iter(|| convex_hull(black_box(pts))));
         g.bench_function(format!("parry/{name}"), |bch| {
             bch.iter(|| parry3d_f64::transformation::try_convex_hull(black_box(pts)))

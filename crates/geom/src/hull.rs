@@ -69,8 +69,39 @@ struct Tri {
     /// Static error bound of `normal . (q - a)` over the input's bounding box: a float value beyond it has the sign
     /// of the exact determinant.
     filter: f64,
-    outside: Vec<u32>,
+    /// Outside set: a FIFO linked list through [`Outside::next`] (no allocation per triangle).
+    head: u32,
+    tail: u32,
     alive: bool,
+}
+
+/// The links of the outside sets: `next[q]` is the point after `q` in its triangle's outside list.
+struct Outside {
+    next: Vec<u32>,
+}
+
+impl Outside {
+    fn push(&mut self, t: &mut Tri, q: u32) {
+        self.next[q as usize] = NONE;
+        if t.head == NONE {
+            t.head = q;
+        } else {
+            self.next[t.tail as usize] = q;
+        }
+        t.tail = q;
+    }
+
+    /// The points of `t`'s outside set, in insertion order.
+    fn iter<'a>(&'a self, t: &Tri) -> impl Iterator<Item = u32> + 'a {
+        let mut cur = t.head;
+        std::iter::from_fn(move || {
+            (cur != NONE).then(|| {
+                let q = cur;
+                cur = self.next[q as usize];
+                q
+            })
+        })
+    }
 }
 
 /// Convex hull of `points`. See the module documentation.
@@ -84,10 +115,11 @@ pub fn convex_hull(points: &[DVec3]) -> Result<ConvexHull, HullError> {
     let simplex = initial_simplex(points)?;
     // a slight overestimate of the largest |q - a| keeps the static filter safe
     let diameter = crate::tolerance::bounding_diagonal(points) * (1.0 + 1e-9);
-    let mut tris = Vec::with_capacity(64);
+    let mut tris = Vec::with_capacity(64 + 4 * points.len().min(4096)); // avoids regrowing the triangle list
+    let mut outside = Outside { next: vec![NONE; points.len()] };
     build_simplex(points, simplex, &mut tris, diameter);
-    assign_initial_outside(points, simplex, &mut tris);
-    expand(points, &mut tris, diameter);
+    assign_initial_outside(points, simplex, &mut tris, &mut outside);
+    expand(points, &mut tris, &mut outside, diameter);
     merge(points, &tris)
 }
 
@@ -136,7 +168,7 @@ const FILTER: f64 = 1e-12;
 fn make_tri(p: &[DVec3], v: [u32; 3], diameter: f64) -> Tri {
     let (a, b, c) = (p[v[0] as usize], p[v[1] as usize], p[v[2] as usize]);
     let filter = FILTER * (b - a).length() * (c - a).length() * diameter;
-    Tri { v, nbr: [NONE; 3], normal: (b - a).cross(c - a), filter, outside: Vec::new(), alive: true }
+    Tri { v, nbr: [NONE; 3], normal: (b - a).cross(c - a), filter, head: NONE, tail: NONE, alive: true }
 }
 
 /// Exactly whether `q` is strictly above the triangle's plane: a float evaluation decides when it is farther from
@@ -189,22 +221,22 @@ fn link_all(tris: &mut [Tri]) {
     }
 }
 
-fn assign_initial_outside(p: &[DVec3], s: [u32; 4], tris: &mut [Tri]) {
+fn assign_initial_outside(p: &[DVec3], s: [u32; 4], tris: &mut [Tri], outside: &mut Outside) {
     for q in 0..p.len() as u32 {
         if s.contains(&q) {
             continue;
         }
         for t in tris.iter_mut() {
             if above(p, t, q) {
-                t.outside.push(q);
+                outside.push(t, q);
                 break;
             }
         }
     }
 }
 
-fn expand(p: &[DVec3], tris: &mut Vec<Tri>, diameter: f64) {
-    let mut stack: Vec<u32> = (0..tris.len() as u32).filter(|&t| !tris[t as usize].outside.is_empty()).collect();
+fn expand(p: &[DVec3], tris: &mut Vec<Tri>, outside: &mut Outside, diameter: f64) {
+    let mut stack: Vec<u32> = (0..tris.len() as u32).filter(|&t| tris[t as usize].head != NONE).collect();
     let mut visible: Vec<u32> = Vec::new();
     let mut horizon: Vec<(u32, u32, u32)> = Vec::new(); // (a, b, invisible neighbour) with a -> b in visible tri
     let mut bfs: Vec<u32> = Vec::new();
@@ -216,19 +248,19 @@ fn expand(p: &[DVec3], tris: &mut Vec<Tri>, diameter: f64) {
     let mut orphans: Vec<u32> = Vec::new();
     while let Some(t0) = stack.pop() {
         let t0u = t0 as usize;
-        if !tris[t0u].alive || tris[t0u].outside.is_empty() {
+        if !tris[t0u].alive || tris[t0u].head == NONE {
             continue;
         }
         // farthest outside point of t0 (float heuristic)
         let a0 = p[tris[t0u].v[0] as usize];
         let n0 = tris[t0u].normal;
-        let &apex = tris[t0u]
-            .outside
-            .iter()
-            .max_by(|&&x, &&y| {
+        // `max_by` keeps the last of equal maxima, as the former Vec-based scan did
+        let apex = outside
+            .iter(&tris[t0u])
+            .max_by(|&x, &y| {
                 n0.dot(p[x as usize] - a0).partial_cmp(&n0.dot(p[y as usize] - a0)).unwrap_or(Ordering::Equal)
             })
-            .unwrap_or(&tris[t0u].outside[0]);
+            .unwrap_or(tris[t0u].head);
         // visible set by BFS from t0 (the visible region is connected)
         epoch += 1;
         if mark.len() < tris.len() {
@@ -297,9 +329,10 @@ fn expand(p: &[DVec3], tris: &mut Vec<Tri>, diameter: f64) {
         // redistribute outside points of the removed triangles
         orphans.clear();
         for &t in &visible {
+            orphans.extend(outside.iter(&tris[t as usize]));
             let tr = &mut tris[t as usize];
             tr.alive = false;
-            orphans.append(&mut tr.outside);
+            tr.head = NONE;
         }
         for &q in &orphans {
             if q == apex {
@@ -307,13 +340,13 @@ fn expand(p: &[DVec3], tris: &mut Vec<Tri>, diameter: f64) {
             }
             for id in first_new..tris.len() as u32 {
                 if above(p, &tris[id as usize], q) {
-                    tris[id as usize].outside.push(q);
+                    outside.push(&mut tris[id as usize], q);
                     break;
                 }
             }
         }
         for id in first_new..tris.len() as u32 {
-            if !tris[id as usize].outside.is_empty() {
+            if tris[id as usize].head != NONE {
                 stack.push(id);
             }
         }
@@ -343,7 +376,11 @@ fn merge(p: &[DVec3], tris: &[Tri]) -> Result<ConvexHull, HullError> {
             // the vertex of the neighbour opposite the shared edge
             let nt = &tris[j];
             let far = nt.v.iter().copied().find(|v| !t.v.contains(v)).unwrap_or(nt.v[0]);
-            if side(p[t.v[0] as usize], p[t.v[1] as usize], p[t.v[2] as usize], p[far as usize]) == Ordering::Equal {
+            // the static filter settles "not coplanar" for almost every edge; only near-zero values go exact
+            let float_side = t.normal.dot(p[far as usize] - p[t.v[0] as usize]);
+            if float_side.abs() <= t.filter
+                && side(p[t.v[0] as usize], p[t.v[1] as usize], p[t.v[2] as usize], p[far as usize]) == Ordering::Equal
+            {
                 let (a, b) = (find(&mut parent, i as u32), find(&mut parent, j as u32));
                 if a != b {
                     parent[a as usize] = b;
@@ -382,23 +419,40 @@ fn merge(p: &[DVec3], tris: &[Tri]) -> Result<ConvexHull, HullError> {
         }
     }
     // boundary half-edges of each group, chained into a cycle
-    let mut boundary: Vec<Vec<(u32, u32)>> = vec![Vec::new(); group_count as usize];
+    // (one flat list bucketed by group with a counting sort: no allocation per group)
+    let mut bucket_start: Vec<u32> = vec![0; group_count as usize + 1];
     for (i, t) in tris.iter().enumerate() {
-        if !t.alive {
-            continue;
-        }
-        for k in 0..3 {
-            if group_of[t.nbr[k] as usize] != group_of[i] {
-                boundary[group_of[i] as usize].push((t.v[k], t.v[(k + 1) % 3]));
+        if t.alive {
+            for k in 0..3 {
+                if group_of[t.nbr[k] as usize] != group_of[i] {
+                    bucket_start[group_of[i] as usize + 1] += 1;
+                }
             }
         }
     }
+    for g in 0..group_count as usize {
+        bucket_start[g + 1] += bucket_start[g];
+    }
+    let mut fill = bucket_start.clone();
+    let mut flat: Vec<(u32, u32)> = vec![(0, 0); bucket_start[group_count as usize] as usize];
+    for (i, t) in tris.iter().enumerate() {
+        if t.alive {
+            for k in 0..3 {
+                if group_of[t.nbr[k] as usize] != group_of[i] {
+                    let g = group_of[i] as usize;
+                    flat[fill[g] as usize] = (t.v[k], t.v[(k + 1) % 3]);
+                    fill[g] += 1;
+                }
+            }
+        }
+    }
+    let boundary = (0..group_count as usize).map(|g| &flat[bucket_start[g] as usize..bucket_start[g + 1] as usize]);
     let mut next: Vec<u32> = vec![NONE; p.len()];
     let mut new_index: Vec<u32> = vec![NONE; p.len()];
     let mut vertices = Vec::new();
     let mut source = Vec::new();
     let mut faces = Vec::with_capacity(group_count as usize);
-    for b in &boundary {
+    for b in boundary {
         let Some(&(start, _)) = b.iter().min_by_key(|e| e.0) else { continue };
         for &(a, c) in b {
             next[a as usize] = c;

@@ -122,6 +122,12 @@ pub enum PolytopeError {
         /// Second vertex.
         b: usize,
     },
+    /// More vertices than the edge table can index.
+    #[error("{count} vertices: a polytope may have at most 2^31")]
+    TooManyVertices {
+        /// Number of vertices given.
+        count: usize,
+    },
     /// A face has zero area (its normal is undefined).
     #[error("face {face} is degenerate (zero area)")]
     DegenerateFace {
@@ -129,6 +135,9 @@ pub enum PolytopeError {
         face: usize,
     },
 }
+
+/// The most vertices a polytope may have (the edge table packs two vertex indices into one 64-bit key).
+pub const MAX_VERTICES: usize = 1 << 31;
 
 /// A convex polytope in boundary representation. See the module documentation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -183,9 +192,14 @@ impl ConvexPolytope {
                 return Err(PolytopeError::NonFinite { vertex: i });
             }
         }
+        if vertices.len() > MAX_VERTICES {
+            return Err(PolytopeError::TooManyVertices { count: vertices.len() });
+        }
         // half-edges (a, b, face, position), grouped by undirected edge by sorting: each group must be exactly one
         // a -> b and one b -> a (closed, consistently oriented 2-manifold). O(H log H) for H half-edges, no hashing.
-        let mut half: Vec<(usize, usize, usize, usize)> = Vec::with_capacity(faces.iter().map(Vec::len).sum());
+        // The undirected edge and the direction are packed into one integer key, (min << 33) | (max << 1) | (a > b),
+        // so the sort compares plain integers.
+        let mut half: Vec<(u64, u32, u32)> = Vec::with_capacity(faces.iter().map(Vec::len).sum());
         for (f, face) in faces.iter().enumerate() {
             if face.len() < 3 {
                 return Err(PolytopeError::FaceTooSmall { face: f, count: face.len() });
@@ -198,27 +212,33 @@ impl ConvexPolytope {
                 if a == b {
                     return Err(PolytopeError::NotManifold { a, b });
                 }
-                half.push((a, b, f, k));
+                let key = ((a.min(b) as u64) << 33) | ((a.max(b) as u64) << 1) | u64::from(a > b);
+                half.push((key, f as u32, k as u32));
             }
         }
-        half.sort_unstable_by_key(|&(a, b, _, _)| (a.min(b), a.max(b), a > b));
+        half.sort_unstable_by_key(|h| h.0);
+        let ends = |key: u64| -> (usize, usize) {
+            let (lo, hi) = ((key >> 33) as usize, ((key >> 1) & 0xFFFF_FFFF) as usize);
+            if key & 1 == 1 { (hi, lo) } else { (lo, hi) }
+        };
         let mut edges = Vec::with_capacity(half.len() / 2);
         let mut face_edges: Vec<Vec<usize>> = faces.iter().map(|f| vec![usize::MAX; f.len()]).collect();
         let mut i = 0;
         while i < half.len() {
-            let (a, b, f, k) = half[i];
-            let Some(&(c, d, g, j)) = half.get(i + 1) else {
+            let (key, f, k) = half[i];
+            let (a, b) = ends(key);
+            let Some(&(key2, g, j)) = half.get(i + 1) else {
                 return Err(PolytopeError::NotManifold { a, b });
             };
             // the pair must be a -> b and b -> a, and no third half-edge on the same vertices
-            let third = half.get(i + 2).is_some_and(|&(x, y, _, _)| x.min(y) == a.min(b) && x.max(y) == a.max(b));
-            if c != b || d != a || third {
+            let third = half.get(i + 2).is_some_and(|h| h.0 >> 1 == key >> 1);
+            if key2 != key ^ 1 || key & 1 == 1 || third {
                 return Err(PolytopeError::NotManifold { a, b });
             }
             let e = edges.len();
-            edges.push(Edge { vertices: [a, b], faces: [f, g] });
-            face_edges[f][k] = e;
-            face_edges[g][j] = e;
+            edges.push(Edge { vertices: [a, b], faces: [f as usize, g as usize] });
+            face_edges[f as usize][k as usize] = e;
+            face_edges[g as usize][j as usize] = e;
             i += 2;
         }
         let mut out = Vec::with_capacity(faces.len());
