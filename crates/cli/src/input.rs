@@ -22,7 +22,7 @@ pub struct PartArgs {
 impl PartArgs {
     /// The decomposition the flags ask for.
     pub fn decomposition(&self) -> Decomposition {
-        if self.triangulate { Decomposition::Triangulation } else { Decomposition::ConvexMerge }
+        decomposition(self.triangulate)
     }
 }
 
@@ -40,4 +40,64 @@ pub fn load_part_spec(spec: &str, decomposition: Decomposition, decompose_mesh: 
     }
     let options = stackplan_geom::io::ReadOptions { decomposition, decompose_mesh, ..Default::default() };
     Ok(stackplan_geom::io::read_part(std::path::Path::new(spec), &options)?)
+}
+
+/// The decomposition of `--triangulate`: plain triangulation (the seed's component counts) or convex merging.
+pub fn decomposition(triangulate: bool) -> Decomposition {
+    if triangulate { Decomposition::Triangulation } else { Decomposition::ConvexMerge }
+}
+
+/// Reads a pose file: JSON `{"position": [x, y, z], "rotation": [[row 0], [row 1], [row 2]]}` (a proper rotation).
+pub fn read_pose(path: &std::path::Path) -> anyhow::Result<stackplan_geom::Pose> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let record: stackplan_geom::pose::PoseRecord =
+        serde_json::from_str(&text).with_context(|| format!("parsing the pose in {}", path.display()))?;
+    stackplan_geom::Pose::try_from(record).with_context(|| format!("the pose in {}", path.display()))
+}
+
+/// Parses `--pair I,J` (moving component I, fixed component J).
+pub fn parse_pair(s: &str) -> anyhow::Result<(usize, usize)> {
+    let (i, j) = s.split_once(',').with_context(|| format!("--pair expects I,J, got {s:?}"))?;
+    Ok((i.trim().parse().context("--pair: moving index")?, j.trim().parse().context("--pair: fixed index")?))
+}
+
+/// A moving and a fixed part with the fixed part's pose: what `cspace`, `intervals` and `interference` read.
+#[derive(Debug, Clone)]
+pub struct PartPair {
+    /// The moving part.
+    pub moving: Part,
+    /// The fixed part.
+    pub fixed: Part,
+    /// The fixed part's pose (identity without `--fixed-pose`).
+    pub fixed_pose: stackplan_geom::Pose,
+    /// `--pair I,J` if given, checked against the component counts.
+    pub only: Option<(usize, usize)>,
+}
+
+/// Reads the two parts, the fixed part's pose file (if any) and the `--pair` option (if any; the indices are
+/// checked against the parts' component counts).
+pub fn load_pair(
+    moving: &str,
+    fixed: &str,
+    triangulate: bool,
+    fixed_pose: Option<&std::path::Path>,
+    pair: Option<&str>,
+) -> anyhow::Result<PartPair> {
+    let decomposition = decomposition(triangulate);
+    let moving = load_part_spec(moving, decomposition, false)?;
+    let fixed = load_part_spec(fixed, decomposition, false)?;
+    let fixed_pose = match fixed_pose {
+        Some(p) => read_pose(p)?,
+        None => stackplan_geom::Pose::IDENTITY,
+    };
+    let only = pair.map(parse_pair).transpose()?;
+    if let Some((i, j)) = only {
+        anyhow::ensure!(
+            i < moving.components.len(),
+            "--pair: the moving part has {} components",
+            moving.components.len()
+        );
+        anyhow::ensure!(j < fixed.components.len(), "--pair: the fixed part has {} components", fixed.components.len());
+    }
+    Ok(PartPair { moving, fixed, fixed_pose, only })
 }

@@ -4,14 +4,13 @@
 //! the bounds are in degrees; the moving part's own origin is its reference point, `R = Rz Ry Rx`.
 
 use crate::Outcome;
-use crate::input::load_part_spec;
+use crate::input::{PartPair, load_pair};
 use crate::output;
 use anyhow::Context;
 use stackplan::contact_states::acsg::{AcsgSettings, generate};
 use stackplan::contact_states::criteria::ContactPart;
 use stackplan::contact_states::ga::GaSettings;
 use stackplan::contact_states::pose::ConfigBox;
-use stackplan_geom::sheet_metal::Decomposition;
 use stackplan_geom::{DMat3, DVec3, Part, PartOrigin};
 use std::path::PathBuf;
 
@@ -70,9 +69,7 @@ fn config(s: &str, what: &str) -> anyhow::Result<[f64; 6]> {
 pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     anyhow::ensure!(args.population >= 4, "--population must be at least 4");
     let bounds = ConfigBox::new(config(&args.t_min, "--t-min")?, config(&args.t_max, "--t-max")?)?;
-    let decomposition = if args.triangulate { Decomposition::Triangulation } else { Decomposition::ConvexMerge };
-    let moving = load_part_spec(&args.moving, decomposition, false)?;
-    let mut fixed: Part = load_part_spec(&args.fixed, decomposition, false)?;
+    let PartPair { moving, mut fixed, .. } = load_pair(&args.moving, &args.fixed, args.triangulate, None, None)?;
     if let Some(o) = &args.offset {
         let v = parse_list(o, 3, "--offset")?;
         let shift = DVec3::new(v[0], v[1], v[2]);

@@ -5,14 +5,13 @@
 //! the translation `p`; `p` is in the obstacle of a pair iff `normal . p <= offset` for every face of that pair.
 
 use crate::Outcome;
-use crate::input::load_part_spec;
+use crate::input::{PartPair, load_pair};
 use crate::output;
 use anyhow::Context;
 use serde::Serialize;
 use stackplan::cspace::minkowski::{FaceKind, Feature, Obstacle, obstacle};
 use stackplan::cspace::offset::{HalfSpaces, clearance, insertion, insertion_polytope, slice};
-use stackplan_geom::sheet_metal::Decomposition;
-use stackplan_geom::{ConvexPolytope, DMat3, DVec2, DVec3, Plane, Pose};
+use stackplan_geom::{ConvexPolytope, DMat3, DVec2, Plane};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
@@ -123,19 +122,6 @@ pub struct CspaceJson {
     pub pairs: Vec<PairJson>,
 }
 
-fn parse_pair(s: &str) -> anyhow::Result<(usize, usize)> {
-    let (i, j) = s.split_once(',').with_context(|| format!("--pair expects I,J, got {s:?}"))?;
-    Ok((i.trim().parse().context("--pair: moving index")?, j.trim().parse().context("--pair: fixed index")?))
-}
-
-fn read_pose(path: &std::path::Path) -> anyhow::Result<(DMat3, DVec3)> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let record: stackplan_geom::pose::PoseRecord =
-        serde_json::from_str(&text).with_context(|| format!("parsing the pose in {}", path.display()))?;
-    let pose = Pose::try_from(record).with_context(|| format!("the pose in {}", path.display()))?;
-    Ok((pose.rotation, pose.position))
-}
-
 fn planes_json(h: &HalfSpaces) -> Vec<PlaneJson> {
     h.planes.iter().map(plane_json).collect()
 }
@@ -147,22 +133,9 @@ fn plane_json(p: &Plane) -> PlaneJson {
 /// The obstacles of the requested pairs: `(moving piece, fixed piece, obstacle)`.
 pub fn obstacles(args: &Args) -> anyhow::Result<Vec<(usize, usize, Obstacle)>> {
     anyhow::ensure!(args.theta_deg.is_finite(), "--theta-deg must be finite");
-    let decomposition = if args.triangulate { Decomposition::Triangulation } else { Decomposition::ConvexMerge };
-    let moving = load_part_spec(&args.moving, decomposition, false)?;
-    let fixed = load_part_spec(&args.fixed, decomposition, false)?;
-    let (fixed_rotation, fixed_position) = match &args.fixed_pose {
-        Some(p) => read_pose(p)?,
-        None => (DMat3::IDENTITY, DVec3::ZERO),
-    };
-    let only = args.pair.as_deref().map(parse_pair).transpose()?;
-    if let Some((i, j)) = only {
-        anyhow::ensure!(
-            i < moving.components.len(),
-            "--pair: the moving part has {} components",
-            moving.components.len()
-        );
-        anyhow::ensure!(j < fixed.components.len(), "--pair: the fixed part has {} components", fixed.components.len());
-    }
+    let PartPair { moving, fixed, fixed_pose, only } =
+        load_pair(&args.moving, &args.fixed, args.triangulate, args.fixed_pose.as_deref(), args.pair.as_deref())?;
+    let (fixed_rotation, fixed_position) = (fixed_pose.rotation, fixed_pose.position);
     let rotation = DMat3::from_rotation_z(args.theta_deg.to_radians());
     let placed: Vec<ConvexPolytope> =
         fixed.components.iter().map(|c| c.transformed(fixed_rotation, fixed_position)).collect();

@@ -9,7 +9,6 @@ use crate::output::{json_text, write_atomic};
 use crate::render::{Marker, Scene, Solid, part_color, png, svg};
 use anyhow::Context;
 use stackplan_geom::io::glb::{GlbItem, glb_bytes};
-use stackplan_geom::sheet_metal::Decomposition;
 use std::path::PathBuf;
 
 /// Arguments of `demo`.
@@ -29,7 +28,7 @@ pub const EXAMPLES: [&str; 6] = ["channel", "triangle", "complex", "cube", "l-co
 /// Runs the demo.
 pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
-    let decomposition = if args.triangulate { Decomposition::Triangulation } else { Decomposition::ConvexMerge };
+    let decomposition = crate::input::decomposition(args.triangulate);
     let bar = indicatif::ProgressBar::new(EXAMPLES.len() as u64);
     let mut summary = Vec::new();
     for name in EXAMPLES {

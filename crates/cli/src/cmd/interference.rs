@@ -3,13 +3,12 @@
 //! clearance) that are closer than the clearance ([A] eq. 6-8).
 
 use crate::Outcome;
-use crate::input::load_part_spec;
+use crate::input::{PartPair, load_pair};
 use crate::output;
 use anyhow::Context;
 use serde::Serialize;
 use stackplan::cspace::interference::{PairContact, PlacedScene, Placement};
-use stackplan_geom::sheet_metal::Decomposition;
-use stackplan_geom::{DMat3, DVec3, Pose};
+use stackplan_geom::{DMat3, DVec3};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
@@ -86,26 +85,14 @@ fn parse_position(s: &str) -> anyhow::Result<DVec3> {
     Ok(DVec3::new(v[0], v[1], v[2]))
 }
 
-fn read_pose(path: &std::path::Path) -> anyhow::Result<(DMat3, DVec3)> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let record: stackplan_geom::pose::PoseRecord =
-        serde_json::from_str(&text).with_context(|| format!("parsing the pose in {}", path.display()))?;
-    let pose = Pose::try_from(record).with_context(|| format!("the pose in {}", path.display()))?;
-    Ok((pose.rotation, pose.position))
-}
-
 /// Runs `interference`.
 pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     anyhow::ensure!(args.theta_deg.is_finite(), "--theta-deg must be finite");
     anyhow::ensure!(args.clearance.is_finite() && args.clearance >= 0.0, "--clearance must be a non-negative number");
     let position = parse_position(&args.position)?;
-    let decomposition = if args.triangulate { Decomposition::Triangulation } else { Decomposition::ConvexMerge };
-    let moving = load_part_spec(&args.moving, decomposition, false)?;
-    let fixed = load_part_spec(&args.fixed, decomposition, false)?;
-    let (fixed_rotation, fixed_position) = match &args.fixed_pose {
-        Some(p) => read_pose(p)?,
-        None => (DMat3::IDENTITY, DVec3::ZERO),
-    };
+    let PartPair { moving, fixed, fixed_pose, .. } =
+        load_pair(&args.moving, &args.fixed, args.triangulate, args.fixed_pose.as_deref(), None)?;
+    let (fixed_rotation, fixed_position) = (fixed_pose.rotation, fixed_pose.position);
     let scene = PlacedScene::new(&[Placement { part: &fixed, rotation: fixed_rotation, position: fixed_position }]);
     let rotation = DMat3::from_rotation_z(args.theta_deg.to_radians());
     let found = scene.interference_pairs(&moving, rotation, position, args.clearance);

@@ -3,13 +3,10 @@
 //! against a fixed component), with the event that ends each ([A] section IV, Appendix C).
 
 use crate::Outcome;
-use crate::input::load_part_spec;
+use crate::input::{PartPair, load_pair};
 use crate::output;
-use anyhow::Context;
 use serde::Serialize;
 use stackplan::orient_interval::{Event, PairEvents};
-use stackplan_geom::sheet_metal::Decomposition;
-use stackplan_geom::{DMat3, DVec3, Pose};
 
 /// Arguments of `intervals`.
 #[derive(Debug, clap::Args)]
@@ -79,37 +76,11 @@ fn event_json(e: &Event) -> serde_json::Value {
     v
 }
 
-fn parse_pair(s: &str) -> anyhow::Result<(usize, usize)> {
-    let (i, j) = s.split_once(',').with_context(|| format!("--pair expects I,J, got {s:?}"))?;
-    Ok((i.trim().parse().context("--pair: moving index")?, j.trim().parse().context("--pair: fixed index")?))
-}
-
-fn read_pose(path: &std::path::Path) -> anyhow::Result<(DMat3, DVec3)> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let record: stackplan_geom::pose::PoseRecord =
-        serde_json::from_str(&text).with_context(|| format!("parsing the pose in {}", path.display()))?;
-    let pose = Pose::try_from(record).with_context(|| format!("the pose in {}", path.display()))?;
-    Ok((pose.rotation, pose.position))
-}
-
 /// Runs `intervals`.
 pub fn run(args: &Args) -> anyhow::Result<Outcome> {
-    let decomposition = if args.triangulate { Decomposition::Triangulation } else { Decomposition::ConvexMerge };
-    let moving = load_part_spec(&args.moving, decomposition, false)?;
-    let fixed = load_part_spec(&args.fixed, decomposition, false)?;
-    let (rotation, translation) = match &args.fixed_pose {
-        Some(p) => read_pose(p)?,
-        None => (DMat3::IDENTITY, DVec3::ZERO),
-    };
-    let only = args.pair.as_deref().map(parse_pair).transpose()?;
-    if let Some((i, j)) = only {
-        anyhow::ensure!(
-            i < moving.components.len(),
-            "--pair: the moving part has {} components",
-            moving.components.len()
-        );
-        anyhow::ensure!(j < fixed.components.len(), "--pair: the fixed part has {} components", fixed.components.len());
-    }
+    let PartPair { moving, fixed, fixed_pose, only } =
+        load_pair(&args.moving, &args.fixed, args.triangulate, args.fixed_pose.as_deref(), args.pair.as_deref())?;
+    let (rotation, translation) = (fixed_pose.rotation, fixed_pose.position);
     anyhow::ensure!(args.from_deg <= args.to_deg, "--from-deg must not exceed --to-deg");
     let mut pairs = Vec::new();
     for (i, a) in moving.components.iter().enumerate() {
