@@ -243,6 +243,20 @@ pub(crate) enum Outcome {
     Unbounded { point: V4, stage: usize },
 }
 
+/// How [`Problem::seek`] ended.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Seek {
+    /// A feasible point with `g . p <= target`.
+    Reached(V4),
+    /// The minimum of `g . p` over the feasible set is above the target.
+    Minimum {
+        /// The minimiser.
+        point: V4,
+        /// `g . point`.
+        value: f64,
+    },
+}
+
 /// The solver gave up.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
 pub enum ActiveSetError {
@@ -409,6 +423,19 @@ impl Problem<'_> {
     /// Lexicographic multipliers of the working set: `mult[stage][k]` for the k-th working constraint.
     /// Returns the index (into the working set) of the constraint to drop, if any, and the stage-0 multipliers.
     fn drop_choice(&self, sub: &Subspace, w: &WorkSet, p: &V4, bland: bool, banned: &[usize]) -> (Option<usize>, V4) {
+        self.drop_choice_to(sub, w, p, bland, banned, self.n)
+    }
+
+    /// [`Problem::drop_choice`] considering the stages `0..=last_stage` only.
+    fn drop_choice_to(
+        &self,
+        sub: &Subspace,
+        w: &WorkSet,
+        p: &V4,
+        bland: bool,
+        banned: &[usize],
+        last_stage: usize,
+    ) -> (Option<usize>, V4) {
         let k = w.len;
         let mut lambda0 = [0.0; MAX_N];
         if k == 0 {
@@ -425,7 +452,7 @@ impl Problem<'_> {
         for a in 0..k {
             undecided[a] = !banned.contains(&w.idx[a]);
         }
-        for stage in 0..=self.n {
+        for stage in 0..=last_stage {
             let gvec = if stage == 0 { self.gradient(p) } else { unit(self.tie[stage - 1]) };
             let sc = sub.newton(&gvec);
             let mut r = gvec;
@@ -468,6 +495,85 @@ impl Problem<'_> {
             }
         }
         (None, lambda0)
+    }
+
+    /// Phase 1 towards one more constraint: the LP `min g . p` (with `h = 0`, no tie-break) run from `start`
+    /// (feasible for the enabled constraints, or infeasible only by rounding) and stopped as soon as
+    /// `g . p <= target`: on the move that crosses the level the point stops exactly there. Returns
+    /// [`Seek::Reached`] with that point, or [`Seek::Minimum`] with the LP's optimum when the level is never reached.
+    /// The same iterations as [`Problem::solve`] (O(m) each), usually far fewer: the first move often crosses.
+    pub(crate) fn seek(&self, start: V4, target: f64) -> Result<Seek, ActiveSetError> {
+        let m = self.rows.len();
+        let bland_after = 4 * m + 20;
+        let limit = 40 * (m + 5);
+        let mut p = start;
+        let mut w = WorkSet::default();
+        let mut banned: Vec<usize> = Vec::new();
+        let mut last_dropped: Option<usize> = None;
+        for iter in 0..limit {
+            let level = dot4(&self.g, &p);
+            if level <= target {
+                return Ok(Seek::Reached(p));
+            }
+            let sub = Subspace::new(self, &w);
+            match self.step(&sub, &p) {
+                Step::Move { dir, bounded, stage: 0 } => {
+                    let len = norm4(&dir);
+                    let mut alpha = if bounded { 1.0 } else { f64::INFINITY };
+                    let mut blocking = None;
+                    for j in 0..m {
+                        if !self.enabled(j) || w.contains(j) {
+                            continue;
+                        }
+                        let a = &self.rows[j];
+                        let ad = dot4(a, &dir);
+                        if ad > BLOCK_TOL * len {
+                            let slack = (self.offsets[j] - dot4(a, &p)).max(0.0);
+                            let t = slack / ad;
+                            if t < alpha {
+                                alpha = t;
+                                blocking = Some(j);
+                            }
+                        }
+                    }
+                    let descent = dot4(&self.g, &dir);
+                    if descent < 0.0 {
+                        let to_level = (target - level) / descent;
+                        if to_level <= alpha {
+                            axpy(&mut p, to_level, &dir);
+                            return Ok(Seek::Reached(p));
+                        }
+                    }
+                    if blocking.is_none() && !bounded {
+                        // unblocked descent ray that never reaches the level: cannot happen (descent < 0)
+                        return Ok(Seek::Reached(p));
+                    }
+                    axpy(&mut p, alpha, &dir);
+                    if alpha * len > 1e-13 * self.length_scale {
+                        banned.clear();
+                    } else if blocking.is_some() && blocking == last_dropped {
+                        banned.extend(blocking);
+                    }
+                    last_dropped = None;
+                    if let Some(j) = blocking {
+                        w.push(j);
+                    }
+                }
+                // stationary for the objective (a tie-break move or none): drop a constraint on a negative
+                // objective multiplier, or stop at the minimum
+                _ => {
+                    let (drop, _) = self.drop_choice_to(&sub, &w, &p, iter >= bland_after, &banned, 0);
+                    match drop {
+                        Some(k) => {
+                            last_dropped = Some(w.idx[k]);
+                            w.remove_at(k);
+                        }
+                        None => return Ok(Seek::Minimum { point: p, value: level }),
+                    }
+                }
+            }
+        }
+        Err(ActiveSetError::IterationLimit { limit })
     }
 
     /// Runs the active-set method from `start` (feasible, or infeasible only by rounding).

@@ -21,7 +21,7 @@
 //!
 //! Redundancy removal costs one LP per inequality (O(m) iterations of O(m) each); membership is O(m).
 
-use crate::active_set::{ActiveSetError, MAX_N, Outcome, Problem, V4, dot4};
+use crate::active_set::{ActiveSetError, MAX_N, Outcome, Problem, Seek, V4, dot4};
 use geom::{Containment, Tolerance};
 use serde::{Deserialize, Serialize};
 use stackplan_geom as geom;
@@ -273,6 +273,78 @@ impl<const D: usize> Cell<D> {
         let mut hs = self.halfspaces.clone();
         hs.extend(extra);
         Self::build(hs, self.tolerance, false)
+    }
+
+    /// Whether this cell with `extra` inequalities added is empty, decided from `start`, a point of this cell (within
+    /// the tolerance), without the Chebyshev LP: the sequential phase 1 on the cell grown by the tolerance (every
+    /// `b_j + tol`; it is non-empty iff the Chebyshev radius is at least `-tol`, so the answer is the one of
+    /// `self.with_halfspaces(extra)?.is_empty()`, up to rounding at that boundary). The inequalities violated at the
+    /// current point by more than the tolerance are taken in order; for each, the LP `min a_j . p` over the
+    /// inequalities satisfied so far runs from the current point (the active-set solver of [`crate::active_set`])
+    /// and stops on reaching `a_j . p = b_j + tol`. If its minimum stays above that, the satisfied inequalities
+    /// already exclude `j`: empty. Otherwise the point moves there and `j` joins the satisfied set. Each LP starts
+    /// feasible; about one LP per violated inequality, usually a single move (a child cell of the planner's search
+    /// violates one inequality at its parent's optimum), against the Chebyshev LP's four variables from a cold start.
+    /// `extra` is normalised as in [`Cell::new`].
+    pub fn is_empty_with(
+        &self,
+        extra: impl IntoIterator<Item = Halfspace<D>>,
+        start: &[f64; D],
+    ) -> Result<bool, CellError> {
+        if self.is_empty() {
+            return Ok(true);
+        }
+        let tol = self.tolerance.linear;
+        let first_extra = self.rows.len();
+        let mut rows = self.rows.clone();
+        // the grown cell's offsets
+        let mut grown: Vec<f64> = self.offsets.iter().map(|b| b + tol).collect();
+        for (k, h) in extra.into_iter().enumerate() {
+            if !h.offset.is_finite() || h.normal.iter().any(|c| !c.is_finite()) {
+                return Err(CellError::NonFinite { index: first_extra + k });
+            }
+            let len = h.normal.iter().map(|c| c * c).sum::<f64>().sqrt();
+            if len > 0.0 {
+                rows.push(to_v4(&h.normal.map(|c| c / len)));
+                grown.push(h.offset / len + tol);
+            } else if h.offset < -tol {
+                return Ok(true);
+            }
+        }
+        let m = rows.len();
+        let mut point = to_v4(start);
+        let satisfied_at = |j: usize, p: &V4| dot4(&rows[j], p) <= grown[j];
+        let mut mask: Vec<bool> = (0..m).map(|j| satisfied_at(j, &point)).collect();
+        for j in 0..m {
+            if mask[j] {
+                continue;
+            }
+            if satisfied_at(j, &point) {
+                mask[j] = true;
+                continue;
+            }
+            let prob = Problem {
+                n: D,
+                rows: &rows,
+                offsets: &grown,
+                mask: Some(&mask),
+                h: [0.0; MAX_N],
+                g: rows[j],
+                tie: default_tie(D),
+                length_scale: self.length_scale(),
+            };
+            match prob.seek(point, grown[j]).map_err(|source| CellError::Solver { purpose: "phase 1", source })? {
+                Seek::Reached(p) => point = p,
+                Seek::Minimum { point: p, value } => {
+                    if value > grown[j] {
+                        return Ok(true);
+                    }
+                    point = p;
+                }
+            }
+            mask[j] = true;
+        }
+        Ok(false)
     }
 
     /// The intersection of two cells (inequalities of `self`, then of `other`); tolerance of `self`.

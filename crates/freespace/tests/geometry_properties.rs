@@ -118,3 +118,56 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    /// The phase 1 of `is_empty_with` (from a point of the parent: its QP optimum or its interior point) decides
+    /// emptiness as the Chebyshev LP of `with_halfspaces` does.
+    #[test]
+    fn phase_one_agrees_with_the_chebyshev_lp(seed in any::<u64>(), extra in 0usize..5, cuts in 1usize..5,
+                                             flat in 0usize..3) {
+        use stackplan_freespace::{Halfspace, SeparableCost, Tag, minimize};
+        let mut rng = Rng(seed);
+        let shape = [Shape::Solid, Shape::Face, Shape::Edge][flat];
+        let cell = random_cell(&mut rng, extra, shape);
+        prop_assume!(!cell.is_empty());
+        let (lo, hi) = bbox(&cell);
+        // start: the QP optimum of a random cost (a boundary point, as in the planner) or the interior point
+        let target = [rng.range(lo[0] - 3.0, hi[0] + 3.0), rng.range(lo[1] - 3.0, hi[1] + 3.0), rng.range(lo[2], hi[2])];
+        let cost = SeparableCost::new([2.0; 3], target.map(|t| -2.0 * t), 0.0).expect("cost");
+        let start = if rng.below(2) == 0 { minimize(&cell, &cost).expect("qp").point } else {
+            cell.interior_point().expect("point")
+        };
+        // cuts through the cell's box: some keep the start, some do not (then the phase 1 has to move)
+        let mut hs = Vec::new();
+        for k in 0..cuts {
+            let n = rng.unit3();
+            let through = [rng.range(lo[0], hi[0]), rng.range(lo[1], hi[1]), rng.range(lo[2], hi[2])];
+            hs.push(Halfspace::new(n, common::dot(&n, &through), Tag::User(100 + k as u64)));
+        }
+        let empty = cell.is_empty_with(hs.iter().copied(), &start).expect("phase 1");
+        let reference = cell.with_halfspaces(hs.iter().copied()).expect("chebyshev");
+        let tol = cell.tolerance().linear;
+        match (empty, reference.shape()) {
+            (true, stackplan_freespace::CellShape::Empty) => {}
+            (false, s) if s != stackplan_freespace::CellShape::Empty => {
+                // and the QP of the non-empty cell has an answer
+                minimize(&reference, &cost).expect("qp");
+            }
+            // a disagreement is allowed only at the tolerance boundary: the Chebyshev radius within rounding of -tol,
+            // i.e. the cell grown by 1.001 tol is non-empty and the cell grown by 0.999 tol is empty (both judged
+            // with a negligible tolerance)
+            (pe, s) => {
+                let fine = stackplan_geom::Tolerance::for_scale(1e-6);
+                let shifted = |by: f64| {
+                    let hs: Vec<Halfspace<3>> = reference.halfspaces().iter()
+                        .map(|h| Halfspace::new(h.normal, h.offset + by, h.tag)).collect();
+                    Cell::new(hs, fine).map(|c| c.is_empty())
+                };
+                prop_assert!(
+                    shifted(1.001 * tol) == Ok(false) && shifted(0.999 * tol) == Ok(true),
+                    "phase 1 empty = {pe}, Chebyshev {s:?}, not a tolerance-boundary case"
+                );
+            }
+        }
+    }
+}

@@ -9,8 +9,10 @@
 //!   sweep's separating axes are the component's face normals, the horizontal normals `e x z` of its edges and the
 //!   edge directions plus `z` (a superset of the sweep's face normals and edge directions, so the test stays exact).
 //!
-//! The broad phase is a linear scan of the stack components' boxes per moving component (O(m_part m_stack) box
-//! tests, a few nanoseconds each; the stacks of [A] have at most a few hundred components). Candidates are returned
+//! The broad phase is a linear scan in two levels: the stack components whose boxes meet the whole part's box, then
+//! per moving component those whose boxes meet its own (O(m_stack + m_part m_near) box tests, a few nanoseconds
+//! each; the stacks of [A] have at most a few hundred components); a moving component is translated (or swept)
+//! only when some box meets its own. Candidates are returned
 //! in a deterministic order: by violation (deepest first), then by (moving component, stack component).
 
 use crate::orientation::Orientation;
@@ -136,6 +138,12 @@ fn swept(placed: &PlacedConvex, axes: &(Vec<DVec3>, Vec<DVec3>), p: DVec3, top: 
     }
 }
 
+/// The box of [`swept`] without building the sweep (the same arithmetic).
+fn swept_box(placed: &PlacedConvex, p: DVec3, top: f64) -> (DVec3, DVec3) {
+    let lift = (top - (placed.aabb.0.z + p.z)).max(0.0) + 1.0;
+    (placed.aabb.0 + p, placed.aabb.1 + p + DVec3::new(0.0, 0.0, lift))
+}
+
 fn boxes_overlap(a: &(DVec3, DVec3), b: &(DVec3, DVec3), margin: f64) -> bool {
     a.0.x <= b.1.x + margin
         && b.0.x <= a.1.x + margin
@@ -165,25 +173,48 @@ pub fn candidates(
 ) -> Vec<Candidate> {
     let mut out = Vec::new();
     let margin = clearance + tol;
+    // broad phase in two levels: the stack components near the whole part's box (a superset of each component's,
+    // the sweep reaching up without bound), then each component's box; a component is moved only when some stack
+    // box meets its own
+    let part_box = match sweep {
+        Some(_) => (orientation.lo + p, DVec3::new(orientation.hi.x + p.x, orientation.hi.y + p.y, f64::INFINITY)),
+        None => (orientation.lo + p, orientation.hi + p),
+    };
+    let near: Vec<usize> = scene
+        .components
+        .iter()
+        .enumerate()
+        .filter(|(_, f)| boxes_overlap(&part_box, &f.placed.aabb, margin))
+        .map(|(i, _)| i)
+        .collect();
+    if near.is_empty() {
+        return out;
+    }
     for (mi, placed) in orientation.components.iter().enumerate() {
-        let moved = match sweep {
-            Some(axes) => swept(placed, &axes.axes[mi], p, scene.top),
-            None => translated(placed, p),
+        let moved_box = match sweep {
+            Some(_) => swept_box(placed, p, scene.top),
+            None => (placed.aabb.0 + p, placed.aabb.1 + p),
         };
-        for (fi, fixed) in scene.components.iter().enumerate() {
-            if !boxes_overlap(&moved.aabb, &fixed.placed.aabb, margin) {
+        let mut moved: Option<PlacedConvex> = None;
+        for &fi in &near {
+            let fixed = &scene.components[fi];
+            if !boxes_overlap(&moved_box, &fixed.placed.aabb, margin) {
                 continue;
             }
+            let moved = moved.get_or_insert_with(|| match sweep {
+                Some(axes) => swept(placed, &axes.axes[mi], p, scene.top),
+                None => translated(placed, p),
+            });
             counts.narrow_phase += 1;
             if horizontal_clearance && clearance > 0.0 {
-                let slack = horizontal_slack(&moved, &fixed.placed, clearance);
+                let slack = horizontal_slack(moved, &fixed.placed, clearance);
                 if slack >= -tol {
                     continue;
                 }
                 out.push(Candidate { moving: mi, fixed: fi, violation: -slack });
                 continue;
             }
-            let violation = match classify_pair(&moved, &fixed.placed, tol, clearance) {
+            let violation = match classify_pair(moved, &fixed.placed, tol, clearance) {
                 PairContact::Penetrating { depth } => depth + clearance,
                 PairContact::Touching { gap } if clearance > tol => clearance - gap,
                 PairContact::Separated { gap } if clearance > tol && gap < clearance - tol => clearance - gap,

@@ -71,14 +71,17 @@ pub struct Orientation {
     pub hi: DVec3,
     /// Rotated c.g. offset `R g`.
     pub cg: DVec3,
-    /// The components rotated, at position zero.
+    /// The components rotated, at position zero (empty until [`Orientation::build_components`]; [`Orientation::new`]
+    /// builds them at once).
     pub components: Vec<PlacedConvex>,
+    /// The rotated vertices of every component, component by component (for `Omega`).
+    vertices: Vec<DVec3>,
     /// The cost at this orientation.
     pub quadratic: SeparableQuadratic,
 }
 
 impl Orientation {
-    /// Builds the orientation data. O(total size of the part).
+    /// Builds the orientation data with its rotated components. O(total size of the part).
     pub fn new(
         part: &Part,
         index: usize,
@@ -88,23 +91,49 @@ impl Orientation {
         rest_rotation: DMat3,
         cost: &Cost,
     ) -> Self {
+        let mut o = Self::without_components(part, index, rest, theta_index, theta, rest_rotation, cost);
+        o.build_components(part);
+        o
+    }
+
+    /// The orientation data without the rotated components (rotation, extents, `Omega`, cost): what the roots of the
+    /// search need. O(number of vertices). The components follow on demand ([`Orientation::build_components`]), only
+    /// for orientations the search expands.
+    pub fn without_components(
+        part: &Part,
+        index: usize,
+        rest: usize,
+        theta_index: usize,
+        theta: f64,
+        rest_rotation: DMat3,
+        cost: &Cost,
+    ) -> Self {
         let rotation = DMat3::from_rotation_z(theta) * rest_rotation;
-        let components: Vec<PlacedConvex> =
-            part.components.iter().map(|c| PlacedConvex::new(c, rotation, DVec3::ZERO)).collect();
+        // the same arithmetic as `PlacedConvex::new(c, rotation, DVec3::ZERO)`, so the extents are bit-identical
+        let vertices: Vec<DVec3> =
+            part.components.iter().flat_map(|c| c.vertices().iter().map(|v| rotation * *v + DVec3::ZERO)).collect();
         let mut lo = DVec3::splat(f64::INFINITY);
         let mut hi = DVec3::splat(f64::NEG_INFINITY);
-        for c in &components {
-            lo = lo.min(c.aabb.0);
-            hi = hi.max(c.aabb.1);
+        for v in &vertices {
+            lo = lo.min(*v);
+            hi = hi.max(*v);
         }
         let cg = rotation * part.mass.center_of_gravity;
         let quadratic = SeparableQuadratic::of_cost(cost, lo, hi, cg);
-        Self { index, rest, theta_index, theta, rotation, lo, hi, cg, components, quadratic }
+        Self { index, rest, theta_index, theta, rotation, lo, hi, cg, components: Vec::new(), vertices, quadratic }
+    }
+
+    /// Builds the rotated components if they are missing. O(total size of the part).
+    pub fn build_components(&mut self, part: &Part) {
+        if self.components.is_empty() {
+            self.components =
+                part.components.iter().map(|c| PlacedConvex::new(c, self.rotation, DVec3::ZERO)).collect();
+        }
     }
 
     /// `max_v d . (R v)` over the rotated vertices.
     fn support(&self, d: DVec3) -> f64 {
-        self.components.iter().flat_map(|c| c.vertices.iter()).map(|v| d.dot(*v)).fold(f64::NEG_INFINITY, f64::max)
+        self.vertices.iter().map(|v| d.dot(*v)).fold(f64::NEG_INFINITY, f64::max)
     }
 
     /// The 3-D permissible set's inequalities (sides, floor, ceiling) in that order.

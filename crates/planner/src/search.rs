@@ -8,10 +8,15 @@
 //! 2. detect the interfering component pairs at `(theta_k, p*)` ([`crate::detect`]);
 //! 3. take the first of them (deepest violation first) whose obstacle ([`crate::obstacles`]) contains `p*` in its
 //!    interior by more than the tolerance, and split `K` into the children
-//!    `K n {n_k . p >= d_k} n {n_j . p <= d_j, j < k}` ([A] VI-A-3). Children are pushed *lazily* with the
-//!    parent's cost as key (a lower bound of theirs); when a pending child is popped its cell is built (emptiness by
-//!    the Chebyshev LP) and its QP solved ([`crate::qp`]), and it is pushed back with its own cost — so children
-//!    that never become the cheapest are never solved;
+//!    `K n {n_k . p >= d_k} n {n_j . p <= d_j, j < k}` ([A] VI-A-3). Children are pushed *lazily* keyed by a lower
+//!    bound of their cost: the larger of the parent's cost and the minimum of the cost over the half-space
+//!    `n_k . p >= d_k` alone (closed form, [`Quadratic::halfspace_lower_bound`]). When a pending child is popped its
+//!    emptiness is decided by a phase 1 from the parent's optimum (`Cell::is_empty_with`: the optimum violates
+//!    only `n_k . p >= d_k`, so this is usually one LP move); a non-empty child's cell is built (Chebyshev centre)
+//!    and its QP solved ([`crate::qp`]), and it is pushed back with its own cost — so children that never become
+//!    the cheapest are never solved. The keys only decide *when* a pending child is solved, never the order of the
+//!    solved nodes (a total order by (cost, orientation, id) that a valid lower bound cannot overtake), so the
+//!    search pops the same solved nodes in the same order as with the parent's cost as key;
 //! 4. if there is none, `p*` is free: it is the next placement (one per cell, in cost order, [A] VI-A-4).
 //!
 //! **Exactness.** The children cover `K` minus the obstacle's interior and each lies in `K`, so no child costs less
@@ -186,7 +191,7 @@ pub struct PlacementResult {
 /// A node's cell: solved (with its optimum) or pending (the parent's cell plus the child's extra inequalities,
 /// keyed by the parent's cost, a valid lower bound: the child is only built and solved when popped).
 enum Body<const D: usize> {
-    Pending(Vec<Halfspace<D>>),
+    Pending(Vec<Halfspace<D>>, [f64; D]),
     Solved(QpOptimum<D>),
 }
 
@@ -242,6 +247,9 @@ fn restrict_quadratic<const D: usize>(q: &SeparableQuadratic, fixed_z: f64) -> Q
     }
     Quadratic { h: std::array::from_fn(|i| q.h[i]), c: std::array::from_fn(|i| q.c[i]), constant }
 }
+
+/// A child of a split: the face's outside half-space `normal . p >= offset` and the child's extra inequalities.
+type Outside<const D: usize> = (([f64; D], f64), Vec<Halfspace<D>>);
 
 /// The search state shared by the loop.
 struct Search<'r, 'a> {
@@ -301,15 +309,12 @@ pub fn place_with_cache(
     let orientations: Vec<Orientation> = orientations
         .into_par_iter()
         .enumerate()
-        .map(|(i, (rest, ti, theta, r))| Orientation::new(part, i, rest, ti, theta, r, &request.cost))
+        .map(|(i, (rest, ti, theta, r))| Orientation::without_components(part, i, rest, ti, theta, r, &request.cost))
         .collect();
     let stack_refs: Vec<(&stackplan_geom::Part, Pose)> = request.stack.iter().map(|s| (s.part, s.pose)).collect();
     let scene = StackScene::new(&stack_refs);
-    let sweeps: Vec<Option<SweepAxes>> = if request.insertion {
-        orientations.par_iter().map(|o| Some(SweepAxes::new(part, o.rotation, o))).collect()
-    } else {
-        vec![None; orientations.len()]
-    };
+    // rotated components and sweep axes are built when an orientation is first expanded
+    let sweeps: Vec<Option<SweepAxes>> = vec![None; orientations.len()];
     let stats = PlacementStats {
         orientations_requested: request.resting_rotations.len() * n_theta,
         orientations_searched: orientations.len(),
@@ -438,10 +443,10 @@ impl Search<'_, '_> {
                 return Err(PlacementError::NodeBudget { budget: self.request.node_budget, found: placements.len() });
             }
             let optimum = match &node.body {
-                Body::Pending(extra) => {
+                Body::Pending(extra, start) => {
                     // build and solve the child now; push it back with its true cost (>= its key)
                     let t_cells = Instant::now();
-                    let solved = self.solve_child::<D>(&node, extra, fixed_z)?;
+                    let solved = self.solve_child::<D>(&node, extra, start, fixed_z)?;
                     if let Some((cell, optimum)) = solved {
                         heap.push(Node {
                             cost: optimum.value,
@@ -458,7 +463,16 @@ impl Search<'_, '_> {
                 Body::Solved(optimum) => optimum,
             };
             self.stats.nodes_expanded += 1;
-            considered[node.orientation] = true;
+            if !considered[node.orientation] {
+                considered[node.orientation] = true;
+                let t_setup = Instant::now();
+                let o = &mut self.orientations[node.orientation];
+                o.build_components(self.request.part);
+                if self.request.insertion {
+                    self.sweeps[node.orientation] = Some(SweepAxes::new(self.request.part, o.rotation, o));
+                }
+                self.stats.time_setup_ms += ms(t_setup);
+            }
             let p = lift(&optimum.point, fixed_z);
             let t_det = Instant::now();
             let mut counts = DetectCounts::default();
@@ -506,14 +520,18 @@ impl Search<'_, '_> {
             let mut applied: Vec<u32> = node.applied.as_ref().clone();
             applied.push(id);
             let applied = Arc::new(applied);
-            for extra in children {
+            let q = restrict_quadratic::<D>(&self.orientations[node.orientation].quadratic, fixed_z);
+            for (outside, extra) in children {
                 self.stats.nodes_pushed += 1;
+                // key: a lower bound of the child's cost, the larger of the parent's cost and the cost's minimum
+                // over the child's half-space outside the obstacle face (slack: twice the cell tolerance)
+                let bound = q.halfspace_lower_bound(&outside.0, outside.1, 2.0 * tol);
                 heap.push(Node {
-                    cost: node.cost,
+                    cost: node.cost.max(bound),
                     orientation: node.orientation,
                     id: next_id,
                     cell: Arc::clone(&node.cell),
-                    body: Body::Pending(extra),
+                    body: Body::Pending(extra, optimum.point),
                     applied: Arc::clone(&applied),
                 });
                 next_id += 1;
@@ -562,7 +580,7 @@ impl Search<'_, '_> {
         orientation: usize,
         id: u32,
         fixed_z: f64,
-    ) -> Result<Vec<Vec<Halfspace<D>>>, PlacementError> {
+    ) -> Result<Vec<Outside<D>>, PlacementError> {
         let tol = self.tol.linear;
         let obstacle = &self.obstacles[id as usize];
         let mut inside: Vec<Halfspace<D>> = Vec::new();
@@ -574,7 +592,7 @@ impl Search<'_, '_> {
                     let keep = Halfspace::new(normal, offset, Tag::ObstacleFace { obstacle: u64::from(id), face });
                     let mut extra = inside.clone();
                     extra.push(keep.flipped(Tag::ObstacleFace { obstacle: u64::from(id), face }));
-                    children.push(extra);
+                    children.push(((normal, offset), extra));
                     inside.push(Halfspace::new(normal, offset, Tag::ObstacleCut { obstacle: u64::from(id), face }));
                 }
                 // a horizontal plane at fixed z: satisfied everywhere (no outside child, no cut needed) or nowhere
@@ -598,9 +616,18 @@ impl Search<'_, '_> {
         &mut self,
         node: &Node<D>,
         extra: &[Halfspace<D>],
+        start: &[f64; D],
         fixed_z: f64,
     ) -> Result<Option<(Cell<D>, QpOptimum<D>)>, PlacementError> {
         let fs_err = |reason: String| PlacementError::FreeSpace { orientation: node.orientation, reason };
+        // emptiness first by the phase 1 from the parent's optimum (it satisfies the parent and the obstacle's
+        // inside cuts; only the child's outside face is violated): most children are empty and never need the
+        // Chebyshev LP. A non-empty child is then built as before (Chebyshev centre as the QP's start), so the QP's
+        // optimum is bit-for-bit the one of a cold build and ties between equal-cost cells break as before.
+        if node.cell.is_empty_with(extra.iter().copied(), start).map_err(|e| fs_err(e.to_string()))? {
+            self.stats.cells_empty += 1;
+            return Ok(None);
+        }
         let cell = node.cell.with_halfspaces(extra.iter().copied()).map_err(|e| fs_err(e.to_string()))?;
         if cell.is_empty() {
             self.stats.cells_empty += 1;

@@ -1,0 +1,32 @@
+//! Times a stacking plan of a fixture part (for profiling): `cargo run -p stackplan-planner --example plan_profile
+//! -- PART.json [COUNT] [W] [DTHETA_DEG]`. Prints the plan's totals and statistics as JSON (floor 660 x 660 mm,
+//! height 400 mm, 5 mm clearance, the plan regression scenarios' settings).
+
+use stackplan_geom::io::{ReadOptions, read_part};
+use stackplan_planner::{FloorVolume, PlanOptions, plan_stack};
+
+#[allow(clippy::print_stdout)]
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let path = args.get(1).ok_or("usage: plan_profile PART.json [COUNT] [W] [DTHETA_DEG]")?;
+    let count: usize = args.get(2).map_or(Ok(15), |s| s.parse())?;
+    let w: f64 = args.get(3).map_or(Ok(0.5), |s| s.parse())?;
+    let dtheta: f64 = args.get(4).map_or(Ok(5.0), |s| s.parse())?;
+    let part = read_part(path, &ReadOptions::default())?;
+    let mut options = PlanOptions::new(count, FloorVolume::rectangle(-330.0, -330.0, 330.0, 330.0, 400.0));
+    options.w = w;
+    options.dtheta = dtheta.to_radians();
+    let started = std::time::Instant::now();
+    let plan = plan_stack(&part, &options)?;
+    let seconds = started.elapsed().as_secs_f64();
+    let summary = serde_json::json!({
+        "placed": plan.parts.len(),
+        "total_cost": plan.total_cost,
+        "height": plan.height,
+        "footprint": plan.footprint,
+        "seconds": seconds,
+        "stats": plan.stats,
+    });
+    println!("{}", serde_json::to_string_pretty(&summary)?);
+    Ok(())
+}
