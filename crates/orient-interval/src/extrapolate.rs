@@ -7,8 +7,8 @@
 //! parallelogram gets `sign * (e^B x R e^A)` normalised, the sign fixed at construction; the offset is the largest
 //! `n . v` over the face's vertices, as the construction does). O(size of the obstacle) and no hull.
 //!
-//! Two outputs: [`ObstacleStructure::extrapolate`] returns a full [`Obstacle`] (it rebuilds the polytope's edge table
-//! through `ConvexPolytope::with_planes`, a hash map over the half-edges), and
+//! Two outputs: [`ObstacleStructure::extrapolate`] returns a full [`Obstacle`] (it copies the template's face and
+//! edge tables through `ConvexPolytope::with_geometry`: no search, but one allocation per face), and
 //! [`ObstacleStructure::extrapolate_geometry`] writes only the vertices and planes into caller buffers (no allocation,
 //! the fast path for callers that need the H-representation).
 
@@ -40,6 +40,9 @@ pub enum ExtrapolateError {
         /// Face index.
         face: usize,
     },
+    /// The extrapolated vertex or plane count differs from the template's (an internal inconsistency).
+    #[error("the extrapolated geometry does not match the template's topology")]
+    TopologyMismatch,
     /// Building the obstacle failed.
     #[error("building the obstacle failed: {0}")]
     Build(#[from] ObstacleError),
@@ -169,7 +172,12 @@ impl ObstacleStructure {
     ) -> Result<Obstacle, ExtrapolateError> {
         let mut geometry = ExtrapolatedGeometry::default();
         self.extrapolate_geometry(moving, fixed, theta, &mut geometry)?;
-        let polytope = ConvexPolytope::with_planes(geometry.vertices, self.faces.clone(), geometry.planes)?;
+        // same topology as the template: reuse its edge table instead of rebuilding it (O(size), no sort)
+        let polytope = self
+            .template
+            .polytope()
+            .with_geometry(geometry.vertices, geometry.planes)
+            .ok_or(ExtrapolateError::TopologyMismatch)?;
         Obstacle::from_parts(
             polytope,
             self.template.vertex_pairs().to_vec(),
