@@ -7,6 +7,7 @@
 pub mod cmd;
 pub mod input;
 pub mod output;
+pub mod plan_files;
 pub mod render;
 
 use clap::{Parser, Subcommand};
@@ -47,6 +48,10 @@ pub enum Command {
     Part(cmd::part::PartCommand),
     /// A stacking plan for N identical parts, with pictures, a 3-D model and a report (default: 15 Triangle parts).
     Plan(cmd::plan::Args),
+    /// Redraws the pictures, 3-D model and report of an existing plan file.
+    Render(cmd::render::Args),
+    /// Plans the same stack for several weights w and draws the stacks side by side (the seed's Fig. 2).
+    Sweep(cmd::sweep::Args),
     /// The built-in example parts described and drawn under out/.
     Demo(cmd::demo::Args),
     /// The best interference-free placements of one part in a stack.
@@ -75,6 +80,8 @@ pub fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Part(c) => cmd::part::run(c),
         Command::Plan(a) => cmd::plan::run(a),
+        Command::Render(a) => cmd::render::run(a),
+        Command::Sweep(a) => cmd::sweep::run(a),
         Command::Demo(a) => cmd::demo::run(a),
         Command::Place(a) => cmd::place::run(a),
         Command::Intervals(a) => cmd::intervals::run(a),

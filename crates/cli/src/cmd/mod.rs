@@ -10,3 +10,5 @@ pub mod part;
 pub mod place;
 pub mod plan;
 pub mod poses;
+pub mod render;
+pub mod sweep;

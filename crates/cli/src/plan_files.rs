@@ -1,0 +1,404 @@
+//! The files of a stacking plan: the plan file (`plan.json`) and everything drawn from it (`stack.svg`,
+//! `stack.png`, `build.svg`, `build.png`, `stack.glb`, `report.html`). Shared by `stackplan plan` (which writes the
+//! plan file and then draws from the very text it wrote) and `stackplan render` (which draws from a plan file on
+//! disk), so the two produce byte-identical pictures for the same plan.
+//!
+//! The build strip is the seed's Fig. 3 ([A] section II-B): one small isometric frame per added part, the new part in
+//! its colour and numbered, the earlier ones grey; for more than [`MAX_BUILD_FRAMES`] parts one frame per `k` parts
+//! (`k = ceil(n / MAX_BUILD_FRAMES)`), each frame captioned with its part count. All frames share one scale and floor
+//! line so the stack's growth can be compared frame to frame.
+
+use crate::output::write_atomic;
+use crate::render::{
+    Figure, FigurePanel, ISOMETRIC, MUTED, Marker, Scene, Solid, figure_png, figure_svg, part_color, three_views,
+};
+use serde_json::{Map, Value, json};
+use stackplan::planner::{FloorVolume, Plan};
+use stackplan_geom::io::glb::{GlbItem, glb_bytes};
+use stackplan_geom::io::{IoError, ReadOptions};
+use stackplan_geom::{DVec3, Part, Pose};
+use std::path::{Path, PathBuf};
+
+/// At most this many frames in the build strip.
+pub const MAX_BUILD_FRAMES: usize = 20;
+
+/// Pixels per SVG unit of the PNG pictures.
+pub const PNG_SCALE: f64 = 2.0;
+
+/// A plan file that is not usable.
+#[derive(Debug, thiserror::Error)]
+pub enum PlanFileError {
+    /// The file cannot be read.
+    #[error("{}: cannot read the plan file: {source}", file.display())]
+    Read {
+        /// The plan file.
+        file: PathBuf,
+        /// The reason.
+        source: std::io::Error,
+    },
+    /// Not a valid stack file (part and placements); the error names the file and the place.
+    #[error(transparent)]
+    Stack(#[from] IoError),
+    /// A valid stack file without the `plan` summary that `stackplan plan` writes.
+    #[error("{}: not a plan file: there is no `plan` summary (only files written by `stackplan plan` can be rendered)", file.display())]
+    NotAPlan {
+        /// The file.
+        file: PathBuf,
+    },
+    /// The summary or the placements' planner fields are malformed.
+    #[error("{}: malformed plan: {message}", file.display())]
+    Malformed {
+        /// The file.
+        file: PathBuf,
+        /// What is wrong (serde's message names the key).
+        message: String,
+    },
+    /// The summary's part count disagrees with the placements.
+    #[error("{}: the summary says {placed} parts were placed, but there are {placements} placements", file.display())]
+    CountMismatch {
+        /// The file.
+        file: PathBuf,
+        /// `plan.placed`.
+        placed: u64,
+        /// Number of placements.
+        placements: usize,
+    },
+    /// No placements: nothing to draw.
+    #[error("{}: the plan has no placed parts: nothing to draw", file.display())]
+    Empty {
+        /// The file.
+        file: PathBuf,
+    },
+}
+
+/// A plan file read back.
+#[derive(Debug, Clone)]
+pub struct PlanFile {
+    /// The part (inline in the file).
+    pub part: Part,
+    /// The plan's summary (`plan.parts` is empty: the parts are `poses` and `placements`).
+    pub plan: Plan,
+    /// The placements as checked poses.
+    pub poses: Vec<Pose>,
+    /// The planner's fields of each placement (`cost`, `theta_deg`, `stage`, ...: [`stackplan::planner::PlannedPart`]
+    /// without the pose), parallel to `poses`.
+    pub placements: Vec<Map<String, Value>>,
+    /// Planning time recorded in the file (s).
+    pub seconds: f64,
+}
+
+/// The plan file's JSON: a stack file (`part` inline, `placements` = the planned parts) plus the `plan` summary
+/// (the [`Plan`] without its parts, with `part_name`, `placed` and `seconds`).
+pub fn plan_document_text(part: &Part, plan: &Plan, seconds: f64) -> anyhow::Result<String> {
+    let inline: Value = serde_json::from_str(&stackplan_geom::io::json::part_json_string(part))?;
+    let placements = serde_json::to_value(&plan.parts)?;
+    let mut summary = serde_json::to_value(plan)?;
+    if let Value::Object(m) = &mut summary {
+        m.remove("parts");
+        m.insert("part_name".into(), json!(part.name));
+        m.insert("placed".into(), json!(plan.parts.len()));
+        m.insert("seconds".into(), json!(seconds));
+    }
+    crate::output::json_text(&json!({ "part": inline, "placements": placements, "plan": summary }))
+}
+
+/// Reads a plan file.
+pub fn read_plan_file(path: &Path) -> Result<PlanFile, PlanFileError> {
+    let bytes = std::fs::read(path).map_err(|source| PlanFileError::Read { file: path.to_path_buf(), source })?;
+    parse_plan_file(&bytes, path)
+}
+
+/// Parses a plan file's bytes; `path` names it in errors.
+pub fn parse_plan_file(bytes: &[u8], path: &Path) -> Result<PlanFile, PlanFileError> {
+    let stack = stackplan_geom::io::stack::parse_stack(bytes, path, &ReadOptions::default())?;
+    let malformed = |message: String| PlanFileError::Malformed { file: path.to_path_buf(), message };
+    // parse_stack accepted the JSON, so it is an object with `placements`
+    let mut document: Value = serde_json::from_slice(bytes).map_err(|e| malformed(e.to_string()))?;
+    let Some(Value::Object(mut summary)) = document.get_mut("plan").map(Value::take) else {
+        return Err(PlanFileError::NotAPlan { file: path.to_path_buf() });
+    };
+    let seconds = summary.get("seconds").and_then(Value::as_f64).unwrap_or(0.0);
+    let placed = summary.get("placed").and_then(Value::as_u64);
+    // the summary is typed; the placements' planner fields (cost, theta, stage, ...) are read leniently for the
+    // report: JSON has no infinity or NaN, so a non-finite number is written as `null` and shown as "-"
+    summary.insert("parts".into(), Value::Array(Vec::new()));
+    let plan: Plan =
+        serde_json::from_value(Value::Object(summary)).map_err(|e| malformed(format!("key `plan`: {e}")))?;
+    let count = stack.placements.len();
+    if let Some(placed) = placed
+        && placed != count as u64
+    {
+        return Err(PlanFileError::CountMismatch { file: path.to_path_buf(), placed, placements: count });
+    }
+    if count == 0 {
+        return Err(PlanFileError::Empty { file: path.to_path_buf() });
+    }
+    Ok(PlanFile { part: stack.part, plan, poses: stack.placements, placements: stack.extras, seconds })
+}
+
+/// Every picture of a plan, ready to write.
+#[derive(Debug, Clone)]
+pub struct PlanPictures {
+    /// `stack.svg`: isometric, top and side views, parts numbered.
+    pub stack_svg: String,
+    /// `stack.png`: the same picture.
+    pub stack_png: Vec<u8>,
+    /// `build.svg`: the step-by-step build strip.
+    pub build_svg: String,
+    /// `build.png`: the same strip.
+    pub build_png: Vec<u8>,
+    /// `stack.glb`: the stack as binary glTF.
+    pub glb: Vec<u8>,
+    /// `report.html`: the pictures and the tables.
+    pub html: String,
+}
+
+impl PlanPictures {
+    /// The standard file names with their contents, in writing order.
+    pub fn files(&self) -> [(&'static str, &[u8]); 6] {
+        [
+            ("stack.svg", self.stack_svg.as_bytes()),
+            ("stack.png", &self.stack_png),
+            ("build.svg", self.build_svg.as_bytes()),
+            ("build.png", &self.build_png),
+            ("stack.glb", &self.glb),
+            ("report.html", self.html.as_bytes()),
+        ]
+    }
+
+    /// Writes `plan.json` (the given text) and every picture into `dir` (created if needed), each atomically.
+    pub fn write_all(&self, dir: &Path, plan_text: &[u8]) -> anyhow::Result<()> {
+        use anyhow::Context;
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        write_atomic(&dir.join("plan.json"), plan_text)?;
+        for (name, bytes) in self.files() {
+            write_atomic(&dir.join(name), bytes)?;
+        }
+        Ok(())
+    }
+}
+
+/// Draws every picture of a plan.
+pub fn plan_pictures(file: &PlanFile) -> anyhow::Result<PlanPictures> {
+    let scene = stack_scene(file, true);
+    let stack_figure = three_views(&scene);
+    let frames = build_frames(file);
+    let build = build_figure(file, &frames);
+    let stack_svg = figure_svg(&stack_figure);
+    let items: Vec<GlbItem<'_>> = file
+        .poses
+        .iter()
+        .enumerate()
+        .map(|(i, pose)| {
+            let c = part_color(i);
+            GlbItem {
+                part: &file.part,
+                pose: *pose,
+                color: [c[0] as f32 / 255.0, c[1] as f32 / 255.0, c[2] as f32 / 255.0, 1.0],
+            }
+        })
+        .collect();
+    Ok(PlanPictures {
+        stack_png: figure_png(&stack_figure, PNG_SCALE)?,
+        build_svg: figure_svg(&build),
+        build_png: figure_png(&build, PNG_SCALE)?,
+        glb: glb_bytes(&items),
+        html: report_html(file, &stack_svg),
+        stack_svg,
+    })
+}
+
+fn floor_outline(floor: &FloorVolume) -> Vec<DVec3> {
+    floor.polygon.iter().map(|p| DVec3::new(p.x, p.y, 0.0)).collect()
+}
+
+/// The stack as a scene: every part in its colour; with `annotate`, numbered and its c.g. marked.
+pub fn stack_scene(file: &PlanFile, annotate: bool) -> Scene {
+    let mut scene = frame_scene(file, file.poses.len(), 0, floor_outline(&file.plan.options.floor));
+    if !annotate {
+        scene.labels.clear();
+        scene.markers.clear();
+    }
+    let plan = &file.plan;
+    scene.title = format!(
+        "{} x {}: w = {}, height {:.1} mm, total cost {:.1}",
+        file.poses.len(),
+        file.part.name,
+        plan.options.w,
+        plan.height,
+        plan.total_cost
+    );
+    scene
+}
+
+/// The first `count` parts; parts from `new_from` on in their colour, numbered, c.g. marked; earlier ones grey.
+fn frame_scene(file: &PlanFile, count: usize, new_from: usize, floor: Vec<DVec3>) -> Scene {
+    let mut scene = Scene { floor, ..Scene::default() };
+    for (i, pose) in file.poses.iter().enumerate().take(count) {
+        let new = i >= new_from;
+        let color = if new { part_color(i) } else { MUTED };
+        for c in &file.part.components {
+            scene.solids.push(Solid { polytope: c.transformed(pose.rotation, pose.position), color, part: i });
+        }
+        if new {
+            let cg = pose.apply(file.part.mass.center_of_gravity);
+            scene.labels.push((i + 1, cg));
+            scene.markers.push(Marker { position: cg, color: [200, 0, 0] });
+        }
+    }
+    scene
+}
+
+/// Part counts shown by the build strip's frames: 1, 2, ..., n, or k, 2k, ..., n for more than
+/// [`MAX_BUILD_FRAMES`] parts.
+pub fn build_frame_counts(n: usize) -> Vec<usize> {
+    let step = n.div_ceil(MAX_BUILD_FRAMES).max(1);
+    let mut counts: Vec<usize> = (1..=n / step).map(|k| k * step).collect();
+    if counts.last() != Some(&n) && n > 0 {
+        counts.push(n);
+    }
+    counts
+}
+
+/// The build strip's scenes with their captions. The outline on the floor is the finished stack's footprint grown
+/// by 10% on every side (the whole floor area would make the parts tiny).
+fn build_frames(file: &PlanFile) -> Vec<(Scene, String)> {
+    let [[x0, y0], [x1, y1]] = file.plan.footprint;
+    let (mx, my) = (0.1 * (x1 - x0), 0.1 * (y1 - y0));
+    let outline = vec![
+        DVec3::new(x0 - mx, y0 - my, 0.0),
+        DVec3::new(x1 + mx, y0 - my, 0.0),
+        DVec3::new(x1 + mx, y1 + my, 0.0),
+        DVec3::new(x0 - mx, y1 + my, 0.0),
+    ];
+    let mut previous = 0;
+    build_frame_counts(file.poses.len())
+        .into_iter()
+        .map(|count| {
+            let scene = frame_scene(file, count, previous, outline.clone());
+            previous = count;
+            (scene, format!("n = {count}"))
+        })
+        .collect()
+}
+
+fn build_figure<'a>(file: &PlanFile, frames: &'a [(Scene, String)]) -> Figure<'a> {
+    let n = file.poses.len();
+    let step = n.div_ceil(MAX_BUILD_FRAMES).max(1);
+    Figure {
+        title: format!(
+            "Building the stack of {n} x {}: {}, the new part{} in colour",
+            file.part.name,
+            if step == 1 { "one frame per part".to_string() } else { format!("one frame per {step} parts") },
+            if step == 1 { "" } else { "s" }
+        ),
+        panels: frames
+            .iter()
+            .map(|(scene, caption)| FigurePanel { scene, view: ISOMETRIC, caption: caption.clone() })
+            .collect(),
+        columns: 5,
+        cell: (220.0, 200.0),
+        common_scale: true,
+    }
+}
+
+fn report_html(file: &PlanFile, svg_text: &str) -> String {
+    let (part, plan, seconds) = (&file.part, &file.plan, file.seconds);
+    let esc = |s: &str| s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;");
+    let mut rows = String::new();
+    for (i, p) in file.placements.iter().enumerate() {
+        let number = |key: &str, digits: usize| match p.get(key).and_then(Value::as_f64) {
+            Some(x) => format!("{x:.digits$}"),
+            None => "-".to_string(),
+        };
+        let position = file.poses[i].position;
+        rows.push_str(&format!(
+            "<tr><td>{}</td><td>{:.2}, {:.2}, {:.2}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+            i + 1,
+            position.x,
+            position.y,
+            position.z,
+            number("theta_deg", 1),
+            number("resting_pose", 0),
+            number("stage", 0),
+            number("cost", 2),
+            number("cg_height", 2),
+            number("stability_margin", 2),
+            number("grasp_radius", 1),
+            p.get("contacts").and_then(Value::as_array).map_or("-".to_string(), |c| c.len().to_string())
+        ));
+    }
+    format!(
+        r#"<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>stackplan: {name}</title>
+<style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse}}td,th{{border:1px solid #ccc;padding:3px 8px;text-align:right}}img{{max-width:100%}}</style>
+</head><body>
+<h1>Stacking plan: {placed} x {name}</h1>
+<p id="summary">{status}. Height {height:.1} mm, footprint {fx:.1} x {fy:.1} mm, total cost {cost:.1} (w = {w}),
+clearance {clearance} mm, whole stack stable: {stable}. Planned in {seconds:.1} s
+({searches} placement searches, {checked} candidates checked, {pairs} component pairs evaluated).</p>
+<h2>Pictures</h2>
+<p><img src="stack.png" alt="the stack: isometric, top and side views" width="1080"></p>
+<details><summary>SVG</summary>{svg}</details>
+<h2>Build</h2>
+<p><img id="build" src="build.png" alt="the stack built part by part, the new part in colour" width="1100"></p>
+<p>3-D model: <a href="stack.glb">stack.glb</a> (any glTF viewer). Plan: <a href="plan.json">plan.json</a>
+(a stack file: <code>stackplan check plan.json</code>).</p>
+<h2>Parts</h2>
+<table id="parts"><tr><th>#</th><th>position (mm)</th><th>theta (deg)</th><th>pose</th><th>stage</th><th>cost</th><th>c.g. height</th><th>margin</th><th>grasp radius</th><th>contacts</th></tr>
+{rows}</table>
+</body></html>
+"#,
+        name = esc(&part.name),
+        placed = file.poses.len(),
+        status = esc(plan.stopped.as_deref().unwrap_or("All parts placed")),
+        height = plan.height,
+        fx = plan.footprint[1][0] - plan.footprint[0][0],
+        fy = plan.footprint[1][1] - plan.footprint[0][1],
+        cost = plan.total_cost,
+        w = plan.options.w,
+        clearance = plan.options.clearance,
+        stable = plan.stack_stable,
+        seconds = seconds,
+        searches = plan.stats.searches,
+        checked = plan.stats.candidates_checked,
+        pairs = plan.stats.pairs_evaluated,
+        svg = svg_text,
+        rows = rows,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn build_frames_cover_every_part_and_end_at_n() {
+        assert_eq!(build_frame_counts(1), vec![1]);
+        assert_eq!(build_frame_counts(15), (1..=15).collect::<Vec<_>>());
+        assert_eq!(build_frame_counts(20).len(), 20);
+        let c = build_frame_counts(121); // step 7: 7, 14, ..., 119, 121
+        assert_eq!(c.first(), Some(&7));
+        assert_eq!(c.last(), Some(&121));
+        assert!(c.len() <= MAX_BUILD_FRAMES + 1);
+        assert!(c.windows(2).all(|w| w[0] < w[1]));
+        assert!(build_frame_counts(0).is_empty());
+    }
+
+    #[test]
+    fn a_stack_file_without_summary_is_not_a_plan() {
+        let part = stackplan_geom::io::json::part_json_string(
+            &stackplan_geom::examples::part_by_name("cube", Default::default()).expect("cube"),
+        );
+        let text = format!(
+            r#"{{"part": {part}, "placements": [{{"position": [0, 0, 0], "rotation": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]}}]}}"#
+        );
+        let e = parse_plan_file(text.as_bytes(), Path::new("dir/p.json")).expect_err("no summary");
+        assert!(matches!(e, PlanFileError::NotAPlan { .. }));
+        assert!(e.to_string().starts_with("dir/p.json:"), "{e}");
+        let with_bad_summary = text.replacen("{\"part\"", "{\"plan\": {\"w\": 1}, \"part\"", 1);
+        let e = parse_plan_file(with_bad_summary.as_bytes(), Path::new("q.json")).expect_err("malformed");
+        assert!(matches!(e, PlanFileError::Malformed { .. }), "{e}");
+        assert!(e.to_string().starts_with("q.json: malformed plan"), "{e}");
+    }
+}

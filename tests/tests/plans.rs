@@ -1,0 +1,259 @@
+//! `render` and `sweep` end to end, the planner's determinism across thread counts, and the HTML report in
+//! headless Chromium.
+
+mod common;
+use common::*;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+/// Every file `plan` and `render --out` write.
+const PLAN_FILES: [&str; 7] =
+    ["plan.json", "stack.svg", "stack.png", "build.svg", "build.png", "stack.glb", "report.html"];
+
+fn read_json(path: &Path) -> Value {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// A small plan of `count` Channel parts under `dir/name`.
+fn small_plan(dir: &Path, name: &str, count: &str, extra: &[&str]) -> PathBuf {
+    let mut args = vec!["plan", "example:channel", "--count", count, "--dtheta-deg", "30", "--out", name];
+    args.extend_from_slice(extra);
+    let o = run_in(dir, &args);
+    assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
+    dir.join(name)
+}
+
+#[test]
+fn render_reproduces_every_file_of_a_plan() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let plan = small_plan(dir.path(), "p", "4", &[]);
+    for f in PLAN_FILES {
+        assert!(plan.join(f).metadata().is_ok_and(|m| m.len() > 0), "plan wrote no {f}");
+    }
+    let o = run_in(dir.path(), &["render", "p/plan.json", "--out", "r", "--png", "one.png", "--build-svg", "b.svg"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for f in PLAN_FILES {
+        let (a, b) = (std::fs::read(plan.join(f)).expect("plan file"), std::fs::read(dir.path().join("r").join(f)));
+        assert!(b.is_ok_and(|b| b == a), "render --out wrote a different {f}");
+    }
+    assert_eq!(std::fs::read(dir.path().join("one.png")).ok(), std::fs::read(plan.join("stack.png")).ok());
+    assert_eq!(std::fs::read(dir.path().join("b.svg")).ok(), std::fs::read(plan.join("build.svg")).ok());
+    // the build strip: one frame per part, captioned with the part count, the report shows it
+    let strip = std::fs::read_to_string(plan.join("build.svg")).expect("build.svg");
+    assert_eq!(strip.matches("<g id=\"view-").count(), 4);
+    assert!(strip.contains(">n = 4</text>"));
+    let html = std::fs::read_to_string(plan.join("report.html")).expect("report");
+    assert!(html.contains("src=\"build.png\""));
+}
+
+#[test]
+fn render_names_the_file_of_a_malformed_plan_and_writes_nothing() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let plan = small_plan(dir.path(), "p", "4", &[]);
+    let good: Value = read_json(&plan.join("plan.json"));
+    let write = |name: &str, v: &Value| {
+        let path = dir.path().join(name);
+        std::fs::write(&path, serde_json::to_string(v).expect("json")).expect("write");
+    };
+    let mut no_summary = good.clone();
+    no_summary.as_object_mut().expect("object").remove("plan");
+    write("no-summary.json", &no_summary);
+    let mut bad_summary = good.clone();
+    bad_summary["plan"]["options"] = Value::String("fast".into());
+    write("bad-summary.json", &bad_summary);
+    let mut wrong_count = good.clone();
+    wrong_count["plan"]["placed"] = Value::from(9);
+    write("wrong-count.json", &wrong_count);
+    let mut bad_rotation = good.clone();
+    bad_rotation["placements"][1]["rotation"][0][0] = Value::from(2.0);
+    write("bad-rotation.json", &bad_rotation);
+    std::fs::write(dir.path().join("truncated.json"), &serde_json::to_string(&good).expect("json")[..200])
+        .expect("write");
+    let cases = [
+        ("no-summary.json", "not a plan file"),
+        ("bad-summary.json", "malformed plan: key `plan`"),
+        ("wrong-count.json", "there are 4 placements"),
+        ("bad-rotation.json", "placement 1"),
+        ("truncated.json", "truncated.json"),
+        ("missing.json", "cannot read"),
+    ];
+    for (file, message) in cases {
+        let out = format!("out-{file}");
+        let o = run_in(dir.path(), &["render", file, "--out", &out, "--png", "x.png"]);
+        assert_eq!(o.status.code(), Some(2), "{file}: {}", stderr(&o));
+        let err = stderr(&o);
+        assert!(err.starts_with("error: ") && err.contains(file) && err.contains(message), "{file}: {err}");
+        assert!(!dir.path().join(&out).exists() && !dir.path().join("x.png").exists(), "{file}: wrote output");
+    }
+    let o = run_in(dir.path(), &["render", "p/plan.json"]);
+    assert_eq!(o.status.code(), Some(2), "render with nothing to write is an error");
+}
+
+#[test]
+fn sweep_writes_a_plan_per_weight_with_its_layers() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    // 4 unit cubes on a 2 x 2 floor: w = 0 puts them side by side, w = 1 in a column
+    let o = run_in(
+        dir.path(),
+        &[
+            "sweep",
+            "example:cube",
+            "--count",
+            "4",
+            "--w-values",
+            "0,1",
+            "--clearance",
+            "0",
+            "--floor",
+            "-1,-1,1,1",
+            "--height",
+            "5",
+            "--dtheta-deg",
+            "90",
+            "--cup-diameter",
+            "0.5",
+            "--out",
+            "s",
+        ],
+    );
+    assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
+    let out = dir.path().join("s");
+    for f in ["sweep.json", "sweep.svg", "sweep.png", "plan-w0.json", "plan-w1.json"] {
+        assert!(out.join(f).metadata().is_ok_and(|m| m.len() > 0), "sweep wrote no {f}");
+    }
+    let sweep = read_json(&out.join("sweep.json"));
+    let runs = sweep["runs"].as_array().expect("runs");
+    assert_eq!(runs.len(), 2);
+    assert_eq!(runs[0]["w"], 0.0);
+    assert_eq!(runs[0]["plan_file"], "plan-w0.json");
+    for r in runs {
+        assert_eq!(r["placed"], 4, "{r}");
+        for key in ["height", "total_cost", "seconds"] {
+            assert!(r[key].as_f64().is_some_and(f64::is_finite), "{key} in {r}");
+        }
+    }
+    assert_eq!(runs[0]["layers"], 1, "w = 0: every cube on the floor: {}", runs[0]);
+    assert_eq!(runs[0]["footprint_size"], serde_json::json!([2.0, 2.0]));
+    assert_eq!(runs[1]["layers"], 4, "w = 1: one column: {}", runs[1]);
+    assert_eq!(runs[1]["layer_counts"], serde_json::json!([1, 1, 1, 1]));
+    assert!((runs[1]["height"].as_f64().expect("height") - 4.0).abs() < 1e-6);
+    // the picture: one panel per weight, captioned
+    let svg = std::fs::read_to_string(out.join("sweep.svg")).expect("svg");
+    assert!(svg.contains(">w = 0</text>") && svg.contains(">w = 1</text>"));
+    // each plan file is a plan: check and render read it
+    let o = run_in(&out, &["check", "plan-w1.json", "--cup-diameter", "0.5"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
+    let o = run_in(&out, &["render", "plan-w0.json", "--png", "w0.png"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // bad weights are refused before planning
+    let o = run_in(dir.path(), &["sweep", "example:cube", "--w-values", "0,2", "--out", "bad"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(!dir.path().join("bad").exists());
+}
+
+/// The plan file without what may differ between runs: the timings and the search statistics.
+fn without_timings(mut v: Value) -> Value {
+    if let Some(summary) = v["plan"].as_object_mut() {
+        summary.remove("seconds");
+        summary.remove("stats");
+    }
+    v
+}
+
+#[test]
+fn plans_do_not_depend_on_the_thread_count() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let one = small_plan(dir.path(), "t1", "6", &["--threads", "1"]);
+    let two = small_plan(dir.path(), "t2", "6", &["--threads", "2"]);
+    let (a, b) = (read_json(&one.join("plan.json")), read_json(&two.join("plan.json")));
+    assert_eq!(a["placements"].as_array().map(Vec::len), Some(6));
+    assert_eq!(without_timings(a), without_timings(b));
+}
+
+/// The Chromium binary: `$CHROMIUM`, else `/usr/bin/chromium`, if it exists.
+fn chromium() -> Option<PathBuf> {
+    let candidate = std::env::var_os("CHROMIUM").map(PathBuf::from).unwrap_or_else(|| "/usr/bin/chromium".into());
+    candidate.exists().then_some(candidate)
+}
+
+fn headless(chromium: &Path, profile: &Path, extra: &[&str], page: &str) -> std::process::Output {
+    std::process::Command::new(chromium)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--no-first-run",
+            "--allow-file-access-from-files",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .args(extra)
+        .arg(page)
+        .output()
+        .expect("chromium starts")
+}
+
+/// The `src` attributes of the `<img>` elements of an HTML text.
+fn image_sources(html: &str) -> Vec<String> {
+    html.split("<img")
+        .skip(1)
+        .filter_map(|tag| {
+            let tag = &tag[..tag.find('>')?];
+            let start = tag.find("src=\"")? + 5;
+            let len = tag[start..].find('"')?;
+            Some(tag[start..start + len].to_string())
+        })
+        .collect()
+}
+
+#[test]
+fn the_report_opens_in_headless_chromium() {
+    let Some(chromium) = chromium() else {
+        let required = std::env::var("STACKPLAN_REQUIRE_CHROMIUM").is_ok_and(|v| v == "1");
+        assert!(!required, "STACKPLAN_REQUIRE_CHROMIUM=1 but no Chromium at $CHROMIUM or /usr/bin/chromium");
+        #[allow(clippy::print_stderr)]
+        {
+            eprintln!("SKIPPED the_report_opens_in_headless_chromium: no Chromium (set CHROMIUM or install chromium)");
+        }
+        return;
+    };
+    let dir = tempfile::tempdir().expect("tempdir");
+    let plan = small_plan(dir.path(), "p", "4", &[]);
+    let report = plan.join("report.html").canonicalize().expect("report path");
+    let page = format!("file://{}", report.display());
+    let profile = dir.path().join("profile");
+    let o = headless(&chromium, &profile, &["--dump-dom"], &page);
+    assert!(o.status.success(), "chromium failed: {}", stderr(&o));
+    let dom = stdout(&o);
+    assert!(dom.contains("<table id=\"parts\">"), "no parts table in the DOM: {dom}");
+    assert_eq!(dom.matches("<tr>").count(), 1 + 4, "a header row and one row per part");
+    assert!(dom.contains("id=\"summary\""));
+    let sources = image_sources(&dom);
+    assert!(sources.iter().any(|s| s == "stack.png") && sources.iter().any(|s| s == "build.png"), "{sources:?}");
+    for s in &sources {
+        assert!(plan.join(s).is_file(), "<img src={s:?}> names no file next to the report");
+    }
+    // a screenshot: the page is drawn, and not blank
+    let shot = dir.path().join("shot.png");
+    let o = headless(
+        &chromium,
+        &profile,
+        &[&format!("--screenshot={}", shot.display()), "--window-size=1200,1600", "--hide-scrollbars"],
+        &page,
+    );
+    assert!(o.status.success() && shot.is_file(), "no screenshot: {}", stderr(&o));
+    let distinct = png_distinct_colours(&std::fs::read(&shot).expect("screenshot"));
+    assert!(distinct > 16, "the screenshot is (nearly) blank: {distinct} colours");
+}
+
+/// Number of distinct RGB colours of a PNG (decoded with the CLI's tiny-skia, through the program's own crate).
+fn png_distinct_colours(png: &[u8]) -> usize {
+    let pixmap = stackplan_cli::render::decode_png(png).expect("a PNG");
+    let mut colours: Vec<[u8; 3]> = pixmap.chunks_exact(4).map(|p| [p[0], p[1], p[2]]).collect();
+    colours.sort_unstable();
+    colours.dedup();
+    colours.len()
+}
