@@ -19,9 +19,10 @@
 //! Cost: one GA run per hypothesis surviving the pruning plus 12 per feasible state; hypotheses per level are at most
 //! (feasible states of lower levels) x (feasible PPCs).
 
-use crate::criteria::{ContactPart, Objective, Weights};
+use crate::criteria::{ContactPart, Objective, Weights, face_point_distance_2d};
 use crate::extremal::{Extremal, extremals, range_of};
 use crate::ga::{GaSettings, minimise_with_polish, mix_seed};
+use crate::manifold::{Manifolds, Rejection, StrictTolerances, segment_segment_distance};
 use crate::pose::{Config, ConfigBox, VARIABLE_NAMES};
 use crate::principal_contact::{ContactState, PrincipalContact, all_ppcs};
 use crate::surface::{Element, ElementKind, SurfaceElements};
@@ -35,8 +36,15 @@ use std::collections::{BTreeMap, HashMap, HashSet};
 pub struct AcsgSettings {
     /// GA settings of the feasibility searches (extremal searches use half the population and generations).
     pub ga: GaSettings,
-    /// Feasibility threshold relative to the characteristic length `L`: feasible iff `min f <= threshold_relative * L`.
+    /// Candidate threshold relative to the characteristic length `L`: a GA minimum `min f <= threshold_relative * L`
+    /// makes the hypothesis a candidate, which is feasible only if the strict check passes near it.
     pub threshold_relative: f64,
+    /// Tolerances of the strict check ([`crate::manifold`]).
+    pub strict: StrictTolerances,
+    /// Random perturbations tried per start when looking for a strict witness.
+    pub witness_attempts: usize,
+    /// Projections per extremal search.
+    pub extremal_budget: usize,
     /// Widening of refined search boxes, as a fraction of the initial box widths.
     pub widen: f64,
     /// Highest level hypothesised.
@@ -45,7 +53,15 @@ pub struct AcsgSettings {
 
 impl Default for AcsgSettings {
     fn default() -> Self {
-        Self { ga: GaSettings::default(), threshold_relative: 1e-4, widen: 0.15, max_level: 12 }
+        Self {
+            ga: GaSettings::default(),
+            threshold_relative: 1e-4,
+            strict: StrictTolerances::default(),
+            witness_attempts: 8,
+            extremal_budget: 400,
+            widen: 0.05,
+            max_level: 12,
+        }
     }
 }
 
@@ -60,10 +76,17 @@ pub struct StateRecord {
     pub label: String,
     /// Level (number of point contacts).
     pub level: usize,
-    /// Whether a configuration in the box satisfies all criteria.
+    /// Whether a configuration in the box verifies the state strictly (its PCs and no others in contact, no
+    /// penetration; [`crate::manifold::Manifolds::verify`]).
     pub feasible: bool,
-    /// Minimum of eq. 8 found (`None` when pruned without a search).
+    /// Eq. 8 at the witness when feasible, else the GA minimum (`None` when pruned, or when a neighbour's
+    /// configuration led to a witness without a GA run).
     pub objective: Option<f64>,
+    /// Why a candidate (GA minimum below the threshold, or a projected neighbour configuration) failed the strict
+    /// check.
+    pub rejection: Option<Rejection>,
+    /// Whether a GA search ran (otherwise the hypothesis was pruned or verified from a neighbour's configuration).
+    pub searched_by_ga: bool,
     /// Why the hypothesis was rejected without a search, if it was.
     pub pruned: Option<String>,
     /// The configuration attaining `objective`.
@@ -94,6 +117,11 @@ pub struct AcsgStats {
     pub ppc_unreachable: usize,
     /// Hypotheses evaluated by a search.
     pub searched: usize,
+    /// Hypotheses verified from a neighbour's configuration without a GA run.
+    pub from_neighbours: usize,
+    /// Hypotheses with a candidate configuration (a projected neighbour's configuration or a GA minimum below the
+    /// threshold) that failed the strict check and were not verified otherwise.
+    pub rejected_candidates: usize,
     /// Hypotheses rejected by Propositions 1-2 without a search.
     pub pruned: usize,
     /// Objective evaluations (approximate: GA + polish budgets).
@@ -113,8 +141,10 @@ pub struct Acsg {
     pub settings: AcsgSettings,
     /// Characteristic length `L` (mm).
     pub length: f64,
-    /// Feasibility threshold (mm).
+    /// Candidate threshold of the GA (mm).
     pub threshold: f64,
+    /// Strict contact tolerance `hold * L` (mm).
+    pub hold: f64,
     /// Evaluated hypotheses (feasible and infeasible), in evaluation order.
     pub states: Vec<StateRecord>,
     /// CLCN/CMCN relations between feasible states.
@@ -172,9 +202,69 @@ pub fn reachable(pc: &PrincipalContact, a: &SurfaceElements, b: &SurfaceElements
     true
 }
 
+/// Lower and upper bounds on the distance between points of two elements of one part: the minimum (exact for
+/// elements of a valid boundary, which meet only along shared boundary: end points and boundary edges against the
+/// other element) and the maximum (over vertex pairs; the elements are convex).
+fn element_distance_range(s: &SurfaceElements, x: Element, y: Element) -> (f64, f64) {
+    let (px, py) = (element_points(s, x), element_points(s, y));
+    let max = px.iter().flat_map(|p| py.iter().map(move |q| (*p - *q).length())).fold(0.0, f64::max);
+    let segments = |e: Element| -> Vec<(DVec3, DVec3)> {
+        match e.kind {
+            ElementKind::Vertex => {
+                let p = s.vertices[e.index].position;
+                vec![(p, p)]
+            }
+            ElementKind::Edge => vec![s.edge_points(e.index)],
+            ElementKind::Face => s.faces[e.index].edges.iter().map(|&i| s.edge_points(i)).collect(),
+        }
+    };
+    let point_to = |p: DVec3, e: Element| -> f64 {
+        match e.kind {
+            ElementKind::Face => {
+                let f = &s.faces[e.index];
+                f.frame.height(p).hypot(face_point_distance_2d(f, f.frame.to_2d(p)))
+            }
+            _ => segments(e).iter().map(|&(a, b)| segment_segment_distance(p, p, a, b)).fold(f64::INFINITY, f64::min),
+        }
+    };
+    let mut min = f64::INFINITY;
+    for (a, b) in segments(x) {
+        min = min.min(point_to(a, y)).min(point_to(b, y));
+        for (c, d) in segments(y) {
+            min = min.min(segment_segment_distance(a, b, c, d));
+        }
+    }
+    for (c, d) in segments(y) {
+        min = min.min(point_to(c, x)).min(point_to(d, x));
+    }
+    (min, max)
+}
+
+/// A necessary condition for PCs to hold together: a rigid motion keeps distances, so for two PCs `(a1, b1)`,
+/// `(a2, b2)` the distance between their contact points lies both in the distance range of `a1, a2` (in A) and in
+/// that of `b1, b2` (in B). Returns the first pair violating it (beyond `slack`).
+fn incompatible_pair(
+    state: &ContactState,
+    sa: &SurfaceElements,
+    sb: &SurfaceElements,
+    slack: f64,
+) -> Option<(PrincipalContact, PrincipalContact)> {
+    for (i, p) in state.pcs.iter().enumerate() {
+        for q in &state.pcs[i + 1..] {
+            let (a_lo, a_hi) = element_distance_range(sa, p.a, q.a);
+            let (b_lo, b_hi) = element_distance_range(sb, p.b, q.b);
+            if a_lo > b_hi + slack || b_lo > a_hi + slack {
+                return Some((*p, *q));
+            }
+        }
+    }
+    None
+}
+
 struct Context<'a> {
     fixed: &'a ContactPart,
     moving: &'a ContactPart,
+    manifolds: Manifolds<'a>,
     bounds: ConfigBox,
     settings: AcsgSettings,
     weights: Weights,
@@ -196,6 +286,8 @@ impl Context<'_> {
             level: state.level(),
             feasible: false,
             objective: None,
+            rejection: None,
+            searched_by_ga: false,
             pruned: None,
             witness: None,
             search_box: None,
@@ -206,10 +298,16 @@ impl Context<'_> {
             record.pruned = Some(format!("{} cannot be reached within the bounds", pc.label()));
             return record;
         }
+        if let Some((p, q)) = incompatible_pair(state, sa, sb, self.manifolds.clear()) {
+            record.pruned =
+                Some(format!("{} and {} cannot hold together (distance ranges disjoint)", p.label(), q.label()));
+            return record;
+        }
         // Proposition 1: hull of the CLCN states' ranges
         let clcn: Vec<&&StateRecord> = feasible_ids.iter().filter(|r| r.state.is_clcn_of(state, sa, sb)).collect();
         let mut search = self.bounds;
         let mut seeds: Vec<Config> = Vec::new();
+        let mut extremal_seeds: Vec<Config> = Vec::new();
         if !clcn.is_empty() {
             let mut hull: Option<ConfigBox> = None;
             for r in &clcn {
@@ -219,8 +317,9 @@ impl Context<'_> {
                 if let Some(w) = r.witness {
                     seeds.push(w);
                 }
-                seeds.extend(r.extremals.iter().filter(|e| e.converged).map(|e| e.t));
+                extremal_seeds.extend(r.extremals.iter().filter(|e| e.converged).map(|e| e.t));
             }
+            seeds.append(&mut extremal_seeds);
             if let Some(h) = hull {
                 search = match search.intersect(&h) {
                     Some(b) => b,
@@ -254,19 +353,54 @@ impl Context<'_> {
         let search = search.widened_within(&self.bounds, self.settings.widen);
         record.search_box = Some(search);
         let objective = Objective { fixed: self.fixed, moving: self.moving, state, weights: self.weights };
-        let f = |t: &Config| objective.value(t);
-        let smooth = |t: &Config| objective.smooth_value(t);
-        let ga = GaSettings { seed: mix_seed(self.settings.ga.seed, stable_hash(state)), ..self.settings.ga };
-        seeds.truncate(ga.population / 2);
-        let m = minimise_with_polish(&f, &smooth, &search, &ga, &seeds);
-        record.objective = Some(m.value);
-        record.witness = Some(m.t);
-        record.feasible = m.value <= self.threshold;
-        if record.feasible {
-            record.extremals = extremals(&objective, &search, m.t, self.threshold, &ga);
-            record.range = Some(range_of(&record.extremals, &search));
+        let hypothesis_seed = mix_seed(self.settings.ga.seed, stable_hash(state));
+        // the neighbours' configurations, projected onto this state's manifold, usually verify it without a GA run
+        let mut witness = None;
+        if !seeds.is_empty() {
+            // the witnesses first, then the extremals; a dozen starts are plenty
+            seeds.truncate(12);
+            match self.manifolds.interior_witness(
+                state,
+                &seeds,
+                &self.bounds,
+                hypothesis_seed,
+                self.settings.witness_attempts,
+            ) {
+                Ok(w) => witness = Some(w),
+                Err(e) => record.rejection = Some(e),
+            }
         }
-        tracing::debug!(state = %record.label, value = m.value, feasible = record.feasible, "hypothesis evaluated");
+        if witness.is_none() {
+            let f = |t: &Config| objective.value(t);
+            let smooth = |t: &Config| objective.smooth_value(t);
+            let ga = GaSettings { seed: hypothesis_seed, ..self.settings.ga };
+            seeds.truncate(ga.population / 2);
+            let m = minimise_with_polish(&f, &smooth, &search, &ga, &seeds);
+            record.searched_by_ga = true;
+            record.objective = Some(m.value);
+            record.witness = Some(m.t);
+            if m.value <= self.threshold {
+                match self.manifolds.interior_witness(
+                    state,
+                    &[m.t],
+                    &self.bounds,
+                    mix_seed(hypothesis_seed, 1),
+                    self.settings.witness_attempts * 2,
+                ) {
+                    Ok(w) => witness = Some(w),
+                    Err(e) => record.rejection = Some(e),
+                }
+            }
+        }
+        if let Some(w) = witness {
+            record.feasible = true;
+            record.rejection = None;
+            record.witness = Some(w);
+            record.objective = Some(objective.value(&w));
+            record.extremals = extremals(&self.manifolds, state, &self.bounds, w, self.settings.extremal_budget);
+            record.range = Some(range_of(&record.extremals, &self.bounds));
+        }
+        tracing::debug!(state = %record.label, value = ?record.objective, feasible = record.feasible, "hypothesis evaluated");
         record
     }
 }
@@ -275,12 +409,14 @@ impl Context<'_> {
 pub fn generate(fixed: &ContactPart, moving: &ContactPart, bounds: ConfigBox, settings: AcsgSettings) -> Acsg {
     let weights = Weights::for_parts(moving);
     let threshold = settings.threshold_relative * weights.length;
-    let ctx = Context { fixed, moving, bounds, settings, weights, threshold };
     let (sa, sb) = (&fixed.surface, &moving.surface);
     let mut stats = AcsgStats::default();
     let candidates = all_ppcs(sa, sb);
     stats.ppc_candidates = candidates.len();
     let ppcs: Vec<PrincipalContact> = candidates.into_iter().filter(|pc| reachable(pc, sa, sb, &bounds)).collect();
+    let manifolds = Manifolds::new(fixed, moving, ppcs.clone(), settings.strict);
+    let hold = manifolds.hold();
+    let ctx = Context { fixed, moving, manifolds, bounds, settings, weights, threshold };
     stats.ppc_unreachable = stats.ppc_candidates - ppcs.len();
     tracing::info!(candidates = stats.ppc_candidates, reachable = ppcs.len(), "PPCs");
 
@@ -306,10 +442,15 @@ pub fn generate(fixed: &ContactPart, moving: &ContactPart, bounds: ConfigBox, se
         for r in records {
             if r.pruned.is_some() {
                 stats.pruned += 1;
+            } else if !r.searched_by_ga {
+                stats.from_neighbours += 1;
             } else {
                 stats.searched += 1;
                 stats.evaluations +=
                     settings.ga.population * (settings.ga.generations + 1) + settings.ga.polish_evaluations;
+            }
+            if !r.feasible && r.rejection.is_some() {
+                stats.rejected_candidates += 1;
             }
             if r.feasible {
                 new_feasible.push(r.state.clone());
@@ -360,6 +501,7 @@ pub fn generate(fixed: &ContactPart, moving: &ContactPart, bounds: ConfigBox, se
         settings,
         length: weights.length,
         threshold,
+        hold,
         states,
         relations,
         stats,
@@ -431,5 +573,32 @@ impl Acsg {
     /// Names of the configuration variables, in order.
     pub fn variable_names() -> [&'static str; 6] {
         VARIABLE_NAMES
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::criteria::tests::box_part;
+
+    #[test]
+    fn distance_ranges_prune_pcs_that_cannot_hold_together() {
+        // a unit cube (diameter sqrt 3) cannot touch the top and the bottom face of a 10 mm slab at once
+        let slab = box_part("slab", DVec3::new(-50.0, -50.0, -10.0), DVec3::new(50.0, 50.0, 0.0));
+        let cube = box_part("cube", DVec3::splat(-0.5), DVec3::splat(0.5));
+        let (sa, sb) = (&slab.surface, &cube.surface);
+        let face = |n: DVec3| sa.faces.iter().position(|f| (f.plane.normal - n).length() < 1e-12).expect("face");
+        let (top, bottom) = (face(DVec3::Z), face(-DVec3::Z));
+        let pc = |f: usize, v: usize| PrincipalContact::new(Element::face(f), Element::vertex(v)).expect("pc");
+        let apart = ContactState { pcs: vec![pc(top, 0), pc(bottom, 7)] };
+        assert!(incompatible_pair(&apart, sa, sb, 1e-9).is_some());
+        // two vertices on the top face: compatible
+        let together = ContactState { pcs: vec![pc(top, 0), pc(top, 7)] };
+        assert!(incompatible_pair(&together, sa, sb, 1e-9).is_none());
+        // exact ranges: top and bottom faces are 10 apart at least, the cube's extreme vertices sqrt 3
+        let (lo, hi) = element_distance_range(sa, Element::face(top), Element::face(bottom));
+        assert!((lo - 10.0).abs() < 1e-12 && hi > 141.0, "{lo} {hi}");
+        let (lo, hi) = element_distance_range(sb, Element::vertex(0), Element::vertex(7));
+        assert!(lo == hi && lo > 1.0, "{lo} {hi}");
     }
 }

@@ -28,7 +28,7 @@
 //! Cost per evaluation: O(size of the PC's elements) per PC plus one growth distance per piece pair whose bounding
 //! boxes overlap.
 
-use crate::growth_distance::{ConvexPiece, growth_distance};
+use crate::growth_distance::{ConvexPiece, growth_distance_capped};
 use crate::pose::{Config, Pose};
 use crate::principal_contact::{ContactState, PcType, PrincipalContact};
 use crate::surface::{SurfaceElements, SurfaceError, SurfaceFace};
@@ -165,7 +165,8 @@ pub fn polygon_polygon_distance(p: &[DVec2], q: &[DVec2]) -> f64 {
     best
 }
 
-fn face_point_distance(face: &SurfaceFace, p: DVec2) -> f64 {
+/// In-plane distance from `p` (face-frame coordinates) to the face's region (0 inside).
+pub fn face_point_distance_2d(face: &SurfaceFace, p: DVec2) -> f64 {
     face.pieces.iter().map(|poly| point_polygon_distance(p, poly)).fold(f64::INFINITY, f64::min)
 }
 
@@ -175,7 +176,7 @@ fn face_segment_distance(face: &SurfaceFace, a: DVec2, b: DVec2) -> f64 {
 
 /// `(h1, h2)` of a face against a point given in the face's part coordinates.
 pub fn face_vertex_terms(face: &SurfaceFace, p: DVec3) -> (f64, f64) {
-    (face.frame.height(p).abs(), face_point_distance(face, face.frame.to_2d(p)))
+    (face.frame.height(p).abs(), face_point_distance_2d(face, face.frame.to_2d(p)))
 }
 
 /// `(h1, h2)` of a face against a segment given in the face's part coordinates.
@@ -276,7 +277,8 @@ pub fn penetration(a: &ContactPart, b: &ContactPart, pose: &Pose) -> f64 {
             if alo.cmpgt(bhi).any() || blo.cmpgt(ahi).any() {
                 continue;
             }
-            total += (1.0 - growth_distance(pa, m)).max(0.0);
+            // capped at 1: only penetrating pairs need the exact value
+            total += (1.0 - growth_distance_capped(pa, pa.seed, m, m.seed, 1.0)).max(0.0);
         }
     }
     total

@@ -1,30 +1,22 @@
 //! Extremal configurations of a feasible contact state ([P] III, Definition 1, eq. 9-12).
 //!
-//! For each configuration variable `t_k` the lower extremal minimises `f1 = t_k + lambda (sum h + W3 d_G)` and the
-//! upper one `f2 = -t_k + lambda (...)` over the state's search box (eq. 11-12). We scale the variable by the box
-//! width and the criteria by the characteristic length `L`, `f1 = (t_k - min_k) / width_k + lambda f / L` with
-//! `lambda = 1e4`: the criteria are sums of absolute values, so the penalty is exact (for `lambda` above the
-//! constraint multipliers the penalised minimiser satisfies `f = 0`), and `lambda = 1e4` exceeds them for every
-//! configuration whose criteria change by at least `1e-4 L` per box width. The 12 searches use the GA with half the
-//! feasibility population and generations, seeded with the feasibility witness, then the polish, which works on the
-//! quadratic penalty `±(t_k - min_k)/width_k + 1e9 (sum of squared terms) / L^2` (smooth, so Nelder-Mead can follow
-//! the curved manifold of the state; the exact penalty makes coordinate moves stall). A result whose
-//! `f` exceeds the feasibility threshold is replaced by the best configuration already known to be in the state (the
-//! witness or another accepted extremal), and flagged `converged = false`.
-//! Cost: 12 GA runs per feasible state, run in parallel (each deterministic).
+//! For each configuration variable `t_k` the lower extremal solves eq. 9, `min t_k` subject to the state's criteria
+//! (eq. 4), non-penetration (eq. 5) and the box (eq. 7), and the upper one eq. 10 (`min -t_k`). [P] solves the
+//! penalised forms eq. 11-12 with a GA; the penalty leaves a slack (the minimiser of `t_k + lambda f` sits where the
+//! decrease of `t_k` balances the growth of `lambda f`), and a GA/compass search on a thin manifold stops short of
+//! the true extreme (the earlier version of this module did: the face-down cube test could only assert that a vertex
+//! contact lifts the centre, not the analytic maximum). Here every extremal is searched *on* the state's manifold
+//! ([`crate::manifold::Manifolds::extremal`]): a compass search whose moves change one variable and restore the
+//! equalities by projection, accepting only points that satisfy eq. 8 to the strict tolerance. The 12 searches run
+//! one after the other from the best configuration known so far for each objective (the witness, or an extremal
+//! already found), which gives the later searches several starting points.
+//! Cost: at most `budget` projections per extremal (each a few residual evaluations and one eq. 8 evaluation).
 
 use crate::criteria::Objective;
-use crate::ga::{GaSettings, minimise_with_polish, mix_seed};
+use crate::manifold::Manifolds;
 use crate::pose::{Config, ConfigBox, VARIABLE_NAMES};
-use rayon::prelude::*;
+use crate::principal_contact::ContactState;
 use serde::{Deserialize, Serialize};
-
-/// Penalty factor `lambda` of eq. 11-12 (on the normalised objective).
-pub const PENALTY: f64 = 1e4;
-
-/// Quadratic penalty factor of the polish (on `sum of squares / L^2`); its minimiser violates the criteria by about
-/// `1 / (2 SMOOTH_PENALTY)` relative, far below the feasibility threshold.
-pub const SMOOTH_PENALTY: f64 = 1e9;
 
 /// One extremal configuration.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -39,79 +31,46 @@ pub struct Extremal {
     pub value: f64,
     /// The configuration.
     pub t: Config,
-    /// `f(t)` of eq. 8 there (below the feasibility threshold).
+    /// `f(t)` of eq. 8 there (below the strict tolerance when `converged`).
     pub objective: f64,
-    /// Whether the optimiser's own result was accepted (otherwise a known configuration of the state stands in).
+    /// Whether the configuration lies in the closure of the state (eq. 8 below the strict tolerance).
     pub converged: bool,
 }
 
-/// The 12 extremals of a state known to be feasible at `witness` (objective `witness_value`), searched in `bounds`.
+/// The 12 extremals of `state`, in the closure of which `witness` lies, searched in `bounds` with at most `budget`
+/// projections each.
 pub fn extremals(
-    objective: &Objective<'_>,
+    manifolds: &Manifolds<'_>,
+    state: &ContactState,
     bounds: &ConfigBox,
     witness: Config,
-    threshold: f64,
-    settings: &GaSettings,
+    budget: usize,
 ) -> Vec<Extremal> {
-    let length = objective.weights.length;
-    let ga = GaSettings {
-        population: (settings.population / 2).max(8),
-        generations: (settings.generations / 2).max(2),
-        polish_evaluations: (settings.polish_evaluations / 2).max(100),
-        seed: settings.seed,
-    };
-    let jobs: Vec<(usize, bool)> = (0..6).flat_map(|k| [(k, false), (k, true)]).collect();
-    let found: Vec<(usize, bool, Config, f64, bool)> = jobs
-        .par_iter()
-        .map(|&(k, upper)| {
-            let width = bounds.width(k);
-            if width <= 0.0 {
-                return (k, upper, witness, objective.value(&witness), true);
-            }
-            let sign = if upper { -1.0 } else { 1.0 };
-            let g = |t: &Config| sign * (t[k] - bounds.min[k]) / width + PENALTY * objective.value(t) / length;
-            // the polish follows the state's manifold better on a smooth (quadratic) penalty
-            let smooth = |t: &Config| {
-                sign * (t[k] - bounds.min[k]) / width + SMOOTH_PENALTY * objective.smooth_value(t) / (length * length)
-            };
-            let mut edge = witness;
-            edge[k] = if upper { bounds.max[k] } else { bounds.min[k] };
-            let s = GaSettings { seed: mix_seed(settings.seed, 1000 + 2 * k as u64 + upper as u64), ..ga };
-            let m = minimise_with_polish(&g, &smooth, bounds, &s, &[witness, edge]);
-            let f = objective.value(&m.t);
-            (k, upper, m.t, f, f <= threshold)
-        })
-        .collect();
-    // fall back to the best known configuration of the state for searches that did not converge
+    let objective = Objective { fixed: manifolds.fixed, moving: manifolds.moving, state, weights: manifolds.weights };
     let mut known: Vec<Config> = vec![witness];
-    known.extend(found.iter().filter(|x| x.4).map(|x| x.2));
-    found
-        .into_iter()
-        .map(|(k, upper, t, f, ok)| {
-            let (t, f) = if ok {
-                (t, f)
+    let mut out = Vec::with_capacity(12);
+    for k in 0..6 {
+        for upper in [false, true] {
+            let better = |a: &Config, b: &Config| if upper { a[k] > b[k] } else { a[k] < b[k] };
+            let start = known.iter().copied().fold(witness, |best, t| if better(&t, &best) { t } else { best });
+            let (t, _) = if bounds.width(k) > 0.0 {
+                manifolds.extremal(state, start, k, upper, bounds, budget)
             } else {
-                let pick = known
-                    .iter()
-                    .copied()
-                    .max_by(|a, b| {
-                        let (x, y) = if upper { (a[k], b[k]) } else { (-a[k], -b[k]) };
-                        x.total_cmp(&y)
-                    })
-                    .unwrap_or(witness);
-                (pick, objective.value(&pick))
+                (start, 0)
             };
-            Extremal {
+            known.push(t);
+            out.push(Extremal {
                 variable: k,
                 name: VARIABLE_NAMES[k].to_string(),
                 upper,
                 value: t[k],
                 t,
-                objective: f,
-                converged: ok,
-            }
-        })
-        .collect()
+                objective: objective.value(&t),
+                converged: manifolds.in_closure(state, &t, bounds),
+            });
+        }
+    }
+    out
 }
 
 /// The range box spanned by a state's extremals; a bound whose search did not converge stays at `fallback`'s (the

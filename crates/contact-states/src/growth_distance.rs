@@ -95,12 +95,19 @@ pub fn growth_distance(a: &ConvexPiece, b: &ConvexPiece) -> f64 {
 
 /// [`growth_distance`] with explicit interior seed points `p` of A and `q` of B.
 pub fn growth_distance_with_seeds(a: &ConvexPiece, p: DVec3, b: &ConvexPiece, q: DVec3) -> f64 {
+    growth_distance_capped(a, p, b, q, f64::INFINITY)
+}
+
+/// `min(sigma, cap)`-exact growth distance: returns as soon as one facet direction proves `sigma >= cap` (the value
+/// returned is then some number `>= cap`). With `cap = 1` it decides penetration (`sigma < 1`) and gives the exact
+/// `sigma` of penetrating pairs, while separated and touching pairs usually stop at the first face normal.
+pub fn growth_distance_capped(a: &ConvexPiece, p: DVec3, b: &ConvexPiece, q: DVec3, cap: f64) -> f64 {
     let d = p - q;
     if d == DVec3::ZERO {
         return 0.0;
     }
     let mut best: f64 = 0.0;
-    let mut consider = |n: DVec3| {
+    let mut consider = |n: DVec3| -> bool {
         let nd = n.dot(d);
         if nd > 0.0 {
             let h = b.support(n) + a.support(-n) + nd;
@@ -108,19 +115,26 @@ pub fn growth_distance_with_seeds(a: &ConvexPiece, p: DVec3, b: &ConvexPiece, q:
                 best = best.max(nd / h);
             }
         }
+        best >= cap
     };
     for n in &b.normals {
-        consider(*n);
+        if consider(*n) {
+            return best;
+        }
     }
     for n in &a.normals {
-        consider(-*n);
+        if consider(-*n) {
+            return best;
+        }
     }
     for ea in &a.edge_directions {
         for eb in &b.edge_directions {
             let n = ea.cross(*eb);
             if n.length_squared() > 1e-24 {
                 let n = if n.dot(d) >= 0.0 { n } else { -n };
-                consider(n);
+                if consider(n) {
+                    return best;
+                }
             }
         }
     }

@@ -11,6 +11,8 @@
 //! * [`criteria`]: feature criteria, the growth-distance penetration term and the objective of [P] eq. 8;
 //! * [`growth_distance`]: Ong & Gilbert's growth distance of convex pieces;
 //! * [`ga`]: the seeded real-coded GA with a local polish; [`extremal`]: extremal configurations ([P] eq. 11-12);
+//! * [`manifold`]: projection onto a state's contact manifold, the strict check of a state at a configuration,
+//!   extremals by a compass search on the manifold;
 //! * [`acsg`]: the bottom-up ACSG with CLCN/CMCN relations and search-range refinement, JSON and DOT output.
 //!
 //! Part A is the fixed part, part B the moving one; PC labels name A's element first (`f2-v3`).
@@ -21,6 +23,7 @@ pub mod dxf_input;
 pub mod extremal;
 pub mod ga;
 pub mod growth_distance;
+pub mod manifold;
 pub mod pose;
 pub mod principal_contact;
 pub mod surface;

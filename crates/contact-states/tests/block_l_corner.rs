@@ -23,11 +23,17 @@ use stackplan_contact_states::surface::Element;
 use stackplan_geom::{DMat3, DVec3, Part, PartOrigin};
 use std::collections::HashSet;
 
-fn parts() -> (ContactPart, ContactPart) {
+mod common;
+
+fn geom_parts() -> (Part, Part) {
     let l = stackplan_geom::examples::l_corner_part();
     let shifted: Vec<_> = l.components.iter().map(|c| c.transformed(DMat3::IDENTITY, DVec3::splat(-20.0))).collect();
     let l = Part::from_components("l-corner", shifted, 1.0, PartOrigin::ConvexPieces).expect("part");
-    let block = stackplan_geom::examples::block_part();
+    (l, stackplan_geom::examples::block_part())
+}
+
+fn parts() -> (ContactPart, ContactPart) {
+    let (l, block) = geom_parts();
     (ContactPart::from_part(&l).expect("l-corner surface"), ContactPart::from_part(&block).expect("block surface"))
 }
 
@@ -64,10 +70,23 @@ fn block_into_l_corner() {
     // independent sampling check
     let observed = sample_states(&fixed, &moving, &bounds, 150, 77);
     let feasible: Vec<&ContactState> = g.feasible().map(|s| &s.state).collect();
+    // every reported state verified independently at its witness (parry3d-f64 distances, c-space interference)
+    let (l_part, block_part) = geom_parts();
+    let tol = 1e-6 * g.length;
+    let mut failures = Vec::new();
     for s in g.feasible() {
-        assert!(bounds.contains(&s.witness.expect("witness")));
+        let w = s.witness.expect("witness");
+        assert!(bounds.contains(&w));
         assert!(s.objective.unwrap_or(f64::INFINITY) <= g.threshold);
+        if let Err(e) = common::independent_check(&fixed, &l_part, &moving, &block_part, &s.state, &w, tol) {
+            failures.push(format!("{}: {e}", s.label));
+        }
+        // and its extremals lie in the closure of the state (eq. 8 within the strict tolerance)
+        for e in &s.extremals {
+            assert!(e.converged && e.objective <= 2.0 * g.hold * s.state.pcs.len() as f64, "{} {e:?}", s.label);
+        }
     }
+    assert!(failures.is_empty(), "{} of {total} states fail the independent check: {failures:?}", failures.len());
     let in_graph: HashSet<&ContactState> = feasible.iter().copied().collect();
     let missing: Vec<String> = observed.iter().filter(|s| !in_graph.contains(s)).map(|s| s.label()).collect();
     assert!(!observed.is_empty());

@@ -4,7 +4,7 @@
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus};
 use proptest::prelude::*;
-use stackplan_contact_states::growth_distance::{ConvexPiece, growth_distance};
+use stackplan_contact_states::growth_distance::{ConvexPiece, growth_distance, growth_distance_capped};
 use stackplan_contact_states::pose::Pose;
 use stackplan_geom::{ConvexPolytope, DVec3, convex_hull};
 
@@ -205,6 +205,34 @@ proptest! {
         if sigma < 1.0 - 1e-9 { prop_assert!(overlapping, "sigma {} but separated", sigma); }
         if separated { prop_assert!(sigma > 1.0); }
         if overlapping { prop_assert!(sigma < 1.0 + 1e-12); }
+    }
+
+    /// Sign agreement with the c-space crate's interference test (`classify_pair`, separating axes with its own
+    /// tolerance): penetrating iff `sigma < 1`, separated iff `sigma > 1`, away from the tolerance band.
+    #[test]
+    fn sign_agrees_with_cspace_interference(a in random_polytope(), b in random_polytope(), pa in pose(), pb in pose()) {
+        use stackplan_cspace::interference::{PairContact, PlacedConvex, classify_pair};
+        let ga = ConvexPiece::from_polytope(&a).transformed(&pa);
+        let gb = ConvexPiece::from_polytope(&b).transformed(&pb);
+        let sigma = growth_distance(&ga, &gb);
+        let ca = PlacedConvex::new(&a, pa.rotation, pa.translation);
+        let cb = PlacedConvex::new(&b, pb.rotation, pb.translation);
+        let tol = 1e-9;
+        match classify_pair(&ca, &cb, tol, 0.0) {
+            PairContact::Penetrating { depth } => prop_assert!(sigma < 1.0, "c-space: penetrating by {}, sigma {}", depth, sigma),
+            PairContact::Separated { gap } => prop_assert!(sigma > 1.0, "c-space: separated by {}, sigma {}", gap, sigma),
+            PairContact::Touching { .. } => prop_assert!((sigma - 1.0).abs() < 1e-6, "c-space: touching, sigma {}", sigma),
+        }
+    }
+
+    /// The capped growth distance used by the penetration term: exact below the cap, at least the cap otherwise.
+    #[test]
+    fn capped_growth_distance(a in random_polytope(), b in random_polytope(), pa in pose(), pb in pose()) {
+        let ga = ConvexPiece::from_polytope(&a).transformed(&pa);
+        let gb = ConvexPiece::from_polytope(&b).transformed(&pb);
+        let sigma = growth_distance(&ga, &gb);
+        let capped = growth_distance_capped(&ga, ga.seed, &gb, gb.seed, 1.0);
+        if sigma < 1.0 { prop_assert_eq!(capped, sigma); } else { prop_assert!(capped >= 1.0, "{} {}", capped, sigma); }
     }
 }
 

@@ -1,0 +1,852 @@
+//! Exact contact manifolds: projection of a configuration onto the set where a state's PCs hold, strict
+//! verification of a state at a configuration, and extremal configurations by a compass search on the manifold
+//! ([P] II-A, III; the projection and the strict check are ours, see the crate README "Exact feasibility").
+//!
+//! **Equalities.** Each PC holds on a smooth manifold given by signed lengths (the *intersection conditions* of
+//! [P] eq. 1 with signs): f-v / v-f the height of the vertex over the face plane (1 equation); e-e the signed
+//! distance between the carrier lines, `(b0 - a0).(da x db) / |da x db|` (1); f-e / e-f the heights of both end
+//! points (2); f-f the heights of all vertices of the moving face over the fixed face's plane (rank 3). The bounding
+//! conditions and non-penetration are inequalities, checked after the projection.
+//!
+//! **Projection** (Levenberg-Marquardt, K. Levenberg 1944, D. Marquardt 1963): minimise `|r(t)|^2` from `t0` in the
+//! scaled variables `u = (x, y, z, L rx, L ry, L rz)` with a central-difference Jacobian `J` (6 columns) and steps
+//! `(J^T J + mu I) du = -J^T r`, kept inside the box (variables at a bound whose step points outwards are frozen).
+//! With small `mu` the step is the minimum-norm Gauss-Newton step, so the result is close to the nearest point of
+//! the manifold; convergence is quadratic near a regular point. Converged when `max |r| <= 1e-11 L`.
+//! Cost: about 13 residual evaluations (O(size of the state's elements)) per iteration, 3-6 iterations.
+//!
+//! **Strict verification** at `t`: inside the box; every PC's full criterion (with the bounding conditions,
+//! [`crate::criteria`]) at most `hold`; the penetration term `L d_G` at most `hold`; and the PPCs in contact are
+//! exactly the state: with Euclidean distances between the elements (point to planar face
+//! `sqrt(height^2 + in-plane distance^2)`, segment to segment in 3-D), the PPCs at distance `<= hold` map to the state
+//! by [`ContactState::canonical`], and no PPC lies in the ambiguous band `(hold, clear]`. `hold = 1e-7 L`,
+//! `clear = 1e-5 L` by default. Cost O(number of reachable PPCs) distance evaluations.
+//!
+//! **Interior witness.** A GA witness of eq. 8 can sit where further contacts also hold (closure semantics). The
+//! witness is projected; if the strict check fails, seeded random perturbations of growing size
+//! (`1e-4 .. 0.1` of the box widths) are projected and checked until one passes.
+//!
+//! **Extremals** ([P] eq. 9-10 solved on the manifold): from a configuration of the state, a compass search on
+//! `±t_k` whose trial moves change one variable `t_j` by a step and let the other variables restore the closure of
+//! the state (projection with `t_j` frozen onto the equalities, the bounding terms and non-penetration, so a move
+//! blocked by a face boundary or another contact is restored by the other variables, e.g. a turn that lets a face
+//! slide further over an edge); a trial is accepted when it improves `±t_k`, stays in the box and satisfies eq. 8
+//! to `hold` (closure: other contacts may hold at an extremal). Steps double after a success and halve after a
+//! failed sweep, down to `1e-7` of the box width. Unlike the penalty formulation of eq. 11-12, every accepted point
+//! lies on the manifold, so the search does not stop short by the penalty's slack; it is local (a compass search
+//! stops at a point where no single-variable move with restoration improves, e.g. a corner of a curved boundary).
+
+use crate::criteria::{ContactPart, Objective, Weights, face_point_distance_2d, pc_criterion, pc_terms, penetration};
+use crate::ga::SplitMix64;
+use crate::pose::{Config, ConfigBox, Pose};
+use crate::principal_contact::{ContactState, PcType, PrincipalContact};
+use serde::{Deserialize, Serialize};
+use stackplan_geom::DVec3;
+
+/// Relative tolerances of the strict check (multiples of the characteristic length `L`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct StrictTolerances {
+    /// A PPC holds when its elements are at most `hold * L` apart; criteria and penetration must be below it.
+    pub hold: f64,
+    /// PPCs not in the state must be more than `clear * L` apart (no ambiguous near-contacts).
+    pub clear: f64,
+}
+
+impl Default for StrictTolerances {
+    fn default() -> Self {
+        Self { hold: 1e-7, clear: 1e-5 }
+    }
+}
+
+/// Why a configuration does not verify a state.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum Rejection {
+    /// The projection onto the state's manifold did not converge.
+    NoProjection,
+    /// Outside the box.
+    OutsideBox,
+    /// A PC of the state does not hold (its criterion, mm).
+    NotInContact {
+        /// The PC.
+        pc: String,
+        /// Its criterion value (mm).
+        value: f64,
+    },
+    /// The parts penetrate (`L d_G`, mm).
+    Penetrating {
+        /// `L d_G` (mm).
+        value: f64,
+    },
+    /// A PPC is nearly but not clearly in contact.
+    Ambiguous {
+        /// The PPC.
+        pc: String,
+        /// Distance between its elements (mm).
+        distance: f64,
+    },
+    /// The contacts that hold make another state.
+    OtherState {
+        /// The state actually in contact.
+        holding: String,
+    },
+}
+
+/// Context of the exact computations for one pair of parts.
+#[derive(Debug, Clone)]
+pub struct Manifolds<'a> {
+    /// Fixed part A.
+    pub fixed: &'a ContactPart,
+    /// Moving part B.
+    pub moving: &'a ContactPart,
+    /// PPCs that can hold within the box (the others never do).
+    pub ppcs: Vec<PrincipalContact>,
+    /// Weights (`L`).
+    pub weights: Weights,
+    /// Tolerances.
+    pub tolerances: StrictTolerances,
+}
+
+const SCALE_ANGLES: [bool; 6] = [false, false, false, true, true, true];
+
+fn scale(k: usize, length: f64) -> f64 {
+    if SCALE_ANGLES[k] { length } else { 1.0 }
+}
+
+/// Solves the symmetric positive definite 6x6 system `a x = b` (Cholesky); `None` if not positive definite.
+fn solve_spd6(a: &[[f64; 6]; 6], b: &[f64; 6]) -> Option<[f64; 6]> {
+    let mut l = [[0.0; 6]; 6];
+    for i in 0..6 {
+        for j in 0..=i {
+            let mut s = a[i][j];
+            for k in 0..j {
+                s -= l[i][k] * l[j][k];
+            }
+            if i == j {
+                if s <= 0.0 || !s.is_finite() {
+                    return None;
+                }
+                l[i][i] = s.sqrt();
+            } else {
+                l[i][j] = s / l[j][j];
+            }
+        }
+    }
+    let mut y = [0.0; 6];
+    for i in 0..6 {
+        let mut s = b[i];
+        for k in 0..i {
+            s -= l[i][k] * y[k];
+        }
+        y[i] = s / l[i][i];
+    }
+    let mut x = [0.0; 6];
+    for i in (0..6).rev() {
+        let mut s = y[i];
+        for k in i + 1..6 {
+            s -= l[k][i] * x[k];
+        }
+        x[i] = s / l[i][i];
+    }
+    Some(x)
+}
+
+/// The variables that the equalities pin locally: a change of `t_j` alone cannot be compensated by the other
+/// variables to first order (the column `J_j` is not in the span of the other columns: least-squares residual above
+/// `1e-6 |J_j|`). A compass move of a pinned variable cannot stay on the manifold, so it is not tried.
+fn pinned_variables(jac: &[[f64; 6]]) -> [bool; 6] {
+    let mut out = [false; 6];
+    if jac.is_empty() {
+        return out;
+    }
+    for j in 0..6 {
+        let norm_j: f64 = jac.iter().map(|row| row[j] * row[j]).sum::<f64>().sqrt();
+        if norm_j <= 1e-12 {
+            continue;
+        }
+        // normal equations of min |J_-j x + J_j| (j's own row and column replaced by the identity)
+        let mut a = [[0.0; 6]; 6];
+        let mut b = [0.0; 6];
+        for row in jac {
+            for p in 0..6 {
+                if p == j {
+                    continue;
+                }
+                b[p] -= row[p] * row[j];
+                for q in 0..6 {
+                    if q != j {
+                        a[p][q] += row[p] * row[q];
+                    }
+                }
+            }
+        }
+        let diag_max = (0..6).map(|p| a[p][p]).fold(0.0, f64::max).max(1e-300);
+        for p in 0..6 {
+            a[p][p] += if p == j { 1.0 } else { 1e-12 * diag_max };
+        }
+        let Some(x) = solve_spd6(&a, &b) else { continue };
+        let residual: f64 = jac
+            .iter()
+            .map(|row| {
+                let v: f64 = (0..6).filter(|&p| p != j).map(|p| row[p] * x[p]).sum::<f64>() + row[j];
+                v * v
+            })
+            .sum::<f64>()
+            .sqrt();
+        out[j] = residual > 1e-6 * norm_j;
+    }
+    out
+}
+
+/// Closest distance between segments `p0 p1` and `q0 q1` in 3-D (C. Ericson, Real-Time Collision Detection 5.1.9).
+pub fn segment_segment_distance(p0: DVec3, p1: DVec3, q0: DVec3, q1: DVec3) -> f64 {
+    let d1 = p1 - p0;
+    let d2 = q1 - q0;
+    let r = p0 - q0;
+    let a = d1.dot(d1);
+    let e = d2.dot(d2);
+    let f = d2.dot(r);
+    let (s, t);
+    if a <= f64::MIN_POSITIVE && e <= f64::MIN_POSITIVE {
+        return r.length();
+    }
+    if a <= f64::MIN_POSITIVE {
+        s = 0.0;
+        t = (f / e).clamp(0.0, 1.0);
+    } else {
+        let c = d1.dot(r);
+        if e <= f64::MIN_POSITIVE {
+            t = 0.0;
+            s = (-c / a).clamp(0.0, 1.0);
+        } else {
+            let b = d1.dot(d2);
+            let denom = a * e - b * b;
+            let mut s0 = if denom > 1e-14 * a * e { ((b * f - c * e) / denom).clamp(0.0, 1.0) } else { 0.0 };
+            let mut t0 = (b * s0 + f) / e;
+            if t0 < 0.0 {
+                t0 = 0.0;
+                s0 = (-c / a).clamp(0.0, 1.0);
+            } else if t0 > 1.0 {
+                t0 = 1.0;
+                s0 = ((b - c) / a).clamp(0.0, 1.0);
+            }
+            s = s0;
+            t = t0;
+        }
+    }
+    ((p0 + d1 * s) - (q0 + d2 * t)).length()
+}
+
+/// The configuration `(x, y, z, rx + pi, pi - ry, rz + pi)` (the same pose: `Rz(c + pi) Ry(pi - b) Rx(a + pi) =
+/// Rz(c) Ry(b) Rx(a)`), with `rx`, `rz` wrapped by `2 pi` into the box, if it lies in the box.
+pub fn other_chart(t: &Config, bounds: &ConfigBox) -> Option<Config> {
+    use std::f64::consts::{PI, TAU};
+    let mut alt = *t;
+    alt[3] += PI;
+    alt[4] = PI - alt[4];
+    alt[5] += PI;
+    for k in [3, 5] {
+        while alt[k] > bounds.max[k] {
+            alt[k] -= TAU;
+        }
+        while alt[k] < bounds.min[k] {
+            alt[k] += TAU;
+        }
+    }
+    if alt[4] > PI {
+        alt[4] -= TAU;
+    }
+    bounds.contains(&alt).then_some(alt)
+}
+
+impl<'a> Manifolds<'a> {
+    /// The context for `fixed` against `moving` with the PPCs reachable in the box.
+    pub fn new(
+        fixed: &'a ContactPart,
+        moving: &'a ContactPart,
+        ppcs: Vec<PrincipalContact>,
+        tolerances: StrictTolerances,
+    ) -> Self {
+        Self { fixed, moving, ppcs, weights: Weights::for_parts(moving), tolerances }
+    }
+
+    /// `hold * L` (mm).
+    pub fn hold(&self) -> f64 {
+        self.tolerances.hold * self.weights.length
+    }
+
+    /// `clear * L` (mm).
+    pub fn clear(&self) -> f64 {
+        self.tolerances.clear * self.weights.length
+    }
+
+    /// The signed equality residuals (mm) of the state's PCs at `pose` (see the module documentation).
+    pub fn residuals(&self, state: &ContactState, pose: &Pose, out: &mut Vec<f64>) {
+        out.clear();
+        let (sa, sb) = (&self.fixed.surface, &self.moving.surface);
+        for pc in &state.pcs {
+            match pc.kind() {
+                PcType::FaceVertex => {
+                    out.push(sa.faces[pc.a.index].frame.height(pose.apply(sb.vertices[pc.b.index].position)))
+                }
+                PcType::VertexFace => {
+                    out.push(sb.faces[pc.b.index].frame.height(pose.inverse_apply(sa.vertices[pc.a.index].position)))
+                }
+                PcType::EdgeEdge => {
+                    let (a0, a1) = sa.edge_points(pc.a.index);
+                    let (b0, b1) = sb.edge_points(pc.b.index);
+                    let (b0, b1) = (pose.apply(b0), pose.apply(b1));
+                    let (da, db) = (a1 - a0, b1 - b0);
+                    let c = da.cross(db);
+                    let n = c.length();
+                    if n > 1e-9 * da.length() * db.length() {
+                        out.push((b0 - a0).dot(c) / n);
+                    } else {
+                        let u = da.normalize();
+                        let w = b0 - a0;
+                        out.push((w - u * w.dot(u)).length());
+                    }
+                }
+                PcType::FaceEdge => {
+                    let frame = &sa.faces[pc.a.index].frame;
+                    let (b0, b1) = sb.edge_points(pc.b.index);
+                    out.push(frame.height(pose.apply(b0)));
+                    out.push(frame.height(pose.apply(b1)));
+                }
+                PcType::EdgeFace => {
+                    let frame = &sb.faces[pc.b.index].frame;
+                    let (a0, a1) = sa.edge_points(pc.a.index);
+                    out.push(frame.height(pose.inverse_apply(a0)));
+                    out.push(frame.height(pose.inverse_apply(a1)));
+                }
+                PcType::FaceFace => {
+                    let frame = &sa.faces[pc.a.index].frame;
+                    for &v in &sb.faces[pc.b.index].vertices {
+                        out.push(frame.height(pose.apply(sb.vertices[v].position)));
+                    }
+                }
+            }
+        }
+    }
+
+    fn residuals_at(&self, state: &ContactState, t: &Config, out: &mut Vec<f64>) {
+        self.residuals(state, &Pose::from_config(t), out);
+    }
+
+    /// Projects `t0` onto the state's manifold inside `bounds`, keeping the variables in `frozen` fixed
+    /// (Levenberg-Marquardt, see the module documentation); `None` when it does not converge.
+    pub fn project(&self, state: &ContactState, t0: &Config, bounds: &ConfigBox, frozen: &[bool; 6]) -> Option<Config> {
+        let target = 1e-11 * self.weights.length;
+        let (t, r) =
+            self.least_squares(|t, out| self.residuals_at(state, t, out), t0, bounds, frozen, target, 40, None);
+        r.iter().all(|x| x.abs() <= target).then_some(t)
+    }
+
+    /// Levenberg-Marquardt on `residuals` from `t0` in the box (see the module documentation); stops when every
+    /// residual is at most `target` or no step improves. Returns the point and its residuals.
+    fn least_squares<R>(
+        &self,
+        residuals_at: R,
+        t0: &Config,
+        bounds: &ConfigBox,
+        frozen: &[bool; 6],
+        target: f64,
+        iterations: usize,
+        jacobian: Option<&[[f64; 6]]>,
+    ) -> (Config, Vec<f64>)
+    where
+        R: Fn(&Config, &mut Vec<f64>),
+    {
+        let length = self.weights.length;
+        let mut t = *t0;
+        bounds.clamp(&mut t);
+        let mut r = Vec::new();
+        let mut trial_r = Vec::new();
+        residuals_at(&t, &mut r);
+        let norm2 = |r: &[f64]| r.iter().map(|x| x * x).sum::<f64>();
+        let mut cost = norm2(&r);
+        let mut mu = 1e-9;
+        let mut plus = Vec::new();
+        let mut minus = Vec::new();
+        // a Jacobian from a nearby point (the caller's) is used as if stale: a failed step recomputes it
+        let mut jac: Vec<[f64; 6]> = jacobian.map(<[[f64; 6]]>::to_vec).unwrap_or_default();
+        let mut fresh = jacobian.is_some_and(|j| j.len() == r.len());
+        let mut since_update = usize::from(fresh);
+        let mut history: Vec<f64> = Vec::with_capacity(iterations);
+        for iteration in 0..iterations {
+            if r.iter().all(|x| x.abs() <= target) {
+                return (t, r);
+            }
+            // near a regular solution the convergence is quadratic: give up on slow progress (an inconsistent
+            // system, the usual case for an infeasible combination of PCs)
+            history.push(cost);
+            if iteration >= 8 && cost > 0.25 * history[iteration - 4] {
+                break;
+            }
+            // Jacobian in the scaled variables by central differences, reused (chord steps) while steps succeed
+            let m = r.len();
+            if !fresh || since_update >= 4 || jac.len() != m {
+                jac = vec![[0.0; 6]; m];
+                for k in 0..6 {
+                    if frozen[k] {
+                        continue;
+                    }
+                    // step of 1e-7 L in the scaled variable
+                    let h = 1e-7 * length / scale(k, length);
+                    let (mut tp, mut tm) = (t, t);
+                    tp[k] += h;
+                    tm[k] -= h;
+                    residuals_at(&tp, &mut plus);
+                    residuals_at(&tm, &mut minus);
+                    for i in 0..m {
+                        jac[i][k] = (plus[i] - minus[i]) / (2.0 * h) / scale(k, length);
+                    }
+                }
+                fresh = true;
+                since_update = 0;
+            }
+            let mut active = [true; 6];
+            for k in 0..6 {
+                active[k] = !frozen[k];
+            }
+            let mut accepted = false;
+            for _ in 0..6 {
+                // normal equations on the active variables
+                let mut a = [[0.0; 6]; 6];
+                let mut g = [0.0; 6];
+                for i in 0..m {
+                    for p in 0..6 {
+                        if !active[p] {
+                            continue;
+                        }
+                        g[p] -= jac[i][p] * r[i];
+                        for q in 0..6 {
+                            if active[q] {
+                                a[p][q] += jac[i][p] * jac[i][q];
+                            }
+                        }
+                    }
+                }
+                let diag_max = (0..6).map(|p| a[p][p]).fold(0.0, f64::max).max(1e-300);
+                for p in 0..6 {
+                    if active[p] {
+                        a[p][p] += mu * diag_max;
+                    } else {
+                        a[p][p] = 1.0;
+                        g[p] = 0.0;
+                    }
+                }
+                let Some(du) = solve_spd6(&a, &g) else {
+                    mu *= 10.0;
+                    continue;
+                };
+                let mut trial = t;
+                let mut froze_one = false;
+                for k in 0..6 {
+                    if !active[k] {
+                        continue;
+                    }
+                    let step = du[k] / scale(k, length);
+                    let next = t[k] + step;
+                    if (next < bounds.min[k] && t[k] <= bounds.min[k])
+                        || (next > bounds.max[k] && t[k] >= bounds.max[k])
+                    {
+                        active[k] = false;
+                        froze_one = true;
+                    }
+                    trial[k] = next.clamp(bounds.min[k], bounds.max[k]);
+                }
+                if froze_one {
+                    continue;
+                }
+                residuals_at(&trial, &mut trial_r);
+                let c = norm2(&trial_r);
+                if c < cost {
+                    t = trial;
+                    std::mem::swap(&mut r, &mut trial_r);
+                    cost = c;
+                    mu = (mu * 0.1).max(1e-15);
+                    accepted = true;
+                    break;
+                }
+                mu *= 10.0;
+                if mu > 1e4 {
+                    break;
+                }
+            }
+            if accepted {
+                since_update += 1;
+            } else if since_update > 0 {
+                // a stale Jacobian failed: recompute it before giving up
+                fresh = false;
+                mu = 1e-9;
+            } else {
+                break;
+            }
+        }
+        (t, r)
+    }
+
+    /// Like [`Self::project`], and also pushes the PPCs of `near` to at least `2 clear` apart and removes
+    /// penetration: hinge residuals `max(0, 2 clear - distance)` and `L d_G` join the equalities.
+    fn project_clear(
+        &self,
+        state: &ContactState,
+        near: &[PrincipalContact],
+        t0: &Config,
+        bounds: &ConfigBox,
+    ) -> Config {
+        let margin = 2.0 * self.clear();
+        let residuals = |t: &Config, out: &mut Vec<f64>| {
+            let pose = Pose::from_config(t);
+            self.residuals(state, &pose, out);
+            for pc in near {
+                out.push((margin - self.ppc_distance(pc, &pose)).max(0.0));
+            }
+            out.push(self.weights.length * penetration(self.fixed, self.moving, &pose));
+        };
+        self.least_squares(residuals, t0, bounds, &[false; 6], 1e-11 * self.weights.length, 40, None).0
+    }
+
+    /// Projection onto the closure of the state (eq. 8 zero): the equalities plus the bounding terms `h2` of every PC
+    /// and `L d_G` as residuals (both are zero inside their regions, so they pull back only what left them), with
+    /// the variables in `frozen` fixed; `None` when it does not converge.
+    pub fn project_closure(
+        &self,
+        state: &ContactState,
+        t0: &Config,
+        bounds: &ConfigBox,
+        frozen: &[bool; 6],
+    ) -> Option<Config> {
+        self.project_closure_with(state, t0, bounds, frozen, None)
+    }
+
+    fn closure_residuals(&self, state: &ContactState, t: &Config, out: &mut Vec<f64>) {
+        let length = self.weights.length;
+        let pose = Pose::from_config(t);
+        self.residuals(state, &pose, out);
+        for pc in &state.pcs {
+            out.push(pc_terms(pc, self.fixed, self.moving, &pose, length).1);
+        }
+        out.push(length * penetration(self.fixed, self.moving, &pose));
+    }
+
+    /// The Jacobian of the closure residuals at `t` (scaled variables).
+    fn closure_jacobian(&self, state: &ContactState, t: &Config) -> Vec<[f64; 6]> {
+        let length = self.weights.length;
+        let (mut plus, mut minus) = (Vec::new(), Vec::new());
+        let mut jac: Vec<[f64; 6]> = Vec::new();
+        for k in 0..6 {
+            let h = 1e-7 * length / scale(k, length);
+            let (mut tp, mut tm) = (*t, *t);
+            tp[k] += h;
+            tm[k] -= h;
+            self.closure_residuals(state, &tp, &mut plus);
+            self.closure_residuals(state, &tm, &mut minus);
+            if jac.is_empty() {
+                jac = vec![[0.0; 6]; plus.len()];
+            }
+            for i in 0..plus.len().min(jac.len()) {
+                jac[i][k] = (plus[i] - minus[i]) / (2.0 * h) / scale(k, length);
+            }
+        }
+        jac
+    }
+
+    fn project_closure_with(
+        &self,
+        state: &ContactState,
+        t0: &Config,
+        bounds: &ConfigBox,
+        frozen: &[bool; 6],
+        jacobian: Option<&[[f64; 6]]>,
+    ) -> Option<Config> {
+        let target = 1e-11 * self.weights.length;
+        // a compass move starts next to the closure: a few iterations suffice, or the move is rejected
+        let (t, r) =
+            self.least_squares(|t, out| self.closure_residuals(state, t, out), t0, bounds, frozen, target, 8, jacobian);
+        r.iter().all(|x| x.abs() <= target).then_some(t)
+    }
+
+    /// Euclidean distance between the elements of a PPC at `pose` (mm).
+    pub fn ppc_distance(&self, pc: &PrincipalContact, pose: &Pose) -> f64 {
+        let (sa, sb) = (&self.fixed.surface, &self.moving.surface);
+        match pc.kind() {
+            PcType::FaceVertex => {
+                let face = &sa.faces[pc.a.index];
+                let p = pose.apply(sb.vertices[pc.b.index].position);
+                face.frame.height(p).hypot(face_point_distance_2d(face, face.frame.to_2d(p)))
+            }
+            PcType::VertexFace => {
+                let face = &sb.faces[pc.b.index];
+                let p = pose.inverse_apply(sa.vertices[pc.a.index].position);
+                face.frame.height(p).hypot(face_point_distance_2d(face, face.frame.to_2d(p)))
+            }
+            PcType::EdgeEdge => {
+                let (a0, a1) = sa.edge_points(pc.a.index);
+                let (b0, b1) = sb.edge_points(pc.b.index);
+                segment_segment_distance(a0, a1, pose.apply(b0), pose.apply(b1))
+            }
+            // not PPCs: the full criterion (zero iff in contact)
+            _ => pc_criterion(pc, self.fixed, self.moving, pose, &self.weights),
+        }
+    }
+
+    /// The PPCs in contact at `t` (distance `<= hold`), and the closest PPC in the ambiguous band, if any.
+    pub fn holding(&self, t: &Config) -> (Vec<PrincipalContact>, Option<(PrincipalContact, f64)>) {
+        let pose = Pose::from_config(t);
+        let (hold, clear) = (self.hold(), self.clear());
+        let mut holding = Vec::new();
+        let mut ambiguous: Option<(PrincipalContact, f64)> = None;
+        for pc in &self.ppcs {
+            let d = self.ppc_distance(pc, &pose);
+            if d <= hold {
+                holding.push(*pc);
+            } else if d <= clear && ambiguous.is_none_or(|(_, best)| d < best) {
+                ambiguous = Some((*pc, d));
+            }
+        }
+        (holding, ambiguous)
+    }
+
+    /// The strict check of `state` at `t` (see the module documentation).
+    pub fn verify(&self, state: &ContactState, t: &Config, bounds: &ConfigBox) -> Result<(), Rejection> {
+        if !bounds.contains(t) {
+            return Err(Rejection::OutsideBox);
+        }
+        let pose = Pose::from_config(t);
+        let hold = self.hold();
+        for pc in &state.pcs {
+            let value = pc_criterion(pc, self.fixed, self.moving, &pose, &self.weights);
+            if value > hold {
+                return Err(Rejection::NotInContact { pc: pc.label(), value });
+            }
+        }
+        let value = self.weights.length * penetration(self.fixed, self.moving, &pose);
+        if value > hold {
+            return Err(Rejection::Penetrating { value });
+        }
+        let (holding, ambiguous) = self.holding(t);
+        if let Some((pc, distance)) = ambiguous {
+            return Err(Rejection::Ambiguous { pc: pc.label(), distance });
+        }
+        let actual = ContactState::canonical(holding, &self.fixed.surface, &self.moving.surface);
+        if &actual != state {
+            return Err(Rejection::OtherState { holding: actual.label() });
+        }
+        Ok(())
+    }
+
+    /// A configuration verifying `state` near one of `starts` (projection, then seeded perturbations of growing
+    /// size, `attempts` per start); the last rejection when none is found.
+    pub fn interior_witness(
+        &self,
+        state: &ContactState,
+        starts: &[Config],
+        bounds: &ConfigBox,
+        seed: u64,
+        attempts: usize,
+    ) -> Result<Config, Rejection> {
+        let mut rng = SplitMix64::new(seed);
+        let mut last = Rejection::NoProjection;
+        let free = [false; 6];
+        // every start projected and checked first, then perturbations around the first few that projected
+        let mut projected: Vec<Config> = Vec::new();
+        for start in starts {
+            let Some(p) = self.project(state, start, bounds, &free) else {
+                continue;
+            };
+            match self.verify(state, &p, bounds) {
+                Ok(()) => return Ok(p),
+                Err(e) => last = e,
+            }
+            if !projected.iter().any(|q| q == &p) {
+                projected.push(p);
+            }
+            // the same pose in the other Euler chart, (rx + pi, pi - ry, rz + pi): near ry = +-pi/2 (gimbal lock) a
+            // bound on ry can block the tilt a strict witness needs, which the other chart allows
+            if let Some(alt) = other_chart(&p, bounds)
+                && !projected.contains(&alt)
+            {
+                match self.verify(state, &alt, bounds) {
+                    Ok(()) => return Ok(alt),
+                    Err(e) => last = e,
+                }
+                projected.push(alt);
+            }
+        }
+        let (sa, sb) = (&self.fixed.surface, &self.moving.surface);
+        for p in projected.iter().take(2) {
+            let start_pose = Pose::from_config(p);
+            for i in 0..attempts {
+                let mut trial = *p;
+                if i > 0 {
+                    let size = 1e-4 * 3e3f64.powf(i as f64 / attempts.saturating_sub(1).max(1) as f64);
+                    for k in 0..6 {
+                        trial[k] += rng.normal() * size * bounds.width(k);
+                    }
+                    bounds.clamp(&mut trial);
+                }
+                // PPCs that may come into contact near the trial point and are not part of the state
+                let pose = Pose::from_config(&trial);
+                let near: Vec<PrincipalContact> = self
+                    .ppcs
+                    .iter()
+                    .copied()
+                    .filter(|q| {
+                        self.ppc_distance(q, &pose).min(self.ppc_distance(q, &start_pose)) <= 0.02 * self.weights.length
+                    })
+                    .filter(|q| {
+                        let mut pcs = state.pcs.clone();
+                        pcs.push(*q);
+                        &ContactState::canonical(pcs, sa, sb) != state
+                    })
+                    .collect();
+                let q = self.project_clear(state, &near, &trial, bounds);
+                // the hinge terms can leave a small equality residual: finish with the plain projection
+                let candidates = [Some(q), self.project(state, &q, bounds, &free)];
+                for q in candidates.into_iter().flatten() {
+                    match self.verify(state, &q, bounds) {
+                        Ok(()) => return Ok(q),
+                        Err(e) => last = e,
+                    }
+                }
+            }
+        }
+        Err(last)
+    }
+
+    /// Whether `t` lies in the closure of the state: eq. 8 at most `hold` inside the box.
+    pub fn in_closure(&self, state: &ContactState, t: &Config, bounds: &ConfigBox) -> bool {
+        // each PC's criterion and the penetration term may each be up to `hold` at a verified witness
+        bounds.contains(t)
+            && Objective { fixed: self.fixed, moving: self.moving, state, weights: self.weights }.value(t)
+                <= self.hold() * (state.pcs.len() + 1) as f64
+    }
+
+    /// The extremal of `t_k` (lower, or upper when `upper`) by the compass search on the manifold from `start`
+    /// (a configuration in the closure of the state). Returns the configuration reached and the evaluations spent.
+    pub fn extremal(
+        &self,
+        state: &ContactState,
+        start: Config,
+        k: usize,
+        upper: bool,
+        bounds: &ConfigBox,
+        budget: usize,
+    ) -> (Config, usize) {
+        let sign = if upper { -1.0 } else { 1.0 };
+        let mut best = start;
+        let mut used = 0;
+        let min_step = 1e-7;
+        let mut step = [0.05f64; 6];
+        let mut frozen = [false; 6];
+        let mut base_jacobian = self.closure_jacobian(state, &best);
+        let mut equality_rows = Vec::new();
+        self.residuals_at(state, &best, &mut equality_rows);
+        let equalities = equality_rows.len().min(base_jacobian.len());
+        while used < budget && step.iter().any(|s| *s >= min_step) {
+            let mut improved = false;
+            // the objective's own variable first, then the others
+            let order = std::iter::once(k).chain((0..6).filter(|&j| j != k));
+            let pinned = pinned_variables(&base_jacobian[..equalities]);
+            for j in order {
+                if step[j] < min_step || bounds.width(j) <= 0.0 || pinned[j] {
+                    continue;
+                }
+                for dir in [-sign, sign] {
+                    if used >= budget {
+                        break;
+                    }
+                    let mut trial = best;
+                    trial[j] = (trial[j] + dir * step[j] * bounds.width(j)).clamp(bounds.min[j], bounds.max[j]);
+                    if trial[j] == best[j] {
+                        continue;
+                    }
+                    frozen[j] = true;
+                    let projected = self.project_closure_with(state, &trial, bounds, &frozen, Some(&base_jacobian));
+                    frozen[j] = false;
+                    used += 1;
+                    let Some(q) = projected else { continue };
+                    if sign * (q[k] - best[k]) < -1e-12 * bounds.width(k).max(1e-12)
+                        && self.in_closure(state, &q, bounds)
+                    {
+                        best = q;
+                        base_jacobian = self.closure_jacobian(state, &best);
+                        // (the pinned set is recomputed from it at the next sweep)
+                        step[j] = (step[j] * 2.0).min(0.5);
+                        improved = true;
+                        break;
+                    }
+                }
+            }
+            if !improved {
+                for s in &mut step {
+                    *s *= 0.5;
+                }
+            }
+        }
+        (best, used)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::criteria::tests::box_part;
+    use crate::principal_contact::all_ppcs;
+    use crate::surface::Element;
+
+    #[test]
+    fn segment_distances() {
+        let d = segment_segment_distance(DVec3::ZERO, DVec3::X, DVec3::new(0.5, -1.0, 2.0), DVec3::new(0.5, 1.0, 2.0));
+        assert!((d - 2.0).abs() < 1e-15);
+        let d = segment_segment_distance(DVec3::ZERO, DVec3::X, DVec3::new(3.0, 1.0, 0.0), DVec3::new(4.0, 1.0, 0.0));
+        assert!((d - 5f64.sqrt()).abs() < 1e-15);
+        // parallel overlapping
+        let d = segment_segment_distance(DVec3::ZERO, DVec3::X, DVec3::new(0.5, 1.0, 0.0), DVec3::new(2.0, 1.0, 0.0));
+        assert!((d - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn projection_puts_a_vertex_on_a_face_and_the_check_is_strict() {
+        let slab = box_part("slab", DVec3::new(-50.0, -50.0, -10.0), DVec3::new(50.0, 50.0, 0.0));
+        let cube = box_part("cube", DVec3::splat(-0.5), DVec3::splat(0.5));
+        let top = slab.surface.faces.iter().position(|f| (f.plane.normal - DVec3::Z).length() < 1e-12).expect("top");
+        let low = cube.surface.vertices.iter().position(|v| v.position == DVec3::splat(-0.5)).expect("vertex");
+        let state = ContactState::single(PrincipalContact::new(Element::face(top), Element::vertex(low)).expect("pc"));
+        let bounds = ConfigBox::new([-1.0, -1.0, 0.0, -0.3, -0.3, -0.3], [1.0, 1.0, 2.0, 0.3, 0.3, 0.3]).expect("box");
+        let m = Manifolds::new(&slab, &cube, all_ppcs(&slab.surface, &cube.surface), StrictTolerances::default());
+        // tilted so that the lowest vertex is -0.5,-0.5,-0.5 of the cube; start 0.2 too high
+        let t0 = [0.1, 0.2, 0.9, 0.15, -0.12, 0.05];
+        let t = m.project(&state, &t0, &bounds, &[false; 6]).expect("converges");
+        let p = Pose::from_config(&t).apply(DVec3::splat(-0.5));
+        assert!(p.z.abs() < 1e-9, "{p:?}");
+        assert!(m.verify(&state, &t, &bounds).is_ok(), "{:?}", m.verify(&state, &t, &bounds));
+        // flat on the face: four vertices touch, the f-v state is not the one in contact
+        let flat =
+            m.project(&state, &[0.0, 0.0, 0.6, 0.0, 0.0, 0.0], &bounds, &[false, false, false, true, true, true]);
+        let flat = flat.expect("flat");
+        assert!(matches!(m.verify(&state, &flat, &bounds), Err(Rejection::OtherState { .. })));
+        // and the interior search finds a strict witness from there
+        let w = m.interior_witness(&state, &[flat], &bounds, 3, 20).expect("witness");
+        assert!(m.verify(&state, &w, &bounds).is_ok());
+    }
+
+    #[test]
+    fn the_other_euler_chart_is_the_same_pose() {
+        use std::f64::consts::PI;
+        let bounds =
+            ConfigBox::new([-1.0, -1.0, -1.0, -PI, -PI / 2.0, -PI], [1.0, 1.0, 1.0, PI, PI / 2.0, PI]).expect("box");
+        // with |ry| <= pi/2 the other chart is in the box only on the gimbal-lock bound
+        let t = [0.1, 0.2, 0.3, 0.7, PI / 2.0, -2.0];
+        assert!(other_chart(&[0.1, 0.2, 0.3, 0.7, 1.5, -2.0], &bounds).is_none());
+        let alt = other_chart(&t, &bounds).expect("in the box");
+        let (a, b) = (Pose::from_config(&t), Pose::from_config(&alt));
+        for p in [DVec3::X, DVec3::Y, DVec3::Z] {
+            assert!((a.apply(p) - b.apply(p)).length() < 1e-12);
+        }
+        // with small angle bounds the other chart is outside
+        let small = ConfigBox::new([-1.0, -1.0, -1.0, -0.2, -0.2, -0.2], [1.0, 1.0, 1.0, 0.2, 0.2, 0.2]).expect("box");
+        assert!(other_chart(&[0.0, 0.0, 0.0, 0.1, 0.1, 0.1], &small).is_none());
+    }
+}
