@@ -1,12 +1,24 @@
-//! Benchmarks: the whole-stack check of 15 parts (boxes staggered in a brick pattern), the contact analysis, and
-//! equilibrium solves for one added part and for the whole stack.
+//! Benchmarks: the whole-stack check of 15 parts (with margins in 8 directions and every prefix stack, the defaults):
+//!
+//! * bricks staggered in a pyramid (one connected group: the worst case for the group decomposition);
+//! * 15 Channel parts as planned by `stackplan plan example:channel` (w = 0.5; `stacks/channel-plan-15.json`);
+//! * 15 Channel parts in 5 columns of 3 (lowest resting pose, each part straight on top of the one below);
+//! * 15 Triangle and 15 Complex parts side by side on the floor in their lowest resting pose (3 x 5). Columns of
+//!   these two are not stable (a part lowered straight onto a copy of itself in the same pose does not rest on it
+//!   stably, so the check would stop before the margins) and the planner places only one Triangle part;
+//!
+//! then the contact analysis, and equilibrium solves for one added part and for the whole brick stack.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{DMat3, DVec3};
+use stackplan_geom::examples::part_by_name;
+use stackplan_geom::io::stack::read_stack;
+use stackplan_geom::sheet_metal::Decomposition;
 use stackplan_geom::{Part, PartOrigin, convex_hull};
 use stackplan_stability::check::{CheckOptions, check_stack};
 use stackplan_stability::contacts::analyse_contacts;
 use stackplan_stability::equilibrium::{EquilibriumOptions, solve_equilibrium};
+use stackplan_stability::resting_poses::resting_poses;
 use stackplan_stability::world::{PlacedPart, stack_tolerance, world_stack};
 use std::hint::black_box;
 
@@ -36,6 +48,56 @@ fn brick_pyramid(part: &Part) -> Vec<PlacedPart<'_>> {
     stack
 }
 
+/// 15 copies of `part` in its lowest resting pose: `columns` columns side by side (10 mm apart along x, wrapping
+/// after 5 columns along y), each part straight on top of the previous one of its column.
+fn columns(part: &Part, columns: usize) -> Vec<PlacedPart<'_>> {
+    let pose = resting_poses(part).expect("poses").into_iter().next().expect("a resting pose");
+    let world: Vec<DVec3> = part.all_vertices().map(|v| pose.rotation * v + pose.position).collect();
+    let lo = world.iter().fold(DVec3::splat(f64::INFINITY), |a, b| a.min(*b));
+    let hi = world.iter().fold(DVec3::splat(f64::NEG_INFINITY), |a, b| a.max(*b));
+    let size = hi - lo;
+    (0..15)
+        .map(|k| {
+            let (column, level) = (k % columns, k / columns);
+            let shift = DVec3::new(
+                (size.x + 10.0) * (column % 5) as f64,
+                (size.y + 10.0) * (column / 5) as f64,
+                size.z * level as f64,
+            );
+            PlacedPart { part, rotation: pose.rotation, position: pose.position + shift }
+        })
+        .collect()
+}
+
+fn bench_fixtures(c: &mut Criterion) {
+    let options = CheckOptions::default();
+    let channel = part_by_name("channel", Decomposition::ConvexMerge).expect("channel");
+    let triangle = part_by_name("triangle", Decomposition::ConvexMerge).expect("triangle");
+    let complex = part_by_name("complex", Decomposition::ConvexMerge).expect("complex");
+    let plan = read_stack(concat!(env!("CARGO_MANIFEST_DIR"), "/benches/stacks/channel-plan-15.json")).expect("plan");
+    let planned: Vec<PlacedPart<'_>> = plan
+        .placements
+        .iter()
+        .map(|p| PlacedPart { part: &plan.part, rotation: p.rotation, position: p.position })
+        .collect();
+    let cases = [
+        ("check_stack 15 Channel (planned, w = 0.5)", planned),
+        ("check_stack 15 Channel (5 columns of 3)", columns(&channel, 5)),
+        ("check_stack 15 Triangle (on the floor)", columns(&triangle, 15)),
+        ("check_stack 15 Complex (on the floor)", columns(&complex, 15)),
+    ];
+    for (name, stack) in &cases {
+        assert_eq!(stack.len(), 15);
+        let report = check_stack(stack, &options).expect("check");
+        assert!(
+            report.stack.verdict.is_stable() && report.stack.margin.is_some(),
+            "{name}: {:?}",
+            report.stack.verdict
+        );
+        c.bench_function(name, |b| b.iter(|| check_stack(black_box(stack), &options).expect("check")));
+    }
+}
+
 fn bench(c: &mut Criterion) {
     let brick = box_part(DVec3::new(200.0, 100.0, 50.0));
     let stack = brick_pyramid(&brick);
@@ -54,7 +116,7 @@ fn bench(c: &mut Criterion) {
     c.bench_function("contacts 15 bricks", |b| b.iter(|| analyse_contacts(black_box(&parts), tol, |_| true)));
     let last = parts.len() - 1;
     let movable: Vec<bool> = (0..parts.len()).map(|i| i == last).collect();
-    let plain = EquilibriumOptions { mu: 0.5, directions: 0 };
+    let plain = EquilibriumOptions::new(0.5, 0);
     c.bench_function("equilibrium: one added part", |b| {
         b.iter(|| solve_equilibrium(black_box(&parts), &movable, &contacts.patches, &plain).expect("solve"))
     });
@@ -64,5 +126,5 @@ fn bench(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, bench);
+criterion_group!(benches, bench, bench_fixtures);
 criterion_main!(benches);

@@ -16,8 +16,12 @@
 //!   stable.
 //!
 //! Pruning: parts and components are paired only when their bounding boxes meet (enlarged by the clearance for the
-//! clearance test). Cost: dominated by the SOCP solves (`n` new-part problems with margin, `n` prefix problems, one
-//! whole-stack margin).
+//! clearance test). Shortcuts that decide exactly what the plain analysis decides: equilibrium problems split into
+//! groups of parts connected by part-part contacts ([`solve_equilibrium`]); prefix `i` solves only the group that part
+//! `i` joins and reuses the other groups' verdicts (`prefix_verdicts`); the grasp analysis runs once per class of
+//! placements of the same part with the same rotation (it depends only on the part's own material, so a translated
+//! copy has the same answer up to rounding); the per-part analyses run in parallel (rayon). Cost: dominated by the
+//! SOCP solves (`n` new-part problems with margin, `n - 1` prefix step groups, the whole-stack margin).
 
 use crate::StabilityError;
 use crate::clearance::{horizontal_distance_at_least, vertically_separated};
@@ -26,6 +30,7 @@ use crate::equilibrium::{ContactForce, Equilibrium, EquilibriumOptions, Verdict,
 use crate::grasp::{GraspOptions, grasp_faces_of_components, is_graspable};
 use crate::insertion::{Obstruction, insertion_obstruction};
 use crate::world::{PlacedPart, WorldPart, aabb_overlap, stack_tolerance, world_stack};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Options of [`check_stack`].
@@ -130,8 +135,7 @@ pub fn check_stack(stack: &[PlacedPart<'_>], options: &CheckOptions) -> Result<S
     };
     let n = parts.len();
     let ContactAnalysis { patches, interferences } = analyse_contacts(&parts, tol, |_| true);
-    let eq_with_margin = EquilibriumOptions { mu: options.mu, directions: options.margin_directions };
-    let eq_plain = EquilibriumOptions { mu: options.mu, directions: 0 };
+    let eq_with_margin = EquilibriumOptions::new(options.mu, options.margin_directions);
 
     // the whole stack, then the prefixes
     let movable_all = vec![true; n];
@@ -146,21 +150,41 @@ pub fn check_stack(stack: &[PlacedPart<'_>], options: &CheckOptions) -> Result<S
     } else {
         solve_equilibrium(&parts, &movable_all, &patches, &eq_with_margin)?
     };
-    let mut prefix_verdicts: Vec<Verdict> = Vec::with_capacity(n);
-    for i in 0..n {
-        if i + 1 == n {
-            prefix_verdicts.push(whole.verdict.clone());
-        } else if options.prefix_stability {
-            let sub: Vec<ContactPatch> = patches.iter().filter(|p| patch_within(p, i)).cloned().collect();
-            let movable: Vec<bool> = (0..n).map(|k| k <= i).collect();
-            prefix_verdicts.push(solve_equilibrium(&parts, &movable, &sub, &eq_plain)?.verdict);
-        } else {
-            prefix_verdicts.push(Verdict::Unknown("not checked".into()));
+    let prefix_verdicts = if options.prefix_stability {
+        prefix_verdicts(&parts, &patches, &whole.verdict, options.mu)?
+    } else {
+        let mut v = vec![Verdict::Unknown("not checked".into()); n];
+        if let Some(last) = v.last_mut() {
+            *last = whole.verdict.clone();
         }
-    }
+        v
+    };
 
-    let mut reports = Vec::with_capacity(n);
+    // the grasp of a part depends only on the part and its rotation (its own material, translated): one analysis per
+    // class of placements sharing both, at the class's first placement
+    let mut grasp_class = vec![0usize; n];
+    let mut representatives: Vec<usize> = Vec::new();
     for i in 0..n {
+        let same = |&r: &usize| {
+            std::ptr::eq(stack[r].part, stack[i].part)
+                && stack[r].rotation.to_cols_array() == stack[i].rotation.to_cols_array()
+        };
+        grasp_class[i] = match representatives.iter().position(same) {
+            Some(c) => c,
+            None => {
+                representatives.push(i);
+                representatives.len() - 1
+            }
+        };
+    }
+    let grasps: Vec<(f64, bool)> = representatives
+        .par_iter()
+        .map(|&r| {
+            let faces = grasp_faces_of_components(&parts[r].components, tol, &options.grasp);
+            (faces.iter().map(|f| f.inscribed_radius).fold(0.0, f64::max), is_graspable(&faces, &options.grasp))
+        })
+        .collect();
+    let part_report = |i: usize| -> Result<PartCheck, StabilityError> {
         let mut interference = 0.0f64;
         let mut interferes_with = Vec::new();
         for x in &interferences {
@@ -182,9 +206,7 @@ pub fn check_stack(stack: &[PlacedPart<'_>], options: &CheckOptions) -> Result<S
         let sub: Vec<ContactPatch> = patches.iter().filter(|p| patch_within(p, i)).cloned().collect();
         let movable: Vec<bool> = (0..n).map(|k| k == i).collect();
         let alone = solve_equilibrium(&parts, &movable, &sub, &eq_with_margin)?;
-        let faces = grasp_faces_of_components(&parts[i].components, tol, &options.grasp);
-        let graspable = is_graspable(&faces, &options.grasp);
-        let grasp_radius = faces.iter().map(|f| f.inscribed_radius).fold(0.0, f64::max);
+        let (grasp_radius, graspable) = grasps[grasp_class[i]];
         let obstruction = insertion_obstruction(&parts, i, tol).err();
         let insertable = obstruction.is_none();
         let remaining_stable = i == 0 || prefix_verdicts[i - 1].is_stable();
@@ -197,7 +219,7 @@ pub fn check_stack(stack: &[PlacedPart<'_>], options: &CheckOptions) -> Result<S
             && graspable
             && insertable
             && removable;
-        reports.push(PartCheck {
+        Ok(PartCheck {
             index: i,
             name: parts[i].name.clone(),
             interference,
@@ -214,11 +236,86 @@ pub fn check_stack(stack: &[PlacedPart<'_>], options: &CheckOptions) -> Result<S
             insertion_obstruction: obstruction,
             removable,
             ok,
-        });
-    }
+        })
+    };
+    let reports: Vec<PartCheck> = (0..n).into_par_iter().map(part_report).collect::<Result<_, _>>()?;
     let ok = reports.iter().all(|r| r.ok);
     tracing::info!(parts = n, ok, "stack checked");
     Ok(StackCheck { parts: reports, stack: whole, contacts: patches, tolerance: tol, ok })
+}
+
+/// The verdicts of the prefix stacks `0..=i` (every part movable, the floor fixed); the last one is `whole`.
+///
+/// A prefix stack is the product of its groups of parts connected by part-part contacts (see
+/// [`solve_equilibrium`]), and a group's problem depends only on its set of parts: its contacts are among its
+/// parts and with the floor, and a later part touching it would have joined it. Placing part `i` changes only the
+/// group that `i` joins, so step `i` solves that group alone (the "step group" of `i`); every group of prefix `i` is
+/// the step group of its highest part. Prefix `i` is unstable when one of its groups is, else unknown when one is,
+/// else stable: the same decision as one solve of the whole prefix, with `n - 1` solves of (usually) small groups
+/// instead of `n - 1` solves of growing prefixes. The step groups are solved in parallel.
+fn prefix_verdicts(
+    parts: &[WorldPart],
+    patches: &[ContactPatch],
+    whole: &Verdict,
+    mu: f64,
+) -> Result<Vec<Verdict>, StabilityError> {
+    let n = parts.len();
+    if n == 0 {
+        return Ok(Vec::new());
+    }
+    // group label of every part after each step: label[k] = the highest part of k's group so far
+    let mut label: Vec<usize> = (0..n).collect();
+    let mut step_groups: Vec<Vec<usize>> = Vec::with_capacity(n);
+    let mut labels_after: Vec<Vec<usize>> = Vec::with_capacity(n);
+    for i in 0..n {
+        let joined: Vec<usize> = patches
+            .iter()
+            .filter_map(|p| match p.a {
+                Body::Part(a) if p.b == i && a < i => Some(label[a]),
+                _ => None,
+            })
+            .collect();
+        for k in 0..i {
+            if joined.contains(&label[k]) {
+                label[k] = i;
+            }
+        }
+        step_groups.push((0..=i).filter(|&k| label[k] == i).collect());
+        labels_after.push(label[..=i].to_vec());
+    }
+    let plain = EquilibriumOptions::new(mu, 0);
+    let step_verdicts: Vec<Verdict> = (0..n - 1)
+        .into_par_iter()
+        .map(|i| {
+            let group = &step_groups[i];
+            let movable: Vec<bool> = (0..n).map(|k| group.contains(&k)).collect();
+            let sub: Vec<ContactPatch> = patches
+                .iter()
+                .filter(|p| {
+                    patch_within(p, i) && (group.contains(&p.b) || matches!(p.a, Body::Part(a) if group.contains(&a)))
+                })
+                .cloned()
+                .collect();
+            solve_equilibrium(parts, &movable, &sub, &plain).map(|e| e.verdict)
+        })
+        .collect::<Result<_, _>>()?;
+    let mut out = Vec::with_capacity(n);
+    for labels in labels_after.iter().take(n - 1) {
+        let mut tops: Vec<usize> = labels.clone();
+        tops.sort_unstable();
+        tops.dedup();
+        let verdicts: Vec<&Verdict> = tops.iter().map(|&t| &step_verdicts[t]).collect();
+        let combined = if let Some(v) = verdicts.iter().find(|v| ***v == Verdict::Unstable) {
+            (*v).clone()
+        } else if let Some(v) = verdicts.iter().find(|v| !v.is_stable()) {
+            (*v).clone()
+        } else {
+            Verdict::Stable
+        };
+        out.push(combined);
+    }
+    out.push(whole.clone());
+    Ok(out)
 }
 
 /// Whether both bodies of the patch are among the floor and parts `0..=i`.

@@ -32,8 +32,14 @@
 //! flat convex patch; it ignores torsional friction inside a patch, so it is slightly conservative. Feasibility means
 //! that *some* admissible force distribution exists (rigid-body statics, no dynamics or compliance).
 //!
-//! Cost: an interior-point solve with `3 K + 1` variables and `6 M` equalities (K contact points, M movable parts);
-//! one margin costs `directions` more solves.
+//! Decomposition: the movable parts split into groups connected by contacts between movable parts (the floor and
+//! fixed parts do not connect); the groups share no unknown, so each is solved on its own, in parallel (rayon), and
+//! the answers combine exactly (see [`solve_equilibrium`]). A group of one part whose contacts are all supports from
+//! below in one horizontal plane gets its margin in closed form (`min(mu, s / H)`, see `FlatSupport`), the SOCP's
+//! optimum without a solve; `EquilibriumOptions::margins_by_socp_only` turns this off for cross-checks.
+//!
+//! Cost: per group an interior-point solve with `3 K + 1` variables and `6 M` equalities (K contact points, M movable
+//! parts); a margin costs `directions` more solves per group (none for closed-form groups).
 
 use crate::contacts::{Body, ContactPatch, plane_basis};
 use crate::polygon2d::{convex_hull_2d, signed_boundary_distance};
@@ -44,6 +50,7 @@ use clarabel::solver::{
     ZeroConeT,
 };
 use glam::{DVec2, DVec3};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Upper bound of the reported robustness margin (a stack that resists 10 g sideways is locked).
@@ -75,11 +82,22 @@ pub struct EquilibriumOptions {
     pub mu: f64,
     /// Number of horizontal load directions for the margin (0 = no margin).
     pub directions: usize,
+    /// Compute every margin by its SOCP, also where the closed form of a part on a flat support applies (for
+    /// cross-checking the closed form; the results agree to the solver's tolerance).
+    #[serde(default)]
+    pub margins_by_socp_only: bool,
+}
+
+impl EquilibriumOptions {
+    /// Friction `mu`, `directions` margin directions, closed-form margins where they apply.
+    pub fn new(mu: f64, directions: usize) -> Self {
+        Self { mu, directions, margins_by_socp_only: false }
+    }
 }
 
 impl Default for EquilibriumOptions {
     fn default() -> Self {
-        Self { mu: 0.5, directions: 8 }
+        Self::new(0.5, 8)
     }
 }
 
@@ -141,6 +159,14 @@ struct Point {
 
 /// The equilibrium SOCP over `parts` with the given contact `patches`; `movable[i]` says whether part `i` moves.
 /// Patches between two fixed bodies are ignored.
+///
+/// The movable parts are split into groups connected by contacts between movable parts (fixed bodies do not
+/// connect): the groups share no unknown and no equation, so the problem is the product of one problem per group and
+/// each group is solved on its own (in parallel). Verdict: unstable when some group is, else unknown when some group
+/// is, else stable, with the groups' minimum-norm forces (the minimum-norm solution of a product is the product of
+/// the minimum-norm solutions). Margin: the load of the margin acts on every group at once, and a group resists a
+/// load factor `alpha` iff `alpha <= ` its own largest factor (its feasible set in `alpha` is an interval containing
+/// 0), so the stack's largest factor in direction `d` is the smallest over the groups.
 pub fn solve_equilibrium(
     parts: &[WorldPart],
     movable: &[bool],
@@ -174,68 +200,221 @@ pub fn solve_equilibrium(
         }
     }
     let movers: Vec<usize> = (0..parts.len()).filter(|&i| is_movable(i)).collect();
-    if movers.is_empty() {
-        return Ok(Equilibrium {
-            verdict: Verdict::Stable,
-            forces: Vec::new(),
-            margin: None,
-            weakest_direction: None,
-            decided_by_precheck: false,
-        });
+    let not_stable = |verdict: Verdict, decided_by_precheck: bool| Equilibrium {
+        verdict,
+        forces: Vec::new(),
+        margin: None,
+        weakest_direction: None,
+        decided_by_precheck,
+    };
+    let groups = movable_groups(parts.len(), &movers, &points, is_movable);
+    // the pre-check first: one failing group decides without any solve
+    for group in &groups {
+        if let Some(result) = precheck(parts, &group.movers, &group.points(&points)) {
+            return Ok(result);
+        }
     }
-    if let Some(result) = precheck(parts, &movers, &points) {
-        return Ok(result);
-    }
-    let problem = Problem::new(parts, &movers, &points, options.mu);
-    let (status, x) = problem.solve(None)?;
-    let verdict = verdict_of(status);
-    if !verdict.is_stable() {
-        tracing::debug!(?status, "equilibrium not stable");
-        return Ok(Equilibrium {
-            verdict,
-            forces: Vec::new(),
-            margin: None,
-            weakest_direction: None,
-            decided_by_precheck: false,
-        });
-    }
-    let forces = points
-        .iter()
-        .enumerate()
-        .map(|(k, pt)| ContactForce {
-            patch: pt.patch,
-            point: pt.p,
-            force: (pt.frame[0] * x[3 * k] + pt.frame[1] * x[3 * k + 1] + pt.frame[2] * x[3 * k + 2])
-                * problem.force_scale,
+    let solved: Vec<(Problem, SolverStatus, Vec<f64>)> = groups
+        .par_iter()
+        .map(|group| {
+            let problem = Problem::new(parts, &group.movers, &group.points(&points), options.mu);
+            problem.solve(None).map(|(status, x)| (problem, status, x))
         })
-        .collect();
-    let mut margin = None;
-    let mut weakest_direction = None;
-    if options.directions > 0 {
-        let mut smallest = f64::INFINITY;
-        let mut all_solved = true;
-        for j in 0..options.directions {
-            let angle = std::f64::consts::TAU * j as f64 / options.directions as f64;
-            let d = DVec3::new(angle.cos(), angle.sin(), 0.0);
-            let (status, x) = problem.solve(Some(d))?;
-            if status != SolverStatus::Solved {
-                tracing::debug!(?status, direction = j, "margin solve did not end Solved");
-                all_solved = false;
-                break;
-            }
-            let alpha = x[x.len() - 1].clamp(0.0, MARGIN_CAP);
-            if alpha < smallest {
-                smallest = alpha;
-                weakest_direction = Some(d);
-            }
-        }
-        if all_solved {
-            margin = Some(smallest);
-        } else {
-            weakest_direction = None;
+        .collect::<Result<_, _>>()?;
+    let verdicts: Vec<Verdict> = solved.iter().map(|(_, status, _)| verdict_of(*status)).collect();
+    if let Some(v) = verdicts.iter().find(|v| **v == Verdict::Unstable) {
+        tracing::debug!("equilibrium infeasible");
+        return Ok(not_stable(v.clone(), false));
+    }
+    if let Some(v) = verdicts.iter().find(|v| !v.is_stable()) {
+        tracing::debug!(?v, "equilibrium solve did not end Solved");
+        return Ok(not_stable(v.clone(), false));
+    }
+    let mut forces: Vec<(usize, ContactForce)> = Vec::with_capacity(points.len());
+    for (group, (problem, _, x)) in groups.iter().zip(&solved) {
+        for (local, &k) in group.point_indices.iter().enumerate() {
+            let pt = &points[k];
+            let force = (pt.frame[0] * x[3 * local] + pt.frame[1] * x[3 * local + 1] + pt.frame[2] * x[3 * local + 2])
+                * problem.force_scale;
+            forces.push((k, ContactForce { patch: pt.patch, point: pt.p, force }));
         }
     }
-    Ok(Equilibrium { verdict, forces, margin, weakest_direction, decided_by_precheck: false })
+    forces.sort_by_key(|(k, _)| *k);
+    let forces = forces.into_iter().map(|(_, f)| f).collect();
+    let (margin, weakest_direction) = if options.directions > 0 {
+        let closed: Vec<Option<FlatSupport>> = groups
+            .iter()
+            .map(|g| {
+                if options.margins_by_socp_only { None } else { FlatSupport::of(parts, &g.movers, &g.points(&points)) }
+            })
+            .collect();
+        margins(&solved, &closed, options.directions, options.mu)?
+    } else {
+        (None, None)
+    };
+    Ok(Equilibrium { verdict: Verdict::Stable, forces, margin, weakest_direction, decided_by_precheck: false })
+}
+
+/// The robustness margin over `directions` evenly spaced horizontal load directions: per direction the smallest
+/// largest load factor over the groups, then the smallest over the directions (the first direction achieving it is
+/// the weakest). `None` when a solve does not end `Solved`.
+fn margins(
+    solved: &[(Problem, SolverStatus, Vec<f64>)],
+    closed: &[Option<FlatSupport>],
+    directions: usize,
+    mu: f64,
+) -> Result<(Option<f64>, Option<DVec3>), EquilibriumError> {
+    let tasks: Vec<(usize, usize)> = (0..directions).flat_map(|j| (0..solved.len()).map(move |g| (j, g))).collect();
+    let direction = |j: usize| {
+        let angle = std::f64::consts::TAU * j as f64 / directions as f64;
+        DVec3::new(angle.cos(), angle.sin(), 0.0)
+    };
+    let alphas: Vec<Option<f64>> = tasks
+        .par_iter()
+        .map(|&(j, g)| {
+            if let Some(flat) = &closed[g] {
+                return Ok(Some(flat.margin(direction(j), mu)));
+            }
+            let (status, x) = solved[g].0.solve(Some(direction(j)))?;
+            if status != SolverStatus::Solved {
+                tracing::debug!(?status, direction = j, group = g, "margin solve did not end Solved");
+                return Ok(None);
+            }
+            Ok(Some(x[x.len() - 1].clamp(0.0, MARGIN_CAP)))
+        })
+        .collect::<Result<_, EquilibriumError>>()?;
+    let mut smallest = f64::INFINITY;
+    let mut weakest = None;
+    for (j, per_group) in alphas.chunks(solved.len()).enumerate() {
+        let mut alpha = f64::INFINITY;
+        for a in per_group {
+            match a {
+                Some(a) => alpha = alpha.min(*a),
+                None => return Ok((None, None)),
+            }
+        }
+        if alpha < smallest {
+            smallest = alpha;
+            weakest = Some(direction(j));
+        }
+    }
+    Ok((Some(smallest), weakest))
+}
+
+/// A single movable part whose contact points are all supports from below (normal +z, exerted on the part) in one
+/// horizontal plane `z = h` (within the tolerance), with a support polygon of positive area: its margin has a closed
+/// form. With a horizontal load `alpha m g d` the moment balance about the horizontal axes through the c.g. puts the
+/// centre of pressure of the normal forces at `c + alpha H d` (`H = c_z - h`), which must lie in the support polygon;
+/// the friction forces must sum to `alpha m g`, at most `mu m g`. Both conditions are also sufficient: normal forces
+/// realising that centre of pressure (a convex combination of the polygon's vertices) with friction proportional to
+/// them (`t_k = -alpha n_k d`, inside every cone when `alpha <= mu`) balance forces and all three moments (the
+/// torsion is `-alpha m ((cop - c) x d)_z = 0`). So the largest factor is `min(mu, s / H)` with `s` the distance
+/// from the projected c.g. along `d` to the polygon's boundary: the SOCP's optimum, without a solve.
+struct FlatSupport {
+    /// Projected c.g.
+    cg: DVec2,
+    /// Height of the c.g. above the support plane (> 0).
+    height: f64,
+    /// Support polygon, counter-clockwise.
+    polygon: Vec<DVec2>,
+}
+
+impl FlatSupport {
+    fn of(parts: &[WorldPart], movers: &[usize], points: &[&Point]) -> Option<Self> {
+        let [i] = movers else { return None };
+        let tol = 1e-9 * parts[*i].diagonal().max(1.0);
+        if points.is_empty() || !points.iter().all(|p| p.b == *i && p.frame[0].z >= 1.0 - 1e-12) {
+            return None;
+        }
+        let (lo, hi) =
+            points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.p.z), hi.max(p.p.z)));
+        if hi - lo > tol {
+            return None;
+        }
+        let c = parts[*i].center_of_gravity;
+        let height = c.z - 0.5 * (lo + hi);
+        let polygon = convex_hull_2d(&points.iter().map(|p| DVec2::new(p.p.x, p.p.y)).collect::<Vec<_>>(), tol);
+        let cg = DVec2::new(c.x, c.y);
+        if height <= tol || polygon.len() < 3 || signed_boundary_distance(cg, &polygon) < -tol {
+            return None;
+        }
+        Some(Self { cg, height, polygon })
+    }
+
+    /// `min(mu, s / H, cap)` for the horizontal unit direction `d`.
+    fn margin(&self, d: DVec3, mu: f64) -> f64 {
+        let d2 = DVec2::new(d.x, d.y);
+        let mut reach = f64::INFINITY;
+        for (k, &a) in self.polygon.iter().enumerate() {
+            let b = self.polygon[(k + 1) % self.polygon.len()];
+            let e = b - a;
+            let outward = DVec2::new(e.y, -e.x) / e.length();
+            let towards = outward.dot(d2);
+            if towards > 0.0 {
+                reach = reach.min((-outward.dot(self.cg - a)).max(0.0) / towards);
+            }
+        }
+        (reach / self.height).min(mu).clamp(0.0, MARGIN_CAP)
+    }
+}
+
+/// Movable parts connected by contacts between movable parts, with the contact points acting on them.
+struct Group {
+    /// Movable parts, ascending.
+    movers: Vec<usize>,
+    /// Indices of the contact points acting on a part of the group, ascending.
+    point_indices: Vec<usize>,
+}
+
+impl Group {
+    fn points<'a>(&self, points: &'a [Point]) -> Vec<&'a Point> {
+        self.point_indices.iter().map(|&k| &points[k]).collect()
+    }
+}
+
+/// The groups of movable parts (connected components of the graph "movable parts, joined by a contact point between
+/// two movable parts"), ordered by their smallest part. Union-find, O((P + K) alpha(P)).
+fn movable_groups(
+    n_parts: usize,
+    movers: &[usize],
+    points: &[Point],
+    is_movable: impl Fn(usize) -> bool,
+) -> Vec<Group> {
+    let mut parent: Vec<usize> = (0..n_parts).collect();
+    fn find(parent: &mut [usize], mut x: usize) -> usize {
+        while parent[x] != x {
+            parent[x] = parent[parent[x]];
+            x = parent[x];
+        }
+        x
+    }
+    for pt in points {
+        if let Some(a) = pt.a
+            && is_movable(a)
+            && is_movable(pt.b)
+        {
+            let (ra, rb) = (find(&mut parent, a), find(&mut parent, pt.b));
+            if ra != rb {
+                parent[ra.max(rb)] = ra.min(rb);
+            }
+        }
+    }
+    let mut slot = vec![usize::MAX; n_parts];
+    let mut groups: Vec<Group> = Vec::new();
+    for &i in movers {
+        let r = find(&mut parent, i);
+        if slot[r] == usize::MAX {
+            slot[r] = groups.len();
+            groups.push(Group { movers: Vec::new(), point_indices: Vec::new() });
+        }
+        groups[slot[r]].movers.push(i);
+    }
+    for (k, pt) in points.iter().enumerate() {
+        let body = if is_movable(pt.b) { pt.b } else { pt.a.expect("a point between fixed bodies was skipped") };
+        let r = find(&mut parent, body);
+        groups[slot[r]].point_indices.push(k);
+    }
+    groups
 }
 
 fn verdict_of(status: SolverStatus) -> Verdict {
@@ -247,9 +426,9 @@ fn verdict_of(status: SolverStatus) -> Verdict {
 }
 
 /// The pre-check of the module documentation (single movable part on horizontal supports only).
-fn precheck(parts: &[WorldPart], movers: &[usize], points: &[Point]) -> Option<Equilibrium> {
+fn precheck(parts: &[WorldPart], movers: &[usize], points: &[&Point]) -> Option<Equilibrium> {
     let [i] = movers else { return None };
-    let mine: Vec<&Point> = points.iter().filter(|p| p.b == *i || p.a == Some(*i)).collect();
+    let mine: Vec<&Point> = points.iter().copied().filter(|p| p.b == *i || p.a == Some(*i)).collect();
     let horizontal_support = |p: &Point| p.b == *i && p.frame[0].z >= 1.0 - 1e-12;
     let tol = 1e-9 * parts[*i].diagonal().max(1.0);
     let unstable = Equilibrium {
@@ -290,7 +469,7 @@ struct Problem {
 }
 
 impl Problem {
-    fn new(parts: &[WorldPart], movers: &[usize], points: &[Point], mu: f64) -> Self {
+    fn new(parts: &[WorldPart], movers: &[usize], points: &[&Point], mu: f64) -> Self {
         let force_scale: f64 = movers.iter().map(|&i| parts[i].mass).sum::<f64>().max(f64::MIN_POSITIVE);
         let mut lo = DVec3::splat(f64::INFINITY);
         let mut hi = DVec3::splat(f64::NEG_INFINITY);
