@@ -515,8 +515,16 @@ impl Problem<'_> {
             if level <= target {
                 return Ok(Seek::Reached(p));
             }
-            let sub = Subspace::new(self, &w);
-            match self.step(&sub, &p) {
+            // with no working constraint the objective is linear on the whole space: the move is `-g` (what
+            // `Subspace::new` and `step` give, without their Gram-Schmidt work)
+            let (sub, step) = if w.len == 0 {
+                (None, Step::Move { dir: self.g.map(|c| -c), bounded: false, stage: 0 })
+            } else {
+                let sub = Subspace::new(self, &w);
+                let step = self.step(&sub, &p);
+                (Some(sub), step)
+            };
+            match step {
                 Step::Move { dir, bounded, stage: 0 } => {
                     let len = norm4(&dir);
                     let mut alpha = if bounded { 1.0 } else { f64::INFINITY };
@@ -562,6 +570,7 @@ impl Problem<'_> {
                 // stationary for the objective (a tie-break move or none): drop a constraint on a negative
                 // objective multiplier, or stop at the minimum
                 _ => {
+                    let sub = sub.unwrap_or_else(|| Subspace::new(self, &w));
                     let (drop, _) = self.drop_choice_to(&sub, &w, &p, iter >= bland_after, &banned, 0);
                     match drop {
                         Some(k) => {

@@ -270,7 +270,9 @@ impl<const D: usize> Cell<D> {
 
     /// A cell with `extra` inequalities added (a subset of this one, so no boundedness check).
     pub fn with_halfspaces(&self, extra: impl IntoIterator<Item = Halfspace<D>>) -> Result<Self, CellError> {
-        let mut hs = self.halfspaces.clone();
+        let extra = extra.into_iter();
+        let mut hs = Vec::with_capacity(self.halfspaces.len() + extra.size_hint().0);
+        hs.extend_from_slice(&self.halfspaces);
         hs.extend(extra);
         Self::build(hs, self.tolerance, false)
     }
@@ -296,9 +298,11 @@ impl<const D: usize> Cell<D> {
         }
         let tol = self.tolerance.linear;
         let first_extra = self.rows.len();
-        let mut rows = self.rows.clone();
+        let mut rows = Vec::with_capacity(first_extra + 8);
+        rows.extend_from_slice(&self.rows);
         // the grown cell's offsets
-        let mut grown: Vec<f64> = self.offsets.iter().map(|b| b + tol).collect();
+        let mut grown: Vec<f64> = Vec::with_capacity(first_extra + 8);
+        grown.extend(self.offsets.iter().map(|b| b + tol));
         for (k, h) in extra.into_iter().enumerate() {
             if !h.offset.is_finite() || h.normal.iter().any(|c| !c.is_finite()) {
                 return Err(CellError::NonFinite { index: first_extra + k });

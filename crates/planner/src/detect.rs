@@ -18,9 +18,11 @@
 use crate::orientation::Orientation;
 use glam::{DMat3, DVec3};
 use stackplan_cspace::PlacedConvex;
-use stackplan_cspace::interference::{PairContact, classify_pair};
+use stackplan_cspace::interference::{PairContact, gjk_distance};
 use stackplan_geom::polytope::ConvexPolytope;
 use stackplan_geom::{Part, Pose};
+use std::collections::HashMap;
+use std::collections::hash_map::Entry;
 
 /// A component of a stack part, placed in the world.
 #[derive(Debug, Clone)]
@@ -138,12 +140,6 @@ fn swept(placed: &PlacedConvex, axes: &(Vec<DVec3>, Vec<DVec3>), p: DVec3, top: 
     }
 }
 
-/// The box of [`swept`] without building the sweep (the same arithmetic).
-fn swept_box(placed: &PlacedConvex, p: DVec3, top: f64) -> (DVec3, DVec3) {
-    let lift = (top - (placed.aabb.0.z + p.z)).max(0.0) + 1.0;
-    (placed.aabb.0 + p, placed.aabb.1 + p + DVec3::new(0.0, 0.0, lift))
-}
-
 fn boxes_overlap(a: &(DVec3, DVec3), b: &(DVec3, DVec3), margin: f64) -> bool {
     a.0.x <= b.1.x + margin
         && b.0.x <= a.1.x + margin
@@ -160,7 +156,426 @@ pub struct DetectCounts {
     pub narrow_phase: u64,
 }
 
-/// The violating pairs of the orientation at `p` (see the module documentation).
+/// The separating axes of one (orientation, moving component, stack component) pair with the stack component's
+/// projection on each: everything of the separating-axis test that does not depend on the position, kept for the
+/// pair's next test ([`AxesCache`]). The axes are those of `stackplan_cspace::interference::sat_gap` and of
+/// [`horizontal_slack`] in their order (the moving component's normal axes, the stack component's, then the unit
+/// cross products of their edge directions longer than `1e-9`), computed with the same arithmetic, so every
+/// per-axis value is bit-identical to theirs.
+#[derive(Debug, Clone)]
+pub struct PairAxes {
+    /// Per axis: the unit axis `u`, the stack component's projection `[lo, hi]` on it, and `|u_xy|`.
+    axes: Vec<(DVec3, f64, f64, f64)>,
+    /// The axis that separated last time: tried first (the maximum over the axes does not depend on their order).
+    witness: usize,
+}
+
+impl PairAxes {
+    fn new(moving_normals: &[DVec3], moving_edges: &[DVec3], fixed: &PlacedConvex) -> Self {
+        let mut axes = Vec::with_capacity(
+            moving_normals.len() + fixed.normal_axes.len() + moving_edges.len() * fixed.edge_directions.len(),
+        );
+        let mut push = |u: DVec3| {
+            let (lo, hi) = project(&fixed.vertices, u);
+            axes.push((u, lo, hi, (1.0 - u.z * u.z).max(0.0).sqrt()));
+        };
+        for &u in moving_normals.iter().chain(&fixed.normal_axes) {
+            push(u);
+        }
+        for &da in moving_edges {
+            for &db in &fixed.edge_directions {
+                let c = da.cross(db);
+                let len2 = c.length_squared();
+                if len2 > 1e-18 {
+                    push(c / len2.sqrt());
+                }
+            }
+        }
+        Self { axes, witness: 0 }
+    }
+
+    /// Scans the axes `witness + k` (cyclically) for `k` in `range`, raising `scan.best` to `gap_u - weight |u_xy|`;
+    /// stops at the first axis that makes it pass the rule's threshold (remembered as the next witness) and returns
+    /// whether it did. O(axes x moving vertices).
+    fn scan(&mut self, moving: &[DVec3], rule: &Rule, range: std::ops::Range<usize>, best: &mut f64) -> bool {
+        let n = self.axes.len();
+        for k in range {
+            let i = (self.witness + k) % n;
+            let (u, b_lo, b_hi, horizontal) = self.axes[i];
+            let (a_lo, a_hi) = project(moving, u);
+            let gap = (b_lo - a_hi).max(a_lo - b_hi);
+            let value = if rule.weight == 0.0 { gap } else { gap - rule.weight * horizontal };
+            *best = best.max(value);
+            if rule.decided(*best) {
+                self.witness = i;
+                return true;
+            }
+        }
+        false
+    }
+}
+
+/// The stopping rule of a scan: the per-axis value is `gap - weight |u_xy|`; a running maximum past `stop` decides
+/// the pair as not violating.
+#[derive(Debug, Clone, Copy)]
+struct Rule {
+    weight: f64,
+    stop: f64,
+    inclusive: bool,
+}
+
+impl Rule {
+    #[inline]
+    fn decided(&self, best: f64) -> bool {
+        if self.inclusive { best >= self.stop } else { best > self.stop }
+    }
+}
+
+/// The scan of a pair seen for the first time, on the fly (no allocation): the normal axes (`normals = true`) or
+/// the edge cross products, in the order and with the arithmetic of [`PairAxes`].
+fn scan_direct(
+    moving_normals: &[DVec3],
+    moving_edges: &[DVec3],
+    fixed: &PlacedConvex,
+    moving: &[DVec3],
+    rule: &Rule,
+    normals: bool,
+    best: &mut f64,
+) -> bool {
+    let mut test = |u: DVec3| {
+        let (b_lo, b_hi) = project(&fixed.vertices, u);
+        let (a_lo, a_hi) = project(moving, u);
+        let gap = (b_lo - a_hi).max(a_lo - b_hi);
+        let value = if rule.weight == 0.0 { gap } else { gap - rule.weight * (1.0 - u.z * u.z).max(0.0).sqrt() };
+        *best = best.max(value);
+        rule.decided(*best)
+    };
+    if normals {
+        for &u in moving_normals.iter().chain(&fixed.normal_axes) {
+            if test(u) {
+                return true;
+            }
+        }
+        return false;
+    }
+    for &da in moving_edges {
+        for &db in &fixed.edge_directions {
+            let c = da.cross(db);
+            let len2 = c.length_squared();
+            if len2 > 1e-18 && test(c / len2.sqrt()) {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+/// What [`AxesCache`] knows of a pair: tested once (its axes are computed on the fly), or its [`PairAxes`] (built
+/// on the second test, so pairs tested once cost no allocation).
+#[derive(Debug, Clone)]
+pub enum PairEntry {
+    /// Tested once.
+    Seen,
+    /// Tested more than once.
+    Axes(PairAxes),
+}
+
+/// A multiplicative hasher for the small integer keys of [`AxesCache`] (the standard SipHash dominated the lookups).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct KeyHasher(u64);
+
+impl std::hash::Hasher for KeyHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(u64::from(b));
+        }
+    }
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    fn write_usize(&mut self, x: usize) {
+        self.write_u64(x as u64);
+    }
+}
+
+/// The separating-axis data of the pairs tested so far, by (orientation index, moving component, stack component).
+pub type AxesCache = HashMap<(usize, usize, usize), PairEntry, std::hash::BuildHasherDefault<KeyHasher>>;
+
+#[inline]
+fn project(vertices: &[DVec3], u: DVec3) -> (f64, f64) {
+    let mut lo = f64::INFINITY;
+    let mut hi = f64::NEG_INFINITY;
+    for v in vertices {
+        let x = u.dot(*v);
+        lo = lo.min(x);
+        hi = hi.max(x);
+    }
+    (lo, hi)
+}
+
+/// A pair whose normal axes did not decide it: the running maximum so far (an upper bound of its violation follows
+/// from it) and whether its scan runs on the fly or on cached axes.
+#[derive(Debug, Clone, Copy)]
+struct OpenPair {
+    moving: usize,
+    fixed: usize,
+    best: f64,
+    direct: bool,
+    /// Axes scanned so far (cached path).
+    scanned: usize,
+}
+
+/// The violating pairs of an orientation at `p`, produced lazily in the order of [`candidates`] (largest violation
+/// first, then moving, then stack component).
+///
+/// Every pair that passes the boxes is scanned on its normal axes at once (most non-violating pairs are decided
+/// there); the others stay *open* with an upper bound of their violation from the running maximum (a maximum over
+/// fewer axes is smaller, and the distance that `classify_pair` takes from GJK is at least the separating-axis
+/// gap, up to GJK's accuracy, for which the bound keeps a margin). [`CandidateQueue::next`] returns a pair only when its exact violation is at least every open bound (ties
+/// by the same index order), finishing open scans on demand: the sequence is the one of sorting the exact
+/// violations, but the pairs after the one the search cuts with are never scanned to the end.
+#[derive(Debug)]
+pub struct CandidateQueue {
+    p: DVec3,
+    clearance: f64,
+    horizontal: bool,
+    tol: f64,
+    rule: Rule,
+    moved: Vec<Vec<DVec3>>,
+    open: Vec<OpenPair>,
+    exact: Vec<Candidate>,
+}
+
+/// `a` comes before `b` in the candidates' order.
+fn precedes(a: (f64, usize, usize), b: (f64, usize, usize)) -> bool {
+    b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)) == std::cmp::Ordering::Less
+}
+
+impl CandidateQueue {
+    /// Broad phase and the normal-axis scans (see the type's documentation). `cache` keeps the position-free part
+    /// of each pair's separating-axis test between calls (keyed by `orientation.index`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        scene: &StackScene,
+        orientation: &Orientation,
+        sweep: Option<&SweepAxes>,
+        p: DVec3,
+        clearance: f64,
+        horizontal_clearance: bool,
+        tol: f64,
+        cache: &mut AxesCache,
+        counts: &mut DetectCounts,
+    ) -> Self {
+        let horizontal = horizontal_clearance && clearance > 0.0;
+        let rule = if horizontal {
+            Rule { weight: clearance, stop: -tol, inclusive: true }
+        } else {
+            Rule { weight: 0.0, stop: tol.max(clearance), inclusive: false }
+        };
+        let mut queue = Self {
+            p,
+            clearance,
+            horizontal,
+            tol,
+            rule,
+            moved: vec![Vec::new(); orientation.components.len()],
+            open: Vec::new(),
+            exact: Vec::new(),
+        };
+        let margin = clearance + tol;
+        // broad phase in two levels: the stack components near the whole part's box (a superset of each
+        // component's, the sweep reaching up without bound), then each component's box
+        let part_box = match sweep {
+            Some(_) => (orientation.lo + p, DVec3::new(orientation.hi.x + p.x, orientation.hi.y + p.y, f64::INFINITY)),
+            None => (orientation.lo + p, orientation.hi + p),
+        };
+        let near: Vec<usize> = scene
+            .components
+            .iter()
+            .enumerate()
+            .filter(|(_, f)| boxes_overlap(&part_box, &f.placed.aabb, margin))
+            .map(|(i, _)| i)
+            .collect();
+        for (mi, placed) in orientation.components.iter().enumerate() {
+            if near.is_empty() {
+                break;
+            }
+            let (moved_box, lift) = match sweep {
+                Some(_) => {
+                    let lift = (scene.top - (placed.aabb.0.z + p.z)).max(0.0) + 1.0;
+                    ((placed.aabb.0 + p, placed.aabb.1 + p + DVec3::new(0.0, 0.0, lift)), lift)
+                }
+                None => ((placed.aabb.0 + p, placed.aabb.1 + p), 0.0),
+            };
+            let (normals, edges) = match sweep {
+                Some(s) => (&s.axes[mi].0, &s.axes[mi].1),
+                None => (&placed.normal_axes, &placed.edge_directions),
+            };
+            for &fi in &near {
+                let fixed = &scene.components[fi];
+                if !boxes_overlap(&moved_box, &fixed.placed.aabb, margin) {
+                    continue;
+                }
+                counts.narrow_phase += 1;
+                let moving = &mut queue.moved[mi];
+                if moving.is_empty() {
+                    // the same sums as `translated` / `swept`
+                    moving.extend(placed.vertices.iter().map(|v| *v + p));
+                    if sweep.is_some() {
+                        let n = moving.len();
+                        for k in 0..n {
+                            moving.push(moving[k] + DVec3::new(0.0, 0.0, lift));
+                        }
+                    }
+                }
+                let mut best = f64::NEG_INFINITY;
+                // first test of the pair: on the fly; second: build and keep its axes; later: reuse them
+                let (decided, direct, scanned) = match cache.entry((orientation.index, mi, fi)) {
+                    Entry::Vacant(v) => {
+                        v.insert(PairEntry::Seen);
+                        (scan_direct(normals, edges, &fixed.placed, moving, &rule, true, &mut best), true, 0)
+                    }
+                    Entry::Occupied(o) => {
+                        let e = o.into_mut();
+                        if let PairEntry::Seen = e {
+                            *e = PairEntry::Axes(PairAxes::new(normals, edges, &fixed.placed));
+                        }
+                        match e {
+                            PairEntry::Axes(axes) => {
+                                let k = (normals.len() + fixed.placed.normal_axes.len()).min(axes.axes.len());
+                                (axes.scan(moving, &rule, 0..k, &mut best), false, k)
+                            }
+                            PairEntry::Seen => {
+                                (scan_direct(normals, edges, &fixed.placed, moving, &rule, true, &mut best), true, 0)
+                            }
+                        }
+                    }
+                };
+                if !decided {
+                    queue.open.push(OpenPair { moving: mi, fixed: fi, best, direct, scanned });
+                }
+            }
+        }
+        queue
+    }
+
+    /// Upper bound of an open pair's violation: from the running maximum, plus (with a clearance, where
+    /// `classify_pair` replaces the gap by parry's GJK distance, which is the true distance only up to GJK's own
+    /// accuracy) a margin of `1e-3 clearance + tol` covering GJK's error.
+    fn bound(&self, o: &OpenPair) -> f64 {
+        if self.horizontal {
+            -o.best
+        } else if self.clearance > self.tol {
+            self.clearance - o.best + 1e-3 * self.clearance + self.tol
+        } else {
+            self.clearance - o.best
+        }
+    }
+
+    /// The next violating pair (see the type's documentation), `None` when there is none left.
+    pub fn next(
+        &mut self,
+        scene: &StackScene,
+        orientation: &Orientation,
+        sweep: Option<&SweepAxes>,
+        cache: &mut AxesCache,
+    ) -> Option<Candidate> {
+        loop {
+            let best_exact = (0..self.exact.len()).reduce(|a, b| {
+                let (x, y) = (&self.exact[a], &self.exact[b]);
+                if precedes((y.violation, y.moving, y.fixed), (x.violation, x.moving, x.fixed)) { b } else { a }
+            });
+            let best_open = (0..self.open.len()).reduce(|a, b| {
+                let (x, y) = (&self.open[a], &self.open[b]);
+                if precedes((self.bound(y), y.moving, y.fixed), (self.bound(x), x.moving, x.fixed)) { b } else { a }
+            });
+            let refine = match (best_exact, best_open) {
+                (None, None) => return None,
+                (Some(e), None) => return Some(self.exact.swap_remove(e)),
+                (None, Some(o)) => o,
+                (Some(e), Some(o)) => {
+                    let (x, y) = (&self.exact[e], &self.open[o]);
+                    if precedes((self.bound(y), y.moving, y.fixed), (x.violation, x.moving, x.fixed)) {
+                        o
+                    } else {
+                        return Some(self.exact.swap_remove(e));
+                    }
+                }
+            };
+            let open = self.open.swap_remove(refine);
+            if let Some(c) = self.finish(open, scene, orientation, sweep, cache) {
+                self.exact.push(c);
+            }
+        }
+    }
+
+    /// Scans an open pair's remaining axes and classifies it as `classify_pair` / [`horizontal_slack`] would.
+    fn finish(
+        &self,
+        mut open: OpenPair,
+        scene: &StackScene,
+        orientation: &Orientation,
+        sweep: Option<&SweepAxes>,
+        cache: &mut AxesCache,
+    ) -> Option<Candidate> {
+        let (mi, fi) = (open.moving, open.fixed);
+        let placed = &orientation.components[mi];
+        let fixed = &scene.components[fi];
+        let moving = &self.moved[mi];
+        let decided = if open.direct {
+            let (normals, edges) = match sweep {
+                Some(s) => (&s.axes[mi].0, &s.axes[mi].1),
+                None => (&placed.normal_axes, &placed.edge_directions),
+            };
+            scan_direct(normals, edges, &fixed.placed, moving, &self.rule, false, &mut open.best)
+        } else {
+            match cache.get_mut(&(orientation.index, mi, fi)) {
+                Some(PairEntry::Axes(axes)) => {
+                    let n = axes.axes.len();
+                    axes.scan(moving, &self.rule, open.scanned..n, &mut open.best)
+                }
+                // the entry was built when the pair was opened: cannot happen
+                _ => false,
+            }
+        };
+        let tol = self.tol;
+        let clearance = self.clearance;
+        if self.horizontal {
+            let slack = open.best;
+            return (!decided && slack < -tol).then_some(Candidate { moving: mi, fixed: fi, violation: -slack });
+        }
+        // `classify_pair`'s decisions on the same gap
+        let gap = open.best;
+        let contact = if gap < -tol {
+            PairContact::Penetrating { depth: -gap }
+        } else if gap <= tol {
+            PairContact::Touching { gap }
+        } else if clearance > tol && gap < clearance {
+            let moved = match sweep {
+                Some(s) => swept(placed, &s.axes[mi], self.p, scene.top),
+                None => translated(placed, self.p),
+            };
+            PairContact::Separated { gap: gjk_distance(&moved, &fixed.placed).unwrap_or(gap) }
+        } else {
+            PairContact::Separated { gap }
+        };
+        let violation = match contact {
+            PairContact::Penetrating { depth } => depth + clearance,
+            PairContact::Touching { gap } if clearance > tol => clearance - gap,
+            PairContact::Separated { gap } if clearance > tol && gap < clearance - tol => clearance - gap,
+            _ => return None,
+        };
+        Some(Candidate { moving: mi, fixed: fi, violation })
+    }
+}
+
+/// The violating pairs of the orientation at `p`, all of them, in order (largest violation first, then moving, then
+/// stack component): [`CandidateQueue`] drained. The answers are the ones of `classify_pair` and
+/// [`horizontal_slack`] on the moved components.
+#[allow(clippy::too_many_arguments)]
 pub fn candidates(
     scene: &StackScene,
     orientation: &Orientation,
@@ -169,61 +584,15 @@ pub fn candidates(
     clearance: f64,
     horizontal_clearance: bool,
     tol: f64,
+    cache: &mut AxesCache,
     counts: &mut DetectCounts,
 ) -> Vec<Candidate> {
+    let mut queue =
+        CandidateQueue::new(scene, orientation, sweep, p, clearance, horizontal_clearance, tol, cache, counts);
     let mut out = Vec::new();
-    let margin = clearance + tol;
-    // broad phase in two levels: the stack components near the whole part's box (a superset of each component's,
-    // the sweep reaching up without bound), then each component's box; a component is moved only when some stack
-    // box meets its own
-    let part_box = match sweep {
-        Some(_) => (orientation.lo + p, DVec3::new(orientation.hi.x + p.x, orientation.hi.y + p.y, f64::INFINITY)),
-        None => (orientation.lo + p, orientation.hi + p),
-    };
-    let near: Vec<usize> = scene
-        .components
-        .iter()
-        .enumerate()
-        .filter(|(_, f)| boxes_overlap(&part_box, &f.placed.aabb, margin))
-        .map(|(i, _)| i)
-        .collect();
-    if near.is_empty() {
-        return out;
+    while let Some(c) = queue.next(scene, orientation, sweep, cache) {
+        out.push(c);
     }
-    for (mi, placed) in orientation.components.iter().enumerate() {
-        let moved_box = match sweep {
-            Some(_) => swept_box(placed, p, scene.top),
-            None => (placed.aabb.0 + p, placed.aabb.1 + p),
-        };
-        let mut moved: Option<PlacedConvex> = None;
-        for &fi in &near {
-            let fixed = &scene.components[fi];
-            if !boxes_overlap(&moved_box, &fixed.placed.aabb, margin) {
-                continue;
-            }
-            let moved = moved.get_or_insert_with(|| match sweep {
-                Some(axes) => swept(placed, &axes.axes[mi], p, scene.top),
-                None => translated(placed, p),
-            });
-            counts.narrow_phase += 1;
-            if horizontal_clearance && clearance > 0.0 {
-                let slack = horizontal_slack(moved, &fixed.placed, clearance);
-                if slack >= -tol {
-                    continue;
-                }
-                out.push(Candidate { moving: mi, fixed: fi, violation: -slack });
-                continue;
-            }
-            let violation = match classify_pair(moved, &fixed.placed, tol, clearance) {
-                PairContact::Penetrating { depth } => depth + clearance,
-                PairContact::Touching { gap } if clearance > tol => clearance - gap,
-                PairContact::Separated { gap } if clearance > tol && gap < clearance - tol => clearance - gap,
-                _ => continue,
-            };
-            out.push(Candidate { moving: mi, fixed: fi, violation });
-        }
-    }
-    out.sort_by(|a, b| b.violation.total_cmp(&a.violation).then(a.moving.cmp(&b.moving)).then(a.fixed.cmp(&b.fixed)));
     out
 }
 
@@ -231,6 +600,13 @@ pub fn candidates(
 /// cross products), of `gap_u - clearance |u_xy|`. Non-negative iff the pair stays apart when one of them is moved
 /// horizontally by at most `clearance` (up to the mitring of the axis set); negative values measure the violation.
 pub fn horizontal_slack(a: &PlacedConvex, b: &PlacedConvex, clearance: f64) -> f64 {
+    horizontal_slack_below(a, b, clearance, f64::INFINITY)
+}
+
+/// [`horizontal_slack`] that stops as soon as an axis shows a slack of at least `stop` and returns that axis' value
+/// (a value `>= stop`, not necessarily the largest): the pair is then known not to violate. Below `stop` the value is
+/// the exact maximum over all axes (the same arithmetic in the same order as [`horizontal_slack`]).
+pub fn horizontal_slack_below(a: &PlacedConvex, b: &PlacedConvex, clearance: f64, stop: f64) -> f64 {
     let project = |vs: &[DVec3], u: DVec3| {
         vs.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
             let x = u.dot(*v);
@@ -243,18 +619,147 @@ pub fn horizontal_slack(a: &PlacedConvex, b: &PlacedConvex, clearance: f64) -> f
         let (b_lo, b_hi) = project(&b.vertices, u);
         let gap = (b_lo - a_hi).max(a_lo - b_hi);
         best = best.max(gap - clearance * (1.0 - u.z * u.z).max(0.0).sqrt());
+        best >= stop
     };
     for &u in a.normal_axes.iter().chain(&b.normal_axes) {
-        test(u);
+        if test(u) {
+            return best;
+        }
     }
     for &da in &a.edge_directions {
         for &db in &b.edge_directions {
             let c = da.cross(db);
             let len2 = c.length_squared();
-            if len2 > 1e-18 {
-                test(c / len2.sqrt());
+            if len2 > 1e-18 && test(c / len2.sqrt()) {
+                return best;
             }
         }
     }
     best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::request::Cost;
+    use stackplan_cspace::interference::classify_pair;
+    use stackplan_geom::{PartOrigin, convex_hull};
+
+    fn cuboid(lo: DVec3, hi: DVec3) -> ConvexPolytope {
+        let pts: Vec<DVec3> = (0..8)
+            .map(|i| {
+                DVec3::new(
+                    if i & 1 == 0 { lo.x } else { hi.x },
+                    if i & 2 == 0 { lo.y } else { hi.y },
+                    if i & 4 == 0 { lo.z } else { hi.z },
+                )
+            })
+            .collect();
+        convex_hull(&pts).expect("box").polytope
+    }
+
+    fn l_part(a: f64, t: f64, h: f64) -> Part {
+        let c = vec![
+            cuboid(DVec3::ZERO, DVec3::new(a, t, h)),
+            cuboid(DVec3::new(0.0, t, 0.0), DVec3::new(t, a, h)),
+            cuboid(DVec3::new(0.0, 0.0, h), DVec3::new(a * 0.5, a * 0.5, h + t)),
+        ];
+        Part::from_components("l", c, 1.0, PartOrigin::ConvexPieces).expect("part")
+    }
+
+    /// The reference: every pair moved and classified by `classify_pair` / `horizontal_slack` of the full axis set,
+    /// sorted by (violation desc, moving, fixed).
+    fn reference(
+        scene: &StackScene,
+        o: &Orientation,
+        sweep: Option<&SweepAxes>,
+        p: DVec3,
+        clearance: f64,
+        horizontal: bool,
+        tol: f64,
+    ) -> Vec<Candidate> {
+        let mut out = Vec::new();
+        for (mi, placed) in o.components.iter().enumerate() {
+            let moved = match sweep {
+                Some(s) => swept(placed, &s.axes[mi], p, scene.top),
+                None => translated(placed, p),
+            };
+            for (fi, fixed) in scene.components.iter().enumerate() {
+                if !boxes_overlap(&moved.aabb, &fixed.placed.aabb, clearance + tol) {
+                    continue;
+                }
+                if horizontal && clearance > 0.0 {
+                    let slack = horizontal_slack(&moved, &fixed.placed, clearance);
+                    if slack < -tol {
+                        out.push(Candidate { moving: mi, fixed: fi, violation: -slack });
+                    }
+                    continue;
+                }
+                let violation = match classify_pair(&moved, &fixed.placed, tol, clearance) {
+                    PairContact::Penetrating { depth } => depth + clearance,
+                    PairContact::Touching { gap } if clearance > tol => clearance - gap,
+                    PairContact::Separated { gap } if clearance > tol && gap < clearance - tol => clearance - gap,
+                    _ => continue,
+                };
+                out.push(Candidate { moving: mi, fixed: fi, violation });
+            }
+        }
+        out.sort_by(|a, b| {
+            b.violation.total_cmp(&a.violation).then(a.moving.cmp(&b.moving)).then(a.fixed.cmp(&b.fixed))
+        });
+        out
+    }
+
+    /// The lazy queue (first and repeated tests of each pair, i.e. on-the-fly and cached axes) gives exactly the
+    /// reference's pairs, order and violations (bit for bit), with and without clearance, horizontal clearance and
+    /// sweeps, at positions from far apart to deeply overlapping.
+    #[test]
+    fn queue_matches_the_full_separating_axis_test() {
+        let part = l_part(30.0, 8.0, 10.0);
+        let stack_pose = |k: usize| Pose {
+            rotation: DMat3::from_rotation_z(0.3 * k as f64),
+            position: DVec3::new(25.0 * k as f64, 10.0 * (k % 2) as f64, 12.0 * (k / 2) as f64),
+        };
+        let parts = [(&part, stack_pose(0)), (&part, stack_pose(1)), (&part, stack_pose(2))];
+        let scene = StackScene::new(&parts);
+        let tol = 1e-9 * 200.0;
+        let mut seed: u64 = 12345;
+        let mut rnd = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut total = 0;
+        for (clearance, horizontal, insertion) in
+            [(0.0, false, false), (3.0, false, false), (3.0, true, false), (3.0, true, true), (0.0, false, true)]
+        {
+            let mut cache = AxesCache::default();
+            for ti in 0..6 {
+                let theta = ti as f64 * 0.7;
+                let cost = Cost::Target { target: DVec3::ZERO };
+                let o = Orientation::new(&part, ti, 0, ti, theta, DMat3::IDENTITY, &cost);
+                let sweep = insertion.then(|| SweepAxes::new(&part, o.rotation, &o));
+                for _ in 0..12 {
+                    let p = DVec3::new(rnd() * 70.0 - 10.0, rnd() * 40.0 - 10.0, rnd() * 30.0);
+                    let expected = reference(&scene, &o, sweep.as_ref(), p, clearance, horizontal, tol);
+                    for _ in 0..2 {
+                        let mut counts = DetectCounts::default();
+                        let got = candidates(
+                            &scene,
+                            &o,
+                            sweep.as_ref(),
+                            p,
+                            clearance,
+                            horizontal,
+                            tol,
+                            &mut cache,
+                            &mut counts,
+                        );
+                        assert_eq!(got, expected, "p {p}, theta {theta}, clearance {clearance}, {horizontal}");
+                    }
+                    total += expected.len();
+                }
+            }
+        }
+        assert!(total > 50, "too few violating pairs to be a test: {total}");
+    }
 }

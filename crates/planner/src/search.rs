@@ -38,7 +38,7 @@
 //! narrow phase on overlapping boxes) and at most one obstacle construction. Root QPs run in parallel (rayon); the
 //! loop itself is sequential, so the result does not depend on the thread count.
 
-use crate::detect::{DetectCounts, StackScene, SweepAxes, candidates};
+use crate::detect::{AxesCache, CandidateQueue, DetectCounts, StackScene, SweepAxes};
 use crate::obstacles::DerivedObstacle;
 use crate::orientation::{Orientation, SeparableQuadratic};
 use crate::qp::{QpOptimum, Quadratic, minimise};
@@ -261,6 +261,7 @@ struct Search<'r, 'a> {
     cache: &'r ObstacleCache,
     obstacles: Vec<DerivedObstacle>,
     obstacle_ids: HashMap<(usize, usize, usize), u32>,
+    axes: AxesCache,
     stats: PlacementStats,
 }
 
@@ -335,6 +336,7 @@ pub fn place_with_cache(
         cache,
         obstacles: Vec::new(),
         obstacle_ids: HashMap::new(),
+        axes: AxesCache::default(),
         stats,
     };
     let before = cache.stats();
@@ -476,7 +478,7 @@ impl Search<'_, '_> {
             let p = lift(&optimum.point, fixed_z);
             let t_det = Instant::now();
             let mut counts = DetectCounts::default();
-            let cands = candidates(
+            let mut queue = CandidateQueue::new(
                 &self.scene,
                 &self.orientations[node.orientation],
                 self.sweeps[node.orientation].as_ref(),
@@ -484,14 +486,25 @@ impl Search<'_, '_> {
                 clearance,
                 self.request.horizontal_clearance,
                 tol,
+                &mut self.axes,
                 &mut counts,
             );
             self.stats.interference_tests += 1;
             self.stats.narrow_phase_tests += counts.narrow_phase;
             self.stats.time_interference_ms += ms(t_det);
-            // the first candidate whose obstacle holds p* in its interior
+            // the first candidate (deepest first) whose obstacle holds p* in its interior; the queue finishes the
+            // pairs' separating-axis scans only as far as this needs
             let mut cutting: Option<u32> = None;
-            for c in &cands {
+            loop {
+                let t_det = Instant::now();
+                let next = queue.next(
+                    &self.scene,
+                    &self.orientations[node.orientation],
+                    self.sweeps[node.orientation].as_ref(),
+                    &mut self.axes,
+                );
+                self.stats.time_interference_ms += ms(t_det);
+                let Some(c) = next else { break };
                 let id = self.obstacle_id(node.orientation, c.moving, c.fixed)?;
                 if node.applied.contains(&id) {
                     continue;
