@@ -2,9 +2,10 @@
 //!
 //! * `cargo xtask fixtures [--check]` writes `fixtures/parts/` from the built-in example parts, deterministically;
 //!   `--check` fails when a committed fixture differs from what the code generates (stale fixture).
-//! * `cargo xtask regress [--bless] [FILTER]` runs every scenario in `fixtures/regress/*.json` through the library,
+//! * `cargo xtask regress [--bless] [--slow] [FILTER]` runs every scenario in `fixtures/regress/*.json` through the library,
 //!   compares the results with the golden files in `fixtures/regress/golden/` (tolerances per field), prints a table
-//!   and exits non-zero on any difference; `--bless` rewrites the goldens.
+//!   and exits non-zero on any difference; `--bless` rewrites the goldens; `--slow` adds `fixtures/regress/slow/`
+//!   (scenarios too slow for CI, such as the seed's 121-cube Fig. 2).
 
 #![allow(clippy::print_stdout, clippy::print_stderr)] // xtask is a terminal program
 
@@ -21,7 +22,7 @@ fn workspace_root() -> PathBuf {
 }
 
 fn usage() -> ExitCode {
-    eprintln!("usage: cargo xtask fixtures [--check] | cargo xtask regress [--bless] [FILTER]");
+    eprintln!("usage: cargo xtask fixtures [--check] | cargo xtask regress [--bless] [--slow] [FILTER]");
     ExitCode::from(2)
 }
 
@@ -36,7 +37,8 @@ fn main() -> ExitCode {
         Some("regress") => {
             let bless = args.iter().any(|a| a == "--bless");
             let filter = args.iter().skip(1).find(|a| !a.starts_with("--")).cloned();
-            regress::run(&root, bless, filter.as_deref())
+            let slow = args.iter().any(|a| a == "--slow");
+            regress::run(&root, bless, filter.as_deref(), slow)
         }
         _ => return usage(),
     };

@@ -5,7 +5,8 @@
 //! Running it yields a flat map of named result fields (numbers, integers, strings, booleans, arrays of them).
 //! Numbers are compared with `|actual - golden| <= max(abs, rel * |golden|)` (default rel 1e-9, abs 1e-12; a field
 //! named in `tolerances` uses its own); everything else must be equal. Fields prefixed with `info_` are recorded
-//! (e.g. timings) but never compared.
+//! (e.g. timings) but never compared. `--slow` adds the scenarios of `fixtures/regress/slow/` (too slow for CI in
+//! the dev profile, e.g. the seed's full 121-cube Fig. 2; goldens in `fixtures/regress/slow/golden/`).
 
 use anyhow::Context;
 use serde_json::{Map, Value};
@@ -62,12 +63,29 @@ fn short(v: &Value) -> String {
     if s.len() > 38 { format!("{}...", &s[..35]) } else { s }
 }
 
-/// Runs the scenarios; returns false when any result differs from its golden (or a golden is missing).
-pub fn run(root: &Path, bless: bool, filter: Option<&str>) -> anyhow::Result<bool> {
+/// Runs the scenarios of `fixtures/regress/` (and, with `slow`, of `fixtures/regress/slow/`, each directory with
+/// its own `golden/`); returns false when any result differs from its golden (or a golden is missing).
+pub fn run(root: &Path, bless: bool, filter: Option<&str>, slow: bool) -> anyhow::Result<bool> {
     let dir = root.join("fixtures").join("regress");
+    println!("{:<34} {:<28} {:<40} {:<40} status", "scenario", "field", "golden", "actual");
+    let mut all_ok = run_dir(&dir, bless, filter)?;
+    if slow {
+        all_ok &= run_dir(&dir.join("slow"), bless, filter)?;
+    }
+    if !bless {
+        println!(
+            "{}",
+            if all_ok { "regress: all scenarios match their goldens" } else { "regress: DIFFERENCES FOUND" }
+        );
+    }
+    Ok(all_ok)
+}
+
+/// The scenarios of one directory.
+fn run_dir(dir: &Path, bless: bool, filter: Option<&str>) -> anyhow::Result<bool> {
     let golden_dir = dir.join("golden");
     std::fs::create_dir_all(&golden_dir)?;
-    let mut files: Vec<_> = std::fs::read_dir(&dir)
+    let mut files: Vec<_> = std::fs::read_dir(dir)
         .with_context(|| format!("cannot read {}", dir.display()))?
         .filter_map(Result::ok)
         .map(|e| e.path())
@@ -75,7 +93,6 @@ pub fn run(root: &Path, bless: bool, filter: Option<&str>) -> anyhow::Result<boo
         .collect();
     files.sort();
     let mut all_ok = true;
-    println!("{:<34} {:<28} {:<40} {:<40} status", "scenario", "field", "golden", "actual");
     for path in files {
         let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         if filter.is_some_and(|f| !name.contains(f)) {
@@ -85,7 +102,7 @@ pub fn run(root: &Path, bless: bool, filter: Option<&str>) -> anyhow::Result<boo
         let scenario: Value =
             serde_json::from_str(&text).with_context(|| format!("{} is not valid JSON", path.display()))?;
         let started = std::time::Instant::now();
-        let mut fields = match crate::scenarios::run(&scenario, &dir) {
+        let mut fields = match crate::scenarios::run(&scenario, dir) {
             Ok(f) => f,
             Err(e) => {
                 println!("{name:<34} {:<28} {:<40} {:<40} ERROR", "-", "-", format!("{e:#}"));
@@ -133,12 +150,6 @@ pub fn run(root: &Path, bless: bool, filter: Option<&str>) -> anyhow::Result<boo
             let show = |v: Option<&Value>| v.map_or_else(|| "(missing)".to_string(), short);
             println!("{name:<34} {key:<28} {:<40} {:<40} {status}", show(g), show(a));
         }
-    }
-    if !bless {
-        println!(
-            "{}",
-            if all_ok { "regress: all scenarios match their goldens" } else { "regress: DIFFERENCES FOUND" }
-        );
     }
     Ok(all_ok)
 }

@@ -7,14 +7,18 @@
 //!   evaluated over the total.
 //! * `plan`: a stacking plan (`stackplan::planner::plan_stack`) of `count` parts at weight `w`: parts placed, height,
 //!   footprint, total cost, layers (distinct c.g. heights), whether every part passed and the whole stack is stable.
+//!   Optional assertions, checked in code (a failure is an error, whatever the golden holds): `"expect_shape"`
+//!   (`flat`, `column`, `pyramid`: the seed's Fig. 2; adds `layer_counts`, parts per layer bottom up), `"check": true`
+//!   (the finished plan passes `stackplan check` with the planner's mu, cup and clearance; adds `check_ok`) and
+//!   `"expect_height_below"` (mm: the stack nests). These add `info_plan_seconds` (planning alone).
 //! * `orient_intervals`: the constant-topology intervals and sweep counts of every convex pair of two parts over a
 //!   full turn (`stackplan::orient_interval::regress_summary`).
 
 use crate::regress::Fields;
 use anyhow::{Context, bail};
 use serde_json::Value;
-use stackplan_geom::Part;
 use stackplan_geom::sheet_metal::Decomposition;
+use stackplan_geom::{DVec3, Part, Pose};
 use std::path::Path;
 
 /// Runs one scenario (`dir` is the scenario's directory, for relative paths).
@@ -134,7 +138,9 @@ fn plan(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
     options.clearance = num("clearance").unwrap_or(5.0);
     options.dtheta = num("dtheta_deg").unwrap_or(1.0).to_radians();
     options.cup_diameter = num("cup_diameter").unwrap_or(options.cup_diameter);
+    let started = std::time::Instant::now();
     let plan = plan_stack(&part, &options)?;
+    let plan_seconds = started.elapsed().as_secs_f64();
     let mut layers: Vec<f64> = plan.parts.iter().map(|p| (p.cg_height * 1e6).round() / 1e6).collect();
     layers.sort_by(f64::total_cmp);
     layers.dedup();
@@ -150,5 +156,136 @@ fn plan(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
     f.insert("stage_1_parts".into(), plan.parts.iter().filter(|p| p.stage == 1).count().into());
     f.insert("info_searches".into(), plan.stats.searches.into());
     f.insert("info_pairs_evaluated".into(), plan.stats.pairs_evaluated.into());
+    // optional assertions, in code: the result fails the scenario (an error) whatever the golden says
+    let poses: Vec<Pose> = plan
+        .parts
+        .iter()
+        .map(|p| Pose::from_rows(p.rotation, DVec3::from_array(p.position)))
+        .collect::<Result<_, _>>()?;
+    if let Some(shape) = scenario.get("expect_shape").and_then(Value::as_str) {
+        let counts = layer_counts(&part, &poses);
+        f.insert("layer_counts".into(), counts.clone().into());
+        f.insert("info_plan_seconds".into(), ((plan_seconds * 1e3).round() / 1e3).into());
+        expect_shape(shape, count, &plan.parts.len(), &counts)?;
+    }
+    if scenario.get("check").and_then(Value::as_bool) == Some(true) {
+        f.insert("info_plan_seconds".into(), ((plan_seconds * 1e3).round() / 1e3).into());
+        f.insert("check_ok".into(), check_plan(&part, &poses, &options)?.into());
+    }
+    if let Some(limit) = num("expect_height_below") {
+        anyhow::ensure!(
+            plan.height < limit,
+            "the stack is {} mm high, expected below {limit} mm (nesting)",
+            plan.height
+        );
+    }
     Ok(f)
+}
+
+/// Parts per layer, bottom up: the parts' lowest points sorted, a new layer wherever the gap to the previous lowest
+/// point exceeds 1% of the part's height (computed here independently of the CLI's `sweep`).
+fn layer_counts(part: &Part, poses: &[Pose]) -> Vec<usize> {
+    let (lo, hi) = part.aabb();
+    let gap = 0.01 * (hi.z - lo.z);
+    let mut bottoms: Vec<f64> = poses
+        .iter()
+        .map(|p| part.components.iter().flat_map(|c| c.vertices()).map(|v| p.apply(*v).z).fold(f64::INFINITY, f64::min))
+        .collect();
+    bottoms.sort_by(f64::total_cmp);
+    let mut counts = Vec::new();
+    for (k, b) in bottoms.iter().enumerate() {
+        if k == 0 || b - bottoms[k - 1] > gap {
+            counts.push(0usize);
+        }
+        if let Some(last) = counts.last_mut() {
+            *last += 1;
+        }
+    }
+    counts
+}
+
+/// The shapes of the seed's Fig. 2: `flat` (w = 0: one layer, every part on the floor), `column` (w = 1: one part
+/// per layer), `pyramid` (in between: more than one layer, fewer than parts, each layer no larger than the one below
+/// and the bottom layer larger than the top one).
+fn expect_shape(shape: &str, count: usize, placed: &usize, counts: &[usize]) -> anyhow::Result<()> {
+    anyhow::ensure!(*placed == count, "{placed} of {count} parts placed");
+    let layers = counts.len();
+    match shape {
+        "flat" => anyhow::ensure!(layers == 1, "expected one layer on the floor, got layers {counts:?}"),
+        "column" => anyhow::ensure!(counts.iter().all(|&c| c == 1), "expected a single column, got layers {counts:?}"),
+        "pyramid" => {
+            anyhow::ensure!(1 < layers && layers < count, "expected between 1 and {count} layers, got {counts:?}");
+            anyhow::ensure!(
+                counts.windows(2).all(|w| w[0] >= w[1]) && counts[0] > counts[layers - 1],
+                "expected lower layers larger than upper ones, got {counts:?}"
+            );
+        }
+        other => bail!("unknown expect_shape {other:?} (flat, column, pyramid)"),
+    }
+    Ok(())
+}
+
+/// Runs the stack check on a plan with the planner's friction, cup and (horizontal) clearance less 1e-6 mm; fails
+/// the scenario naming every part that does not pass.
+fn check_plan(part: &Part, poses: &[Pose], options: &stackplan::planner::PlanOptions) -> anyhow::Result<bool> {
+    use stackplan::stability::check::{CheckOptions, check_stack};
+    use stackplan::stability::grasp::GraspOptions;
+    use stackplan::stability::world::PlacedPart;
+    let stack: Vec<PlacedPart<'_>> =
+        poses.iter().map(|p| PlacedPart { part, rotation: p.rotation, position: p.position }).collect();
+    let check = CheckOptions {
+        mu: options.mu,
+        clearance: (options.clearance - 1e-6).max(0.0),
+        grasp: GraspOptions { cup_diameter: options.cup_diameter, ..GraspOptions::default() },
+        ..CheckOptions::default()
+    };
+    let report = check_stack(&stack, &check)?;
+    let failed: Vec<String> = report
+        .parts
+        .iter()
+        .filter(|p| !p.ok)
+        .map(|p| {
+            format!(
+                "part {}: interference {:.3e}, clearance met {}, stable {}, stack stable {}, graspable {}, insertable {}, removable {}",
+                p.index,
+                p.interference,
+                p.clearance_met,
+                p.stable.is_stable(),
+                p.stack_stable.is_stable(),
+                p.graspable,
+                p.insertable,
+                p.removable
+            )
+        })
+        .collect();
+    anyhow::ensure!(report.ok, "the plan fails the stack check: {}", failed.join("; "));
+    Ok(report.ok)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shapes_of_fig_2_are_told_apart() {
+        assert!(expect_shape("flat", 4, &4, &[4]).is_ok());
+        assert!(expect_shape("flat", 4, &3, &[3]).is_err(), "a part missing");
+        assert!(expect_shape("flat", 4, &4, &[3, 1]).is_err());
+        assert!(expect_shape("column", 3, &3, &[1, 1, 1]).is_ok());
+        assert!(expect_shape("column", 3, &3, &[2, 1]).is_err());
+        assert!(expect_shape("pyramid", 14, &14, &[9, 4, 1]).is_ok());
+        assert!(expect_shape("pyramid", 6, &6, &[3, 3]).is_err(), "the bottom must be larger than the top");
+        assert!(expect_shape("pyramid", 6, &6, &[2, 3, 1]).is_err(), "a layer larger than the one below");
+        assert!(expect_shape("pyramid", 4, &4, &[4]).is_err());
+        assert!(expect_shape("cone", 4, &4, &[4]).is_err());
+    }
+
+    #[test]
+    fn layers_are_resting_heights_of_the_lowest_points() {
+        let cube = stackplan_geom::examples::part_by_name("cube", Decomposition::ConvexMerge).expect("cube");
+        let at = |x: f64, z: f64| Pose::from_translation(DVec3::new(x, 0.0, z));
+        let poses = [at(0.0, 0.0), at(2.0, 0.0), at(1.0, 1.0), at(5.0, 0.005)];
+        // 0.005 is within 1% of the cube's height of the floor: the same layer
+        assert_eq!(layer_counts(&cube, &poses), vec![3, 1]);
+    }
 }
