@@ -516,20 +516,33 @@ fn argmax(points: &[DVec3], u: DVec3) -> usize {
     best
 }
 
-/// Vertex indices of a feature, as a counter-clockwise cycle about the feature's outward normal for a face of `p`
-/// (reversed when `reflect`, for `-RA`), the two ends for an edge, the vertex itself.
-fn feature_vertices(p: &ConvexPolytope, feature: Feature, arcs: &[Arc], reflect: bool) -> Vec<usize> {
+/// Vertex indices of a feature into `out` (cleared first), as a counter-clockwise cycle about the feature's outward
+/// normal for a face of `p` (reversed when `reflect`, for `-RA`), the two ends for an edge, the vertex itself.
+fn feature_vertices(p: &ConvexPolytope, feature: Feature, arcs: &[Arc], reflect: bool, out: &mut Vec<usize>) {
+    out.clear();
     match feature {
-        Feature::Vertex(v) => vec![v],
-        Feature::Edge(e) => arcs[e].vertices.to_vec(),
+        Feature::Vertex(v) => out.push(v),
+        Feature::Edge(e) => out.extend_from_slice(&arcs[e].vertices),
         Feature::Face(f) => {
-            let mut c = p.faces()[f].vertices.clone();
+            out.extend_from_slice(&p.faces()[f].vertices);
             if reflect {
-                c.reverse();
+                out.reverse();
             }
-            c
         }
     }
+}
+
+/// A labelled point of a planar sum: its coordinates in the face plane and the vertex pair `[i, j]`.
+type Labelled = (f64, f64, [usize; 2]);
+
+/// Buffers reused by every merged face of one obstacle (no allocation per face).
+#[derive(Default)]
+struct PlanarScratch {
+    is: Vec<usize>,
+    js: Vec<usize>,
+    points: Vec<Labelled>,
+    unique: Vec<Labelled>,
+    hull: Vec<Labelled>,
 }
 
 fn assemble(
@@ -550,6 +563,7 @@ fn assemble(
     let mut planes: Vec<Plane> = Vec::with_capacity(specs.len());
     let mut kinds: Vec<FaceKind> = Vec::with_capacity(specs.len());
     let mut cycle: Vec<[usize; 2]> = Vec::with_capacity(16);
+    let mut scratch = PlanarScratch::default();
     for spec in &specs {
         cycle.clear();
         match (spec.fixed, spec.moving) {
@@ -572,9 +586,12 @@ fn assemble(
                 }
             }
             (fixed_feature, moving_feature) => {
-                let js = feature_vertices(fixed, fixed_feature, b_arcs, false);
-                let is = feature_vertices(moving, moving_feature, a_arcs, true);
-                planar_sum(&is, &js, ra, bv, spec.normal, &mut cycle);
+                let mut is = std::mem::take(&mut scratch.is);
+                let mut js = std::mem::take(&mut scratch.js);
+                feature_vertices(fixed, fixed_feature, b_arcs, false, &mut js);
+                feature_vertices(moving, moving_feature, a_arcs, true, &mut is);
+                planar_sum(&is, &js, ra, bv, spec.normal, &mut scratch, &mut cycle);
+                (scratch.is, scratch.js) = (is, js);
             }
         }
         if cycle.len() < 3 {
@@ -608,10 +625,19 @@ fn assemble(
 /// Convex polygon `sum_{i in is, j in js} (b_j - R a_i)` in the plane orthogonal to `normal`, counter-clockwise about
 /// `normal`, as labelled corners (collinear points on merged parallel edges dropped). Andrew's monotone chain on at
 /// most `|is| |js|` points, with the angular tolerance for collinearity.
-fn planar_sum(is: &[usize], js: &[usize], ra: &[DVec3], bv: &[DVec3], normal: DVec3, out: &mut Vec<[usize; 2]>) {
+fn planar_sum(
+    is: &[usize],
+    js: &[usize],
+    ra: &[DVec3],
+    bv: &[DVec3],
+    normal: DVec3,
+    scratch: &mut PlanarScratch,
+    out: &mut Vec<[usize; 2]>,
+) {
     let (e1, _) = normal.any_orthonormal_pair();
     let e2 = normal.cross(e1);
-    let mut pts: Vec<(f64, f64, [usize; 2])> = Vec::with_capacity(is.len() * js.len());
+    let pts = &mut scratch.points;
+    pts.clear();
     for &i in is {
         for &j in js {
             let p = bv[j] - ra[i];
@@ -619,38 +645,47 @@ fn planar_sum(is: &[usize], js: &[usize], ra: &[DVec3], bv: &[DVec3], normal: DV
         }
     }
     // numeric order (not total_cmp: -0.0 and 0.0 must tie, or the chain loses its lexicographic order)
+    // (stable: equal points keep their generation order, so the label kept for a duplicate is deterministic)
     pts.sort_by(|a, b| {
         a.0.partial_cmp(&b.0).unwrap_or(Ordering::Equal).then(a.1.partial_cmp(&b.1).unwrap_or(Ordering::Equal))
     });
     // Length tolerance of the policy on the polygon's extent: points closer than it are the same point (sums of
     // parallel features coincide up to rounding), and a point within it of a hull edge lies on that edge.
     let (mut lo, mut hi) = ((f64::INFINITY, f64::INFINITY), (f64::NEG_INFINITY, f64::NEG_INFINITY));
-    for p in &pts {
+    for p in pts.iter() {
         lo = (lo.0.min(p.0), lo.1.min(p.1));
         hi = (hi.0.max(p.0), hi.1.max(p.1));
     }
-    let lin = RELATIVE * (hi.0 - lo.0).hypot(hi.1 - lo.1);
-    let mut unique: Vec<(f64, f64, [usize; 2])> = Vec::with_capacity(pts.len());
-    for p in pts {
-        let lin_sq = lin * lin;
-        if !unique.iter().any(|q| (p.0 - q.0) * (p.0 - q.0) + (p.1 - q.1) * (p.1 - q.1) <= lin_sq) {
-            unique.push(p);
+    let lin = RELATIVE * ((hi.0 - lo.0) * (hi.0 - lo.0) + (hi.1 - lo.1) * (hi.1 - lo.1)).sqrt();
+    let lin_sq = lin * lin;
+    let unique = &mut scratch.unique;
+    unique.clear();
+    for p in pts.iter() {
+        // `unique` is sorted by x like `pts`: only its tail within `lin` in x can hold a duplicate of `p`
+        let duplicate = unique
+            .iter()
+            .rev()
+            .take_while(|q| q.0 >= p.0 - lin)
+            .any(|q| (p.0 - q.0) * (p.0 - q.0) + (p.1 - q.1) * (p.1 - q.1) <= lin_sq);
+        if !duplicate {
+            unique.push(*p);
         }
     }
-    let pts = unique;
+    let pts = &*unique;
 
     // strictly left of the directed line o -> b by more than `lin`
-    let turns_left = |o: &(f64, f64, [usize; 2]), a: &(f64, f64, [usize; 2]), b: &(f64, f64, [usize; 2])| {
+    let turns_left = |o: &Labelled, a: &Labelled, b: &Labelled| {
         let (ax, ay, bx, by) = (a.0 - o.0, a.1 - o.1, b.0 - o.0, b.1 - o.1);
         // o -> a -> b turns left and a is farther than `lin` from the line o -> b
         ax * by - ay * bx > lin * (bx * bx + by * by).sqrt()
     };
     // the chain itself uses the exact orientation predicate (a tolerance inside the chain loses corners when nearly
     // collinear points come in non-monotone order); near-collinear corners are removed afterwards
-    let exact_left = |o: &(f64, f64, [usize; 2]), a: &(f64, f64, [usize; 2]), b: &(f64, f64, [usize; 2])| {
+    let exact_left = |o: &Labelled, a: &Labelled, b: &Labelled| {
         orient2d(DVec2::new(o.0, o.1), DVec2::new(a.0, a.1), DVec2::new(b.0, b.1)) == Ordering::Greater
     };
-    let mut hull: Vec<(f64, f64, [usize; 2])> = Vec::with_capacity(pts.len() + 1);
+    let hull = &mut scratch.hull;
+    hull.clear();
     for p in pts.iter() {
         while hull.len() >= 2 && !exact_left(&hull[hull.len() - 2], &hull[hull.len() - 1], p) {
             hull.pop();
