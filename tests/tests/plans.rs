@@ -214,10 +214,9 @@ fn the_report_opens_in_headless_chromium() {
     let Some(chromium) = chromium() else {
         let required = std::env::var("STACKPLAN_REQUIRE_CHROMIUM").is_ok_and(|v| v == "1");
         assert!(!required, "STACKPLAN_REQUIRE_CHROMIUM=1 but no Chromium at $CHROMIUM or /usr/bin/chromium");
-        #[allow(clippy::print_stderr)]
-        {
-            eprintln!("SKIPPED the_report_opens_in_headless_chromium: no Chromium (set CHROMIUM or install chromium)");
-        }
+        // straight to the process's stderr, past the test harness's capture, so the skip shows in every log
+        let note = "SKIPPED the_report_opens_in_headless_chromium: no Chromium (set CHROMIUM or install chromium)\n";
+        let _ = std::io::Write::write_all(&mut std::io::stderr(), note.as_bytes());
         return;
     };
     let dir = tempfile::tempdir().expect("tempdir");

@@ -297,7 +297,7 @@ fn build_figure<'a>(file: &PlanFile, frames: &'a [(Scene, String)]) -> Figure<'a
             .map(|(scene, caption)| FigurePanel { scene, view: ISOMETRIC, caption: caption.clone() })
             .collect(),
         columns: 5,
-        cell: (220.0, 200.0),
+        cell: (220.0, 170.0),
         common_scale: true,
     }
 }
