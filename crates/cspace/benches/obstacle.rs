@@ -11,16 +11,7 @@ use stackplan_geom::{ConvexPolytope, convex_hull};
 use std::hint::black_box;
 
 fn cuboid(hi: DVec3) -> ConvexPolytope {
-    let pts: Vec<DVec3> = (0..8)
-        .map(|i| {
-            DVec3::new(
-                if i & 1 == 0 { 0.0 } else { hi.x },
-                if i & 2 == 0 { 0.0 } else { hi.y },
-                if i & 4 == 0 { 0.0 } else { hi.z },
-            )
-        })
-        .collect();
-    convex_hull(&pts).expect("box").polytope
+    ConvexPolytope::cuboid(DVec3::ZERO, hi).expect("box")
 }
 
 /// A sheet-metal piece: a convex hexagon extruded by 2 mm.

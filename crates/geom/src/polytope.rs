@@ -249,6 +249,36 @@ impl ConvexPolytope {
         Ok(Self { vertices, faces: out, edges, face_edges })
     }
 
+    /// The axis-aligned box `[lo, hi]`, built directly (no hull): vertex `i` has x from `hi` when bit 0 of `i` is
+    /// set, y when bit 1 is, z when bit 2 is. An error when the box is empty or flat in some axis, or not finite.
+    pub fn cuboid(lo: DVec3, hi: DVec3) -> Result<Self, PolytopeError> {
+        let vertices: Vec<DVec3> = (0..8)
+            .map(|i| {
+                DVec3::new(
+                    if i & 1 == 0 { lo.x } else { hi.x },
+                    if i & 2 == 0 { lo.y } else { hi.y },
+                    if i & 4 == 0 { lo.z } else { hi.z },
+                )
+            })
+            .collect();
+        let faces = vec![
+            vec![0, 2, 3, 1], // z = lo.z, normal -z
+            vec![4, 5, 7, 6], // z = hi.z
+            vec![0, 1, 5, 4], // y = lo.y
+            vec![2, 6, 7, 3], // y = hi.y
+            vec![0, 4, 6, 2], // x = lo.x
+            vec![1, 3, 7, 5], // x = hi.x
+        ];
+        let extent = hi - lo;
+        // the face reported is the low face of the first empty axis (z, y, x); NaN extents are rejected too
+        for (face, e) in [(0, extent.z), (2, extent.y), (4, extent.x)] {
+            if e.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                return Err(PolytopeError::DegenerateFace { face });
+            }
+        }
+        Self::new(vertices, faces)
+    }
+
     /// Builds a polytope whose face planes are given (for computed polytopes whose planes are known more accurately
     /// than a fit to rounded vertices, e.g. Minkowski sums). Same checks as [`Self::new`]; the planes' normals must be
     /// unit length.
@@ -509,17 +539,17 @@ mod tests {
     use super::*;
 
     pub(crate) fn unit_cube() -> ConvexPolytope {
-        let v: Vec<DVec3> =
-            (0..8).map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64)).collect();
-        let faces = vec![
-            vec![0, 2, 3, 1], // z = 0, normal -z
-            vec![4, 5, 7, 6], // z = 1
-            vec![0, 1, 5, 4], // y = 0
-            vec![2, 6, 7, 3], // y = 1
-            vec![0, 4, 6, 2], // x = 0
-            vec![1, 3, 7, 5], // x = 1
-        ];
-        ConvexPolytope::new(v, faces).expect("cube")
+        ConvexPolytope::cuboid(DVec3::ZERO, DVec3::ONE).expect("cube")
+    }
+
+    #[test]
+    fn cuboid_is_valid_and_rejects_flat_boxes() {
+        let b = ConvexPolytope::cuboid(DVec3::new(-1.0, 2.0, 0.0), DVec3::new(3.0, 2.5, 2.0)).expect("box");
+        b.validate_exact().expect("valid");
+        assert!((b.volume() - 4.0 * 0.5 * 2.0).abs() < 1e-12);
+        assert!(ConvexPolytope::cuboid(DVec3::ZERO, DVec3::new(1.0, 0.0, 1.0)).is_err());
+        assert!(ConvexPolytope::cuboid(DVec3::ZERO, DVec3::new(1.0, 1.0, f64::NAN)).is_err());
+        assert!(ConvexPolytope::cuboid(DVec3::ONE, DVec3::ZERO).is_err());
     }
 
     #[test]

@@ -13,16 +13,7 @@ pub fn cases(default: u32) -> u32 {
 }
 
 pub fn cuboid(lo: DVec3, hi: DVec3) -> ConvexPolytope {
-    let pts: Vec<DVec3> = (0..8)
-        .map(|i| {
-            DVec3::new(
-                if i & 1 == 0 { lo.x } else { hi.x },
-                if i & 2 == 0 { lo.y } else { hi.y },
-                if i & 4 == 0 { lo.z } else { hi.z },
-            )
-        })
-        .collect();
-    convex_hull(&pts).expect("box").polytope
+    ConvexPolytope::cuboid(lo, hi).expect("box")
 }
 
 /// A prism: the convex polygon `outline` (x, y) extruded from `z0` to `z1`, then its axes permuted so the extrusion runs
