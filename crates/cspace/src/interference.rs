@@ -231,34 +231,14 @@ impl PlacedScene {
         position: DVec3,
         clearance: f64,
     ) -> Vec<InterferencePair> {
-        let (lo, hi) = moving.aabb();
-        let tol = self.tolerance.linear.max(Tolerance::for_scale((hi - lo).length()).linear);
-        let mut out = Vec::new();
-        for (mi, c) in moving.components.iter().enumerate() {
-            let placed = PlacedConvex::new(c, rotation, position);
+        self.collect_pairs(moving, rotation, position, clearance, |placed, tol| {
             let query = aabb_of(placed.aabb.0, placed.aabb.1, clearance.max(0.0) + tol);
-            for k in self.bvh.intersect_aabb(&query) {
-                let (fixed_part, fixed_piece, other) = &self.components[k as usize];
-                let contact = classify_pair(&placed, other, tol, clearance);
-                let keep = match contact {
-                    PairContact::Penetrating { .. } | PairContact::Touching { .. } => true,
-                    PairContact::Separated { gap } => clearance > 0.0 && gap < clearance,
-                };
-                if keep {
-                    out.push(InterferencePair {
-                        moving_piece: mi,
-                        fixed_part: *fixed_part,
-                        fixed_piece: *fixed_piece,
-                        contact,
-                    });
-                }
-            }
-        }
-        out.sort_by_key(|p| (p.moving_piece, p.fixed_part, p.fixed_piece));
-        out
+            self.bvh.intersect_aabb(&query).map(|k| k as usize).collect()
+        })
     }
 
-    /// Same as [`Self::interference_pairs`] by testing every component pair (the brute-force reference).
+    /// Same as [`Self::interference_pairs`] by testing every component pair (the brute-force reference for the
+    /// broad phase: same narrow phase and keep rule, no bounding-volume hierarchy).
     pub fn interference_pairs_brute_force(
         &self,
         moving: &Part,
@@ -266,12 +246,26 @@ impl PlacedScene {
         position: DVec3,
         clearance: f64,
     ) -> Vec<InterferencePair> {
+        self.collect_pairs(moving, rotation, position, clearance, |_, _| (0..self.components.len()).collect())
+    }
+
+    /// The narrow phase and keep rule over the fixed components that `candidates` names for each placed moving
+    /// component: penetrating and touching pairs always, separated pairs closer than `clearance` when it is positive.
+    fn collect_pairs(
+        &self,
+        moving: &Part,
+        rotation: DMat3,
+        position: DVec3,
+        clearance: f64,
+        candidates: impl Fn(&PlacedConvex, f64) -> Vec<usize>,
+    ) -> Vec<InterferencePair> {
         let (lo, hi) = moving.aabb();
         let tol = self.tolerance.linear.max(Tolerance::for_scale((hi - lo).length()).linear);
         let mut out = Vec::new();
         for (mi, c) in moving.components.iter().enumerate() {
             let placed = PlacedConvex::new(c, rotation, position);
-            for (fixed_part, fixed_piece, other) in &self.components {
+            for k in candidates(&placed, tol) {
+                let (fixed_part, fixed_piece, other) = &self.components[k];
                 let contact = classify_pair(&placed, other, tol, clearance);
                 let keep = match contact {
                     PairContact::Penetrating { .. } | PairContact::Touching { .. } => true,
