@@ -58,7 +58,7 @@ impl Default for AcsgSettings {
             threshold_relative: 1e-4,
             strict: StrictTolerances::default(),
             witness_attempts: 8,
-            extremal_budget: 400,
+            extremal_budget: 200,
             widen: 0.05,
             max_level: 12,
         }

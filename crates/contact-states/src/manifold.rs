@@ -486,8 +486,8 @@ impl<'a> Manifolds<'a> {
         (t, r)
     }
 
-    /// Like [`Self::project`], and also pushes the PPCs of `near` to at least `2 clear` apart and removes
-    /// penetration: hinge residuals `max(0, 2 clear - distance)` and `L d_G` join the equalities.
+    /// Like [`Self::project_closure`] (equalities, bounding terms, penetration), and also pushes the PPCs of `near`
+    /// to at least `2 clear` apart: hinge residuals `max(0, 2 clear - distance)` join the others.
     fn project_clear(
         &self,
         state: &ContactState,
@@ -497,12 +497,11 @@ impl<'a> Manifolds<'a> {
     ) -> Config {
         let margin = 2.0 * self.clear();
         let residuals = |t: &Config, out: &mut Vec<f64>| {
+            self.closure_residuals(state, t, out);
             let pose = Pose::from_config(t);
-            self.residuals(state, &pose, out);
             for pc in near {
                 out.push((margin - self.ppc_distance(pc, &pose)).max(0.0));
             }
-            out.push(self.weights.length * penetration(self.fixed, self.moving, &pose));
         };
         self.least_squares(residuals, t0, bounds, &[false; 6], 1e-11 * self.weights.length, 40, None).0
     }
@@ -652,8 +651,14 @@ impl<'a> Manifolds<'a> {
         // every start projected and checked first, then perturbations around the first few that projected
         let mut projected: Vec<Config> = Vec::new();
         for start in starts {
+            // onto the equalities; when that leaves a bounding condition or penetration violated, onto the closure
             let Some(p) = self.project(state, start, bounds, &free) else {
                 continue;
+            };
+            let p = if self.in_closure(state, &p, bounds) {
+                p
+            } else {
+                self.project_closure_with(state, &p, bounds, &free, None).unwrap_or(p)
             };
             match self.verify(state, &p, bounds) {
                 Ok(()) => return Ok(p),

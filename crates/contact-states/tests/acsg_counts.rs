@@ -35,6 +35,8 @@ fn box_part(name: &str, lo: DVec3, hi: DVec3) -> ContactPart {
 fn settings(seed: u64) -> AcsgSettings {
     AcsgSettings {
         ga: GaSettings { population: 40, generations: 30, polish_evaluations: 3000, seed },
+        // enough compass steps for the analytic extremals to 1e-6
+        extremal_budget: 400,
         ..AcsgSettings::default()
     }
 }

@@ -5,11 +5,14 @@
 //! (-20, -20, -20) so that `t = 0` puts the block's reference corner into the inner corner (touching the floor and
 //! both walls), which is the nominal insertion frame the seed's bounds refer to.
 //!
-//! One ACSG is generated (GA population 30, 20 generations, polish 800 for test time; about 12 s in the test
-//! profile) and checked:
+//! One ACSG is generated (GA population 30, 20 generations, polish 800, 6 witness attempts, extremal budget 150 for
+//! test time; about 25 s in the test profile on the loaded 2-core machine) and checked:
 //! * regression: the number of feasible states per level is printed with the Table I-style extremal table (recorded
-//!   in docs/benchmarks.md: seed 2004 gives [0, 34, 119, 98, 40, 26, 5, 3], 325 states, against the seed's 63 for its own
-//!   geometry); every feasible state's witness is in the box and below the threshold;
+//!   in BENCHMARKS.md: seed 2004 gives [0, 25, 84, 88, 35, 11], 243 states, against the seed's 63 for its own
+//!   geometry, which has one wall where the `l-corner` fixture has two);
+//! * every reported state is verified **independently** at its witness (`common::independent_check`: parry3d-f64
+//!   element distances, plane checks, c-space interference; the state's PCs hold, nothing penetrates, and exactly
+//!   the state's PPCs are in contact), and its extremals lie in the closure of the state;
 //! * independent sampling: random configurations in the box, pushed along random 6-D directions to first contact
 //!   (bisection on the penetration measure), classified by the PCs whose criteria vanish (tolerance 1e-6 L); every
 //!   observed state must be a feasible state of the ACSG.
@@ -59,6 +62,8 @@ fn block_into_l_corner() {
     let bounds = ConfigBox::new([-5.0, -5.0, 0.0, -d, -d, -d], [5.0, 5.0, 240.0, d, d, d]).expect("box");
     let settings = AcsgSettings {
         ga: GaSettings { population: 30, generations: 20, polish_evaluations: 800, seed: 2004 },
+        witness_attempts: 6,
+        extremal_budget: 150,
         ..AcsgSettings::default()
     };
     let g = generate(&fixed, &moving, bounds, settings);
