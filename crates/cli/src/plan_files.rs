@@ -214,7 +214,7 @@ fn floor_outline(floor: &FloorVolume) -> Vec<DVec3> {
 
 /// The stack as a scene: every part in its colour; with `annotate`, numbered and its c.g. marked.
 pub fn stack_scene(file: &PlanFile, annotate: bool) -> Scene {
-    let mut scene = frame_scene(file, file.poses.len(), 0, floor_outline(&file.plan.options.floor));
+    let mut scene = frame_scene(file, file.poses.len(), 0, floor_outline(&file.plan.options.floor), true);
     if !annotate {
         scene.labels.clear();
         scene.markers.clear();
@@ -231,8 +231,9 @@ pub fn stack_scene(file: &PlanFile, annotate: bool) -> Scene {
     scene
 }
 
-/// The first `count` parts; parts from `new_from` on in their colour, numbered, c.g. marked; earlier ones grey.
-fn frame_scene(file: &PlanFile, count: usize, new_from: usize, floor: Vec<DVec3>) -> Scene {
+/// The first `count` parts; parts from `new_from` on in their colour, numbered with their c.g. marked (only the last
+/// one when a build frame adds several), earlier ones grey.
+fn frame_scene(file: &PlanFile, count: usize, new_from: usize, floor: Vec<DVec3>, number_all: bool) -> Scene {
     let mut scene = Scene { floor, ..Scene::default() };
     for (i, pose) in file.poses.iter().enumerate().take(count) {
         let new = i >= new_from;
@@ -240,7 +241,10 @@ fn frame_scene(file: &PlanFile, count: usize, new_from: usize, floor: Vec<DVec3>
         for c in &file.part.components {
             scene.solids.push(Solid { polytope: c.transformed(pose.rotation, pose.position), color, part: i });
         }
-        if new {
+        // every new part is numbered in the stack picture and in one-part frames; a frame adding several parts
+        // numbers only its last one (small parts' numbers would cover each other)
+        let numbered = new && (number_all || i + 1 == count);
+        if numbered {
             let cg = pose.apply(file.part.mass.center_of_gravity);
             scene.labels.push((i + 1, cg));
             scene.markers.push(Marker { position: cg, color: [200, 0, 0] });
@@ -275,7 +279,7 @@ fn build_frames(file: &PlanFile) -> Vec<(Scene, String)> {
     build_frame_counts(file.poses.len())
         .into_iter()
         .map(|count| {
-            let scene = frame_scene(file, count, previous, outline.clone());
+            let scene = frame_scene(file, count, previous, outline.clone(), count - previous == 1);
             previous = count;
             (scene, format!("n = {count}"))
         })
