@@ -160,9 +160,51 @@ fn subtraction(c: &mut Criterion, name: &str) {
     group.finish();
 }
 
+/// Emptiness of a child cell as the planner's search builds it: a cell of 32 inequalities, its QP optimum as the
+/// known point, and an obstacle-like split (the outside of one random plane through the optimum's neighbourhood plus
+/// the inside of three others): `Cell::is_empty_with` (phase 1 from the optimum) against `with_halfspaces` (the
+/// Chebyshev LP), same cases.
+fn emptiness(c: &mut Criterion, name: &str) {
+    let mut group = c.benchmark_group(format!("child_emptiness_{name}"));
+    let mut rng = Rng(7);
+    let cases: Vec<(Cell<3>, [f64; 3], Vec<Halfspace<3>>)> = (0..32)
+        .map(|_| {
+            let cell = cell(&mut rng, 32);
+            let cost = cost(&mut rng);
+            let at = minimize(&cell, &cost).expect("exact").point;
+            let mut extra = Vec::new();
+            for k in 0..4 {
+                let n = rng.unit();
+                let d: f64 = (0..3).map(|i| n[i] * at[i]).sum::<f64>() + rng.range(0.5, 20.0);
+                let h = Halfspace::new(n, d, Tag::User(100 + k));
+                extra.push(if k == 0 { h.flipped(Tag::User(100)) } else { h });
+            }
+            (cell, at, extra)
+        })
+        .collect();
+    let mut i = 0;
+    group.bench_function("phase_one", |b| {
+        b.iter(|| {
+            i = (i + 1) % cases.len();
+            let (cell, at, extra) = &cases[i];
+            black_box(cell.is_empty_with(extra.iter().copied(), black_box(at)).expect("phase 1"))
+        })
+    });
+    let mut i = 0;
+    group.bench_function("chebyshev", |b| {
+        b.iter(|| {
+            i = (i + 1) % cases.len();
+            let (cell, _, extra) = &cases[i];
+            black_box(cell.with_halfspaces(extra.iter().copied()).expect("cell").is_empty())
+        })
+    });
+    group.finish();
+}
+
 fn wall(c: &mut Criterion) {
     qp(c, "wall");
     subtraction(c, "wall");
+    emptiness(c, "wall");
 }
 
 /// CPU-time medians of the same cases, printed (not a criterion benchmark: see [`cpu_median_ns`]).

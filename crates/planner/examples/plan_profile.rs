@@ -1,6 +1,7 @@
 //! Times a stacking plan of a fixture part (for profiling): `cargo run -p stackplan-planner --example plan_profile
-//! -- PART.json [COUNT] [W] [DTHETA_DEG]`. Prints the plan's totals and statistics as JSON (floor 660 x 660 mm,
-//! height 400 mm, 5 mm clearance, the plan regression scenarios' settings).
+//! -- PART.json [COUNT] [W] [DTHETA_DEG] [HALF_SIZE] [HEIGHT]`. Prints the plan's totals and statistics as JSON
+//! (default floor 660 x 660 mm centred at the origin, height 400 mm; 5 mm clearance, as the Channel plan regression
+//! scenarios).
 
 use stackplan_geom::io::{ReadOptions, read_part};
 use stackplan_planner::{FloorVolume, PlanOptions, plan_stack};
@@ -8,12 +9,14 @@ use stackplan_planner::{FloorVolume, PlanOptions, plan_stack};
 #[allow(clippy::print_stdout)]
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
-    let path = args.get(1).ok_or("usage: plan_profile PART.json [COUNT] [W] [DTHETA_DEG]")?;
+    let path = args.get(1).ok_or("usage: plan_profile PART.json [COUNT] [W] [DTHETA_DEG] [HALF_SIZE] [HEIGHT]")?;
     let count: usize = args.get(2).map_or(Ok(15), |s| s.parse())?;
     let w: f64 = args.get(3).map_or(Ok(0.5), |s| s.parse())?;
     let dtheta: f64 = args.get(4).map_or(Ok(5.0), |s| s.parse())?;
+    let half: f64 = args.get(5).map_or(Ok(330.0), |s| s.parse())?;
+    let height: f64 = args.get(6).map_or(Ok(400.0), |s| s.parse())?;
     let part = read_part(path, &ReadOptions::default())?;
-    let mut options = PlanOptions::new(count, FloorVolume::rectangle(-330.0, -330.0, 330.0, 330.0, 400.0));
+    let mut options = PlanOptions::new(count, FloorVolume::rectangle(-half, -half, half, half, height));
     options.w = w;
     options.dtheta = dtheta.to_radians();
     let started = std::time::Instant::now();
