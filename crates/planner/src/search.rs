@@ -259,7 +259,8 @@ struct Search<'r, 'a> {
     scene: StackScene,
     tol: Tolerance,
     cache: &'r ObstacleCache,
-    obstacles: Vec<DerivedObstacle>,
+    obstacles: Vec<Arc<DerivedObstacle>>,
+    derived: HashMap<(usize, usize, usize), Arc<DerivedObstacle>>,
     obstacle_ids: HashMap<(usize, usize, usize), u32>,
     axes: AxesCache,
     stats: PlacementStats,
@@ -275,6 +276,62 @@ pub fn place(request: &PlacementRequest<'_>) -> Result<PlacementResult, Placemen
 pub fn place_with_cache(
     request: &PlacementRequest<'_>,
     cache: &ObstacleCache,
+) -> Result<PlacementResult, PlacementError> {
+    place_with_caches(request, cache, &mut SearchCaches::default())
+}
+
+/// What successive searches into a growing stack share beyond the [`ObstacleCache`]: the derived obstacles (insertion
+/// and clearance applied) and the separating-axis data of each (orientation, pair), both keyed by orientation index.
+/// They are reused only while the searches have the same orientations (bit-identical rotations), the same
+/// clearance, insertion and horizontal-clearance settings, and the previous search's stack components are the first
+/// components of the new stack, bit for bit (parts appended, never moved); otherwise they are cleared. Reuse changes
+/// no result: both are pure functions of those inputs.
+#[derive(Debug, Default)]
+pub struct SearchCaches {
+    signature: Option<CacheSignature>,
+    axes: AxesCache,
+    derived: HashMap<(usize, usize, usize), Arc<DerivedObstacle>>,
+}
+
+#[derive(Debug, PartialEq)]
+struct CacheSignature {
+    rotations: Vec<[u64; 9]>,
+    clearance: u64,
+    insertion: bool,
+    horizontal: bool,
+    stack: Vec<Vec<DVec3>>,
+}
+
+impl SearchCaches {
+    /// Empty caches.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Keeps the caches when `next` extends the signature they were built under, clears them otherwise.
+    fn adopt(&mut self, next: CacheSignature) {
+        let keep = self.signature.as_ref().is_some_and(|old| {
+            old.rotations == next.rotations
+                && old.clearance == next.clearance
+                && old.insertion == next.insertion
+                && old.horizontal == next.horizontal
+                && old.stack.len() <= next.stack.len()
+                && old.stack.iter().zip(&next.stack).all(|(a, b)| a == b)
+        });
+        if !keep {
+            self.axes.clear();
+            self.derived.clear();
+        }
+        self.signature = Some(next);
+    }
+}
+
+/// [`place_with_cache`] sharing `caches` with earlier searches (see [`SearchCaches`]); the stacking planner passes
+/// the same caches to every search of a plan.
+pub fn place_with_caches(
+    request: &PlacementRequest<'_>,
+    cache: &ObstacleCache,
+    caches: &mut SearchCaches,
 ) -> Result<PlacementResult, PlacementError> {
     request.validate()?;
     let start = Instant::now();
@@ -327,6 +384,13 @@ pub fn place_with_cache(
         total_pairs_searched: (part.components.len() * scene.components.len() * orientations.len()) as u64,
         ..Default::default()
     };
+    caches.adopt(CacheSignature {
+        rotations: orientations.iter().map(|o| o.rotation.to_cols_array().map(f64::to_bits)).collect(),
+        clearance: request.clearance.to_bits(),
+        insertion: request.insertion,
+        horizontal: request.horizontal_clearance,
+        stack: scene.components.iter().map(|c| c.placed.vertices.clone()).collect(),
+    });
     let mut search = Search {
         request,
         orientations,
@@ -336,7 +400,8 @@ pub fn place_with_cache(
         cache,
         obstacles: Vec::new(),
         obstacle_ids: HashMap::new(),
-        axes: AxesCache::default(),
+        axes: std::mem::take(&mut caches.axes),
+        derived: std::mem::take(&mut caches.derived),
         stats,
     };
     let before = cache.stats();
@@ -346,6 +411,8 @@ pub fn place_with_cache(
         Some(z) => search.run::<2>(z),
     };
     let after = cache.stats();
+    caches.axes = std::mem::take(&mut search.axes);
+    caches.derived = std::mem::take(&mut search.derived);
     let mut result = result?;
     result.stats.obstacles_constructed = after.constructions - before.constructions;
     result.stats.obstacle_cache_hits = after.hits - before.hits;
@@ -562,6 +629,14 @@ impl Search<'_, '_> {
             return Ok(*id);
         }
         let t = Instant::now();
+        if let Some(shared) = self.derived.get(&(orientation, moving, fixed)) {
+            let id = self.obstacles.len() as u32;
+            self.obstacles.push(Arc::clone(shared));
+            self.obstacle_ids.insert((orientation, moving, fixed), id);
+            self.stats.pairs_evaluated += 1;
+            self.stats.time_obstacles_ms += ms(t);
+            return Ok(id);
+        }
         let o = &self.orientations[orientation];
         let built = DerivedObstacle::build(
             self.request.part,
@@ -578,6 +653,8 @@ impl Search<'_, '_> {
             let sc = &self.scene.components[fixed];
             PlacementError::Obstacle { moving_piece: moving, fixed_part: sc.part, fixed_piece: sc.piece, reason }
         })?;
+        let built = Arc::new(built);
+        self.derived.insert((orientation, moving, fixed), Arc::clone(&built));
         let id = self.obstacles.len() as u32;
         self.obstacles.push(built);
         self.obstacle_ids.insert((orientation, moving, fixed), id);

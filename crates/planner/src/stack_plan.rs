@@ -22,7 +22,7 @@
 //! Cost: O(n) placements, each the search of [`crate::search`] plus at most `candidates` stack checks.
 
 use crate::request::{Cost, FloorVolume, PlacementError, PlacementRequest, StackPart, thetas_with_step};
-use crate::search::{Contact, NoPlacement, Placement, place_with_cache};
+use crate::search::{Contact, NoPlacement, Placement, SearchCaches, place_with_caches};
 use glam::{DMat3, DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 use stackplan_cspace::cache::ObstacleCache;
@@ -251,7 +251,9 @@ pub fn plan_stack_with_progress(
         contact_tolerance: None,
         prefix_stability: false,
     };
+    // shared by every search of the plan: the stack only grows and its parts never move
     let cache = ObstacleCache::new();
+    let mut caches = SearchCaches::new();
     let mut placed: Vec<Pose> = Vec::new();
     let mut planned: Vec<PlannedPart> = Vec::new();
     let mut stats = PlanStats::default();
@@ -282,7 +284,7 @@ pub fn plan_stack_with_progress(
             request.insertion = options.insertion;
             request.k = options.candidates;
             let started = std::time::Instant::now();
-            let result = match place_with_cache(&request, &cache) {
+            let result = match place_with_caches(&request, &cache, &mut caches) {
                 Ok(r) => r,
                 // stage 1's clipped floor may be malformed (a sliver): fall through to stage 2
                 Err(PlacementError::BadFloor(msg)) if stage == 1 => {

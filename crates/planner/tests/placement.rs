@@ -113,3 +113,53 @@ fn errors_and_empty_results() {
     req.fixed_z = Some(-5.0);
     assert_eq!(place(&req).expect("runs").exhausted, Some(NoPlacement::EmptyOmega));
 }
+
+/// Searches into a growing stack sharing `SearchCaches` (and one obstacle cache) give exactly the results of fresh
+/// searches, also when a search with other settings (clearance, insertion) in between forces the caches to be
+/// cleared, and when the stack is replaced by a different one.
+#[test]
+fn shared_search_caches_change_no_result() {
+    use stackplan_cspace::ObstacleCache;
+    use stackplan_planner::{SearchCaches, place_with_cache, place_with_caches};
+    let part = cuboid_part(DVec3::ZERO, DVec3::new(40.0, 25.0, 15.0));
+    let floor = FloorVolume::rectangle(0.0, 0.0, 120.0, 100.0, 200.0);
+    let shared_obstacles = ObstacleCache::new();
+    let mut caches = SearchCaches::new();
+    let mut poses: Vec<Pose> = Vec::new();
+    for step in 0..5 {
+        let stack: Vec<StackPart<'_>> = poses.iter().map(|&pose| StackPart { part: &part, pose }).collect();
+        let mut req = PlacementRequest::new(&part, stack, floor.clone());
+        req.thetas = uniform_thetas(12);
+        req.cost = Cost::Stacking { w: 0.6, origin: DVec3::new(60.0, 50.0, 0.0) };
+        req.k = 3;
+        // every other step: other settings in between (the caches must be dropped, then rebuilt)
+        if step % 2 == 1 {
+            let mut other = req.clone();
+            other.clearance = 2.0;
+            other.insertion = true;
+            other.horizontal_clearance = true;
+            let a = place_with_caches(&other, &shared_obstacles, &mut caches).expect("search");
+            let b = place_with_cache(&other, &ObstacleCache::new()).expect("search");
+            assert_eq!(a.placements, b.placements);
+            assert_eq!(a.stats.pairs_evaluated, b.stats.pairs_evaluated);
+        }
+        let a = place_with_caches(&req, &shared_obstacles, &mut caches).expect("search");
+        let b = place_with_cache(&req, &ObstacleCache::new()).expect("search");
+        assert_eq!(a.placements, b.placements, "step {step}");
+        assert_eq!(a.stats.nodes_expanded, b.stats.nodes_expanded);
+        assert_eq!(a.stats.pairs_evaluated, b.stats.pairs_evaluated);
+        let best = a.placements.first().expect("a placement");
+        poses.push(best.pose());
+    }
+    // a different stack (the parts moved): cleared, same answers
+    let moved: Vec<StackPart<'_>> = poses
+        .iter()
+        .rev()
+        .map(|&pose| StackPart { part: &part, pose: Pose { position: pose.position + DVec3::X, ..pose } })
+        .collect();
+    let mut req = PlacementRequest::new(&part, moved, floor);
+    req.thetas = uniform_thetas(12);
+    let a = place_with_caches(&req, &ObstacleCache::new(), &mut caches).expect("search");
+    let b = place_with_cache(&req, &ObstacleCache::new()).expect("search");
+    assert_eq!(a.placements, b.placements);
+}
