@@ -6,8 +6,9 @@ use stackplan_contact_states::acsg::{AcsgSettings, generate};
 use stackplan_contact_states::criteria::{ContactPart, Objective, Weights};
 use stackplan_contact_states::ga::{GaSettings, minimise};
 use stackplan_contact_states::growth_distance::{ConvexPiece, growth_distance};
+use stackplan_contact_states::manifold::{Manifolds, StrictTolerances};
 use stackplan_contact_states::pose::{Config, ConfigBox, Pose};
-use stackplan_contact_states::principal_contact::{ContactState, PrincipalContact};
+use stackplan_contact_states::principal_contact::{ContactState, PrincipalContact, all_ppcs};
 use stackplan_contact_states::surface::Element;
 use stackplan_geom::{DMat3, DVec3, Part, PartOrigin};
 use std::hint::black_box;
@@ -49,6 +50,15 @@ fn bench(c: &mut Criterion) {
     c.bench_function("feasibility_test_default_ga", |bench| {
         bench.iter(|| minimise(&f, &bx, &GaSettings::default(), &[]))
     });
+    // the exact machinery: projection of a nearby configuration onto the f-v manifold, and the strict check
+    let manifolds =
+        Manifolds::new(&fixed, &moving, all_ppcs(&fixed.surface, &moving.surface), StrictTolerances::default());
+    let near: Config = [1.0, 2.0, 0.4, 0.05, 0.05, 0.0];
+    let on = manifolds.project(&state, &near, &bx, &[false; 6]).expect("projects");
+    c.bench_function("projection_onto_f_v_manifold", |bench| {
+        bench.iter(|| manifolds.project(&state, black_box(&near), &bx, &[false; 6]))
+    });
+    c.bench_function("strict_check_f_v", |bench| bench.iter(|| manifolds.verify(&state, black_box(&on), &bx)));
     let mut group = c.benchmark_group("acsg");
     group.sample_size(10);
     group.bench_function("block_l_corner_default_ga", |bench| {
