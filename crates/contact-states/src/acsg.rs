@@ -385,7 +385,8 @@ impl Context<'_> {
                     &[m.t],
                     &self.bounds,
                     mix_seed(hypothesis_seed, 1),
-                    self.settings.witness_attempts * 2,
+                    // single PPCs have no neighbours to start from, and every state above grows from them
+                    self.settings.witness_attempts * if state.pcs.len() == 1 && state.level() == 1 { 6 } else { 2 },
                 ) {
                     Ok(w) => witness = Some(w),
                     Err(e) => record.rejection = Some(e),
