@@ -636,7 +636,7 @@ impl<'a> Manifolds<'a> {
     }
 
     /// A configuration verifying `state` near one of `starts` (projection, then seeded perturbations of growing
-    /// size, `attempts` per start); the last rejection when none is found.
+    /// size, `attempts` per start); when none is found, the rejection at the first projected start.
     pub fn interior_witness(
         &self,
         state: &ContactState,
@@ -647,6 +647,8 @@ impl<'a> Manifolds<'a> {
     ) -> Result<Config, Rejection> {
         let mut rng = SplitMix64::new(seed);
         let mut last = Rejection::NoProjection;
+        // the rejection at the first projected start is the informative one (later ones come from perturbations)
+        let mut first: Option<Rejection> = None;
         let free = [false; 6];
         // every start projected and checked first, then perturbations around the first few that projected
         let mut projected: Vec<Config> = Vec::new();
@@ -662,7 +664,10 @@ impl<'a> Manifolds<'a> {
             };
             match self.verify(state, &p, bounds) {
                 Ok(()) => return Ok(p),
-                Err(e) => last = e,
+                Err(e) => {
+                    first.get_or_insert_with(|| e.clone());
+                    last = e;
+                }
             }
             if !projected.iter().any(|q| q == &p) {
                 projected.push(p);
@@ -717,7 +722,7 @@ impl<'a> Manifolds<'a> {
                 }
             }
         }
-        Err(last)
+        Err(first.unwrap_or(last))
     }
 
     /// Whether `t` lies in the closure of the state: eq. 8 at most `hold` inside the box.
