@@ -11,6 +11,9 @@
 //!   (`flat`, `column`, `pyramid`: the seed's Fig. 2; adds `layer_counts`, parts per layer bottom up), `"check": true`
 //!   (the finished plan passes `stackplan check` with the planner's mu, cup and clearance; adds `check_ok`) and
 //!   `"expect_height_below"` (mm: the stack nests). These add `info_plan_seconds` (planning alone).
+//! * `obstacle`: the c-space obstacle of every convex pair of two parts (the fixed one placed by `"fixed_pose"`) at
+//!   each angle of `"theta_deg"` (`stackplan::cspace::obstacle`): per angle and pair the vertex and face counts and
+//!   the volume, face-kind totals, and the route (Gauss map or hull fallback); every obstacle must pass `validate()`.
 //! * `orient_intervals`: the constant-topology intervals and sweep counts of every convex pair of two parts over a
 //!   full turn (`stackplan::orient_interval::regress_summary`).
 
@@ -29,6 +32,7 @@ pub fn run(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
         "place" => place(scenario),
         "plan" => plan(scenario, dir),
         "orient_intervals" => orient_intervals(scenario, dir),
+        "obstacle" => obstacle(scenario, dir),
         other => bail!("unknown scenario kind {other:?}"),
     }
 }
@@ -94,6 +98,23 @@ fn place(scenario: &Value) -> anyhow::Result<Fields> {
 fn orient_intervals(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
     let moving = load_part(scenario, "moving", dir)?;
     let fixed = load_part(scenario, "fixed", dir)?;
+    let step = scenario.get("step_deg").and_then(Value::as_f64).unwrap_or(1.0);
+    let summary = stackplan::orient_interval::regress_summary(&moving, &fixed, fixed_pose(scenario)?, step);
+    let mut f = Fields::new();
+    if let Some(Value::Object(totals)) = summary.get("totals") {
+        for (k, v) in totals {
+            f.insert(format!("total_{k}"), v.clone());
+        }
+    }
+    if let Some(Value::Array(pairs)) = summary.get("pairs") {
+        let intervals: Vec<Value> = pairs.iter().map(|p| p.get("intervals").cloned().unwrap_or(Value::Null)).collect();
+        f.insert("intervals_per_pair".into(), intervals.into());
+    }
+    Ok(f)
+}
+
+/// The scenario's `"fixed_pose"` (`position`, row-major `rotation`), identity when absent.
+fn fixed_pose(scenario: &Value) -> anyhow::Result<(stackplan_geom::DMat3, DVec3)> {
     let pose = scenario.get("fixed_pose");
     let position = pose
         .and_then(|p| p.get("position"))
@@ -105,24 +126,49 @@ fn orient_intervals(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
         .map(|v| serde_json::from_value::<[[f64; 3]; 3]>(v.clone()))
         .transpose()?
         .unwrap_or([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
-    let rotation = stackplan_geom::DMat3::from_cols_array_2d(&rows).transpose();
-    let step = scenario.get("step_deg").and_then(Value::as_f64).unwrap_or(1.0);
-    let summary = stackplan::orient_interval::regress_summary(
-        &moving,
-        &fixed,
-        (rotation, stackplan_geom::DVec3::from_array(position)),
-        step,
-    );
-    let mut f = Fields::new();
-    if let Some(Value::Object(totals)) = summary.get("totals") {
-        for (k, v) in totals {
-            f.insert(format!("total_{k}"), v.clone());
+    Ok((stackplan_geom::DMat3::from_cols_array_2d(&rows).transpose(), DVec3::from_array(position)))
+}
+
+fn obstacle(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
+    use stackplan::cspace::{Route, obstacle};
+    let moving = load_part(scenario, "moving", dir)?;
+    let fixed = load_part(scenario, "fixed", dir)?;
+    let (rotation, translation) = fixed_pose(scenario)?;
+    let placed: Vec<_> = fixed.components.iter().map(|c| c.transformed(rotation, translation)).collect();
+    let angles: Vec<f64> = scenario
+        .get("theta_deg")
+        .map(|v| serde_json::from_value(v.clone()))
+        .transpose()?
+        .context("obstacle scenario has no \"theta_deg\" list")?;
+    let (mut vertices, mut faces, mut volumes) = (Vec::new(), Vec::new(), Vec::new());
+    let mut kinds: std::collections::BTreeMap<&'static str, usize> = Default::default();
+    let mut hull_route = 0usize;
+    for theta in &angles {
+        let r = stackplan_geom::DMat3::from_rotation_z(theta.to_radians());
+        let (mut v_row, mut f_row, mut vol_row) = (Vec::new(), Vec::new(), Vec::new());
+        for (i, a) in moving.components.iter().enumerate() {
+            for (j, b) in placed.iter().enumerate() {
+                let o = obstacle(a, r, b).with_context(|| format!("theta {theta} deg, pair ({i}, {j})"))?;
+                o.polytope().validate().with_context(|| format!("theta {theta} deg, pair ({i}, {j}): invalid"))?;
+                v_row.push(o.polytope().vertices().len());
+                f_row.push(o.polytope().faces().len());
+                vol_row.push(o.polytope().volume());
+                for k in o.face_kinds() {
+                    *kinds.entry(k.name()).or_default() += 1;
+                }
+                hull_route += usize::from(o.route() != Route::GaussMap);
+            }
         }
+        vertices.push(v_row);
+        faces.push(f_row);
+        volumes.push(vol_row);
     }
-    if let Some(Value::Array(pairs)) = summary.get("pairs") {
-        let intervals: Vec<Value> = pairs.iter().map(|p| p.get("intervals").cloned().unwrap_or(Value::Null)).collect();
-        f.insert("intervals_per_pair".into(), intervals.into());
-    }
+    let mut f = Fields::new();
+    f.insert("vertices_per_angle_and_pair".into(), serde_json::to_value(vertices)?);
+    f.insert("faces_per_angle_and_pair".into(), serde_json::to_value(faces)?);
+    f.insert("volume_per_angle_and_pair".into(), serde_json::to_value(volumes)?);
+    f.insert("face_kinds".into(), serde_json::to_value(kinds)?);
+    f.insert("hull_route_obstacles".into(), hull_route.into());
     Ok(f)
 }
 
