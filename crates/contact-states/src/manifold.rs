@@ -32,9 +32,10 @@
 //! blocked by a face boundary or another contact is restored by the other variables, e.g. a turn that lets a face
 //! slide further over an edge); a trial is accepted when it improves `±t_k`, stays in the box and satisfies eq. 8
 //! to `hold` (closure: other contacts may hold at an extremal). Steps double after a success and halve after a
-//! failed sweep, down to `1e-7` of the box width. Unlike the penalty formulation of eq. 11-12, every accepted point
-//! lies on the manifold, so the search does not stop short by the penalty's slack; it is local (a compass search
-//! stops at a point where no single-variable move with restoration improves, e.g. a corner of a curved boundary).
+//! failed sweep, down to `1e-7` of the box width; the search ends at once when `t_k` reaches its bound. Unlike the
+//! penalty formulation of eq. 11-12, every accepted point lies on the manifold, so the search does not stop short by
+//! the penalty's slack; it is local (a compass search stops at a point where no single-variable move with
+//! restoration improves, e.g. a corner of a curved boundary).
 
 use crate::criteria::{ContactPart, Objective, Weights, face_point_distance_2d, pc_criterion, pc_terms, penetration};
 use crate::ga::SplitMix64;
@@ -754,7 +755,8 @@ impl<'a> Manifolds<'a> {
         let mut equality_rows = Vec::new();
         self.residuals_at(state, &best, &mut equality_rows);
         let equalities = equality_rows.len().min(base_jacobian.len());
-        while used < budget && step.iter().any(|s| *s >= min_step) {
+        let at_bound = |t: &Config| if upper { t[k] >= bounds.max[k] } else { t[k] <= bounds.min[k] };
+        while used < budget && step.iter().any(|s| *s >= min_step) && !at_bound(&best) {
             let mut improved = false;
             // the objective's own variable first, then the others
             let order = std::iter::once(k).chain((0..6).filter(|&j| j != k));
