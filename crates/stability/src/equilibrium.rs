@@ -39,7 +39,8 @@
 //! optimum without a solve; `EquilibriumOptions::margins_by_socp_only` turns this off for cross-checks.
 //!
 //! Cost: per group an interior-point solve with `3 K + 1` variables and `6 M` equalities (K contact points, M movable
-//! parts); a margin costs `directions` more solves per group (none for closed-form groups).
+//! parts); a margin costs `directions` more solves per group (none for closed-form groups), four directions sharing one
+//! solver's symbolic factorisation.
 
 use crate::contacts::{Body, ContactPatch, plane_basis};
 use crate::polygon2d::{convex_hull_2d, signed_boundary_distance};
@@ -52,6 +53,9 @@ use clarabel::solver::{
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+
+/// Margin directions solved one after the other with one reused solver (see `Problem::solve_loads`).
+const DIRECTIONS_PER_SOLVER: usize = 4;
 
 /// Upper bound of the reported robustness margin (a stack that resists 10 g sideways is locked).
 pub const MARGIN_CAP: f64 = 10.0;
@@ -264,25 +268,44 @@ fn margins(
     directions: usize,
     mu: f64,
 ) -> Result<(Option<f64>, Option<DVec3>), EquilibriumError> {
-    let tasks: Vec<(usize, usize)> = (0..directions).flat_map(|j| (0..solved.len()).map(move |g| (j, g))).collect();
     let direction = |j: usize| {
         let angle = std::f64::consts::TAU * j as f64 / directions as f64;
         DVec3::new(angle.cos(), angle.sin(), 0.0)
     };
-    let alphas: Vec<Option<f64>> = tasks
+    // tasks: (group, first direction) over chunks of DIRECTIONS_PER_SOLVER directions sharing one solver; the chunks
+    // do not depend on the number of threads, so neither do the answers
+    let tasks: Vec<(usize, usize)> =
+        (0..solved.len()).flat_map(|g| (0..directions).step_by(DIRECTIONS_PER_SOLVER).map(move |j| (g, j))).collect();
+    let chunks: Vec<Vec<Option<f64>>> = tasks
         .par_iter()
-        .map(|&(j, g)| {
+        .map(|&(g, first)| {
+            let js: Vec<usize> = (first..directions.min(first + DIRECTIONS_PER_SOLVER)).collect();
             if let Some(flat) = &closed[g] {
-                return Ok(Some(flat.margin(direction(j), mu)));
+                return Ok(js.iter().map(|&j| Some(flat.margin(direction(j), mu))).collect());
             }
-            let (status, x) = solved[g].0.solve(Some(direction(j)))?;
-            if status != SolverStatus::Solved {
-                tracing::debug!(?status, direction = j, group = g, "margin solve did not end Solved");
-                return Ok(None);
-            }
-            Ok(Some(x[x.len() - 1].clamp(0.0, MARGIN_CAP)))
+            let loads: Vec<DVec3> = js.iter().map(|&j| direction(j)).collect();
+            let results = solved[g].0.solve_loads(&loads)?;
+            Ok(results
+                .into_iter()
+                .zip(&js)
+                .map(|((status, alpha), j)| {
+                    if status == SolverStatus::Solved {
+                        Some(alpha)
+                    } else {
+                        tracing::debug!(?status, direction = j, group = g, "margin solve did not end Solved");
+                        None
+                    }
+                })
+                .collect())
         })
         .collect::<Result<_, EquilibriumError>>()?;
+    // alphas[j * groups + g]
+    let mut alphas: Vec<Option<f64>> = vec![None; directions * solved.len()];
+    for (&(g, first), chunk) in tasks.iter().zip(&chunks) {
+        for (k, a) in chunk.iter().enumerate() {
+            alphas[(first + k) * solved.len() + g] = *a;
+        }
+    }
     let mut smallest = f64::INFINITY;
     let mut weakest = None;
     for (j, per_group) in alphas.chunks(solved.len()).enumerate() {
@@ -516,6 +539,58 @@ impl Problem {
     /// Solves the equilibrium problem (`load = None`) or the margin problem `max alpha` for load direction `d`.
     /// Returns the status and the primal solution (forces in the local frames, then alpha when present).
     fn solve(&self, load: Option<DVec3>) -> Result<(SolverStatus, Vec<f64>), EquilibriumError> {
+        let mut solver = self.solver(load)?;
+        solver.solve();
+        Ok((solver.solution.status, solver.solution.x.clone()))
+    }
+
+    /// The largest load factors for several horizontal load directions, one solver reused through `update_A` (only
+    /// the load column changes; the symbolic factorisation and the equilibration of the first direction are kept,
+    /// which changes the answers only at the solver's tolerance). Per direction: the status and the clamped factor.
+    fn solve_loads(&self, loads: &[DVec3]) -> Result<Vec<(SolverStatus, f64)>, EquilibriumError> {
+        let Some(&first) = loads.first() else { return Ok(Vec::new()) };
+        let mut solver = self.solver(Some(first))?;
+        let mut out = Vec::with_capacity(loads.len());
+        for (k, &d) in loads.iter().enumerate() {
+            if k > 0 {
+                let (a, _) = self.constraints(Some(d));
+                if solver.update_A(&a).is_err() {
+                    solver = self.solver(Some(d))?;
+                }
+            }
+            solver.solve();
+            let x = &solver.solution.x;
+            out.push((solver.solution.status, x[x.len() - 1].clamp(0.0, MARGIN_CAP)));
+        }
+        Ok(out)
+    }
+
+    /// A clarabel solver for the equilibrium problem (`load = None`) or the margin problem for direction `d`.
+    fn solver(&self, load: Option<DVec3>) -> Result<DefaultSolver<f64>, EquilibriumError> {
+        let nf = 3 * self.n_points;
+        let n = nf + usize::from(load.is_some());
+        let (a, (b, cones)) = self.constraints(load);
+        let (p, q) = match load {
+            None => {
+                let diag: Vec<usize> = (0..n).collect();
+                (CscMatrix::new_from_triplets(n, n, diag.clone(), diag, vec![1.0; n]), vec![0.0; n])
+            }
+            Some(_) => {
+                let mut q = vec![0.0; n];
+                q[nf] = -1.0;
+                (CscMatrix::zeros((n, n)), q)
+            }
+        };
+        let settings = DefaultSettingsBuilder::default()
+            .verbose(false)
+            .build()
+            .map_err(|e| EquilibriumError::Solver(format!("{e:?}")))?;
+        DefaultSolver::new(&p, &q, &a, &b, &cones, settings).map_err(|e| EquilibriumError::Solver(format!("{e:?}")))
+    }
+
+    /// The constraint matrix `A`, right-hand side `b` and cones of the problem (see [`Problem::solver`]).
+    #[allow(clippy::type_complexity)]
+    fn constraints(&self, load: Option<DVec3>) -> (CscMatrix<f64>, (Vec<f64>, Vec<SupportedConeT<f64>>)) {
         let nf = 3 * self.n_points;
         let n = nf + usize::from(load.is_some());
         let n_eq = self.rhs.len();
@@ -529,7 +604,9 @@ impl Problem {
             // + alpha w d in the force rows (moves to the left-hand side of  sum f + alpha w d = w z)
             for &(r, w) in &self.mover_rows {
                 for (axis, value) in [d.x, d.y, d.z].into_iter().enumerate() {
-                    if value != 0.0 {
+                    // x and y always (explicit zeros keep one sparsity pattern for every horizontal direction, so a
+                    // solver can be reused through `update_A`)
+                    if axis < 2 || value != 0.0 {
                         ri.push(r + axis);
                         ci.push(nf);
                         vi.push(w * value);
@@ -575,25 +652,6 @@ impl Problem {
             cones.push(SecondOrderConeT(3));
             row += 3;
         }
-        let a = CscMatrix::new_from_triplets(row, n, ri, ci, vi);
-        let (p, q) = match load {
-            None => {
-                let diag: Vec<usize> = (0..n).collect();
-                (CscMatrix::new_from_triplets(n, n, diag.clone(), diag, vec![1.0; n]), vec![0.0; n])
-            }
-            Some(_) => {
-                let mut q = vec![0.0; n];
-                q[nf] = -1.0;
-                (CscMatrix::zeros((n, n)), q)
-            }
-        };
-        let settings = DefaultSettingsBuilder::default()
-            .verbose(false)
-            .build()
-            .map_err(|e| EquilibriumError::Solver(format!("{e:?}")))?;
-        let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings)
-            .map_err(|e| EquilibriumError::Solver(format!("{e:?}")))?;
-        solver.solve();
-        Ok((solver.solution.status, solver.solution.x.clone()))
+        (CscMatrix::new_from_triplets(row, n, ri, ci, vi), (b, cones))
     }
 }
