@@ -32,6 +32,36 @@ fn cspace_of_two_unit_cubes_is_the_cube_of_side_two() {
 }
 
 #[test]
+fn cspace_extrapolated_obstacle_equals_the_built_one_inside_its_interval() {
+    let base = ["cspace", "example:channel", "example:channel", "--pair", "0,1", "--json"];
+    let with = |extra: &[&str]| run(&[&base[..], extra].concat());
+    let built = with(&["--theta-deg", "12"]);
+    assert!(built.status.success(), "{}", stderr(&built));
+    let extrapolated = with(&["--theta-deg", "12", "--extrapolate-from", "10"]);
+    assert!(extrapolated.status.success(), "{}", stderr(&extrapolated));
+    let (b, e) = (json(&built), json(&extrapolated));
+    assert_eq!(e["extrapolated_from_deg"], 10.0);
+    let (pb, pe) = (&b["pairs"][0], &e["pairs"][0]);
+    let interval = pe["interval_deg"].as_array().expect("interval");
+    let (start, end) = (interval[0].as_f64().expect("start"), interval[1].as_f64().expect("end"));
+    assert!(start < 10.0 && 12.0 < end, "interval [{start}, {end}] must contain 10 and 12");
+    // same structure and provenance, coordinates within 1e-9 relative
+    assert_eq!(pb["vertex_pairs"], pe["vertex_pairs"]);
+    assert_eq!(pb["faces"].as_array().map(Vec::len), pe["faces"].as_array().map(Vec::len));
+    let (vb, ve) = (pb["vertices"].as_array().expect("v"), pe["vertices"].as_array().expect("v"));
+    for (x, y) in vb.iter().zip(ve) {
+        for k in 0..3 {
+            let (x, y) = (x[k].as_f64().expect("x"), y[k].as_f64().expect("y"));
+            assert!((x - y).abs() <= 1e-9 * (1.0 + x.abs()), "{x} vs {y}");
+        }
+    }
+    // the channel's box pieces change structure when their sides align (every 90 degrees): 100 is outside
+    let outside = with(&["--theta-deg", "100", "--extrapolate-from", "10"]);
+    assert!(!outside.status.success());
+    assert!(stderr(&outside).contains("outside the constant-structure interval"), "{}", stderr(&outside));
+}
+
+#[test]
 fn interference_reports_penetrating_touching_and_free() {
     let case = |pos: &str| {
         let o = run(&["interference", "example:cube", "example:cube", "--position", pos, "--json"]);

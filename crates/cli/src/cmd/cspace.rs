@@ -1,5 +1,7 @@
-//! `stackplan cspace MOVING FIXED [--fixed-pose POSE.json] [--theta-deg T] [--pair I,J] [--clearance MM] [--insertion]
-//! [--slice-z Z] [--json | --obj F | --svg F]`: the translational c-space obstacle of every convex pair ([A] App. B).
+//! `stackplan cspace MOVING FIXED [--fixed-pose POSE.json] [--theta-deg T] [--extrapolate-from T0] [--pair I,J]
+//! [--clearance MM] [--insertion] [--slice-z Z] [--json | --obj F | --svg F]`: the translational c-space obstacle of
+//! every convex pair ([A] App. B); with `--extrapolate-from T0` each obstacle is built at `T0` and extrapolated to `T`
+//! within its constant-structure interval ([A] IV-B, eq. 4), an error when `T` is outside that interval.
 //!
 //! Convention: the moving part's pose is the rotation about world z by `theta` applied to its file coordinates, then
 //! the translation `p`; `p` is in the obstacle of a pair iff `normal . p <= offset` for every face of that pair.
@@ -11,6 +13,7 @@ use anyhow::Context;
 use serde::Serialize;
 use stackplan::cspace::minkowski::{FaceKind, Feature, Obstacle, obstacle};
 use stackplan::cspace::offset::{HalfSpaces, clearance, insertion, insertion_polytope, slice};
+use stackplan::orient_interval::extrapolate_from;
 use stackplan_geom::{ConvexPolytope, DMat3, DVec2, Plane};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -28,6 +31,10 @@ pub struct Args {
     /// Rotation of the moving part about world z (degrees).
     #[arg(long, default_value_t = 0.0)]
     pub theta_deg: f64,
+    /// Build each obstacle at this angle (degrees) and extrapolate it to --theta-deg (an error when --theta-deg is
+    /// outside the obstacle's constant-structure interval around this angle).
+    #[arg(long, value_name = "T0")]
+    pub extrapolate_from: Option<f64>,
     /// Only this pair: moving component I, fixed component J.
     #[arg(long, value_name = "I,J")]
     pub pair: Option<String>,
@@ -96,6 +103,10 @@ pub struct PairJson {
     pub faces: Vec<FaceJson>,
     /// Volume of the obstacle (mm^3).
     pub volume: f64,
+    /// With `--extrapolate-from`: the constant-structure interval `[start, end]` (degrees) the obstacle was
+    /// extrapolated within.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub interval_deg: Option<[f64; 2]>,
     /// With `--clearance`: the grown obstacle's planes.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub clearance_planes: Option<Vec<PlaneJson>>,
@@ -112,6 +123,9 @@ pub struct PairJson {
 pub struct CspaceJson {
     /// Rotation of the moving part about z (degrees).
     pub theta_deg: f64,
+    /// With `--extrapolate-from`: the angle (degrees) the obstacles were built at before extrapolation to `theta_deg`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub extrapolated_from_deg: Option<f64>,
     /// Clearance used (mm), if any.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub clearance: Option<f64>,
@@ -130,9 +144,22 @@ fn plane_json(p: &Plane) -> PlaneJson {
     PlaneJson { normal: p.normal.to_array(), offset: p.offset }
 }
 
-/// The obstacles of the requested pairs: `(moving piece, fixed piece, obstacle)`.
-pub fn obstacles(args: &Args) -> anyhow::Result<Vec<(usize, usize, Obstacle)>> {
+/// The obstacle of one convex pair.
+pub struct PairObstacle {
+    /// Component of the moving part.
+    pub moving_piece: usize,
+    /// Component of the fixed part.
+    pub fixed_piece: usize,
+    /// The obstacle.
+    pub obstacle: Obstacle,
+    /// With `--extrapolate-from`: the constant-structure interval (degrees).
+    pub interval_deg: Option<[f64; 2]>,
+}
+
+/// The obstacles of the requested pairs.
+pub fn obstacles(args: &Args) -> anyhow::Result<Vec<PairObstacle>> {
     anyhow::ensure!(args.theta_deg.is_finite(), "--theta-deg must be finite");
+    anyhow::ensure!(args.extrapolate_from.is_none_or(f64::is_finite), "--extrapolate-from must be finite");
     let PartPair { moving, fixed, fixed_pose, only } =
         load_pair(&args.moving, &args.fixed, args.triangulate, args.fixed_pose.as_deref(), args.pair.as_deref())?;
     let (fixed_rotation, fixed_position) = (fixed_pose.rotation, fixed_pose.position);
@@ -145,15 +172,23 @@ pub fn obstacles(args: &Args) -> anyhow::Result<Vec<(usize, usize, Obstacle)>> {
             if only.is_some_and(|o| o != (i, j)) {
                 continue;
             }
-            let o =
-                obstacle(a, rotation, b).with_context(|| format!("obstacle of moving piece {i} / fixed piece {j}"))?;
-            out.push((i, j, o));
+            let what = || format!("obstacle of moving piece {i} / fixed piece {j}");
+            let (o, interval) = match args.extrapolate_from {
+                None => (obstacle(a, rotation, b).with_context(what)?, None),
+                Some(t0) => {
+                    let (o, iv) =
+                        extrapolate_from(a, b, t0.to_radians(), args.theta_deg.to_radians()).with_context(what)?;
+                    (o, Some([iv.start.to_degrees(), iv.end.to_degrees()]))
+                }
+            };
+            out.push(PairObstacle { moving_piece: i, fixed_piece: j, obstacle: o, interval_deg: interval });
         }
     }
     Ok(out)
 }
 
-fn pair_json(args: &Args, i: usize, j: usize, o: &Obstacle) -> PairJson {
+fn pair_json(args: &Args, pair: &PairObstacle) -> PairJson {
+    let (i, j, o) = (pair.moving_piece, pair.fixed_piece, &pair.obstacle);
     let c = o.polytope();
     let faces = c
         .faces()
@@ -175,6 +210,7 @@ fn pair_json(args: &Args, i: usize, j: usize, o: &Obstacle) -> PairJson {
         vertex_pairs: o.vertex_pairs().to_vec(),
         faces,
         volume: c.volume(),
+        interval_deg: pair.interval_deg,
         clearance_planes: args.clearance.map(|d| planes_json(&clearance(o, d))),
         insertion_planes: args.insertion.then(|| planes_json(&insertion(c))),
         slice: args.slice_z.map(|z| slice(c, z).iter().map(|p| p.to_array()).collect()),
@@ -197,9 +233,10 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     }
     let json = CspaceJson {
         theta_deg: args.theta_deg,
+        extrapolated_from_deg: args.extrapolate_from,
         clearance: args.clearance,
         slice_z: args.slice_z,
-        pairs: obstacles.iter().map(|(i, j, o)| pair_json(args, *i, *j, o)).collect(),
+        pairs: obstacles.iter().map(|pair| pair_json(args, pair)).collect(),
     };
     if args.json {
         output::print_json(&json)?;
@@ -221,17 +258,17 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     Ok(Outcome::Success)
 }
 
-fn obj_text(args: &Args, obstacles: &[(usize, usize, Obstacle)]) -> anyhow::Result<String> {
+fn obj_text(args: &Args, obstacles: &[PairObstacle]) -> anyhow::Result<String> {
     let floor = obstacles
         .iter()
-        .map(|(_, _, o)| {
+        .map(|PairObstacle { obstacle: o, .. }| {
             let (lo, hi) = o.polytope().aabb();
             lo.z - 0.1 * (hi.z - lo.z).max(1.0)
         })
         .fold(f64::INFINITY, f64::min);
     let mut text = String::from("# stackplan c-space obstacles\n");
     let mut base = 1;
-    for (i, j, o) in obstacles {
+    for PairObstacle { moving_piece: i, fixed_piece: j, obstacle: o, .. } in obstacles {
         let truncated;
         let poly = if args.insertion {
             truncated = insertion_polytope(o.polytope(), floor).context("truncated insertion obstacle")?;
@@ -252,10 +289,10 @@ fn obj_text(args: &Args, obstacles: &[(usize, usize, Obstacle)]) -> anyhow::Resu
     Ok(text)
 }
 
-fn svg_text(args: &Args, obstacles: &[(usize, usize, Obstacle)]) -> String {
+fn svg_text(args: &Args, obstacles: &[PairObstacle]) -> String {
     let z = args.slice_z.unwrap_or(0.0);
     let polygons: Vec<(usize, usize, Vec<DVec2>)> =
-        obstacles.iter().map(|(i, j, o)| (*i, *j, slice(o.polytope(), z))).collect();
+        obstacles.iter().map(|p| (p.moving_piece, p.fixed_piece, slice(p.obstacle.polytope(), z))).collect();
     let mut lo = DVec2::splat(f64::INFINITY);
     let mut hi = DVec2::splat(f64::NEG_INFINITY);
     for (_, _, p) in &polygons {
