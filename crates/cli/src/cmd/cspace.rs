@@ -145,6 +145,7 @@ fn plane_json(p: &Plane) -> PlaneJson {
 }
 
 /// The obstacle of one convex pair.
+#[derive(Debug)]
 pub struct PairObstacle {
     /// Component of the moving part.
     pub moving_piece: usize,
