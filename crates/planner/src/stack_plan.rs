@@ -55,15 +55,24 @@ pub struct PlanOptions {
     pub insertion: bool,
     /// Interference-free candidates per part and stage, tested in cost order.
     pub candidates: usize,
+    /// When every candidate of the last stage fails the checks, the search there is repeated with four times as many
+    /// candidates, up to this many: a part fits nowhere only when the search is exhausted or this limit is reached.
+    /// Equal to `candidates`: no repetition.
+    #[serde(default = "default_max_candidates")]
+    pub max_candidates: usize,
     /// Resting poses considered (lowest c.g. first).
     pub max_resting_poses: usize,
     /// How far stage 1 may grow the stack's footprint to nest a part (mm).
     pub nest_allowance: f64,
 }
 
+fn default_max_candidates() -> usize {
+    1024
+}
+
 impl PlanOptions {
     /// Defaults of the seed's examples: w = 0.5, 5 mm clearance, 1-degree steps, mu = 0.5, 10 mm cup, insertion,
-    /// 8 candidates, 3 resting poses, 5 mm nesting allowance.
+    /// 8 candidates (up to 1024 when all fail), 3 resting poses, 5 mm nesting allowance.
     pub fn new(count: usize, floor: FloorVolume) -> Self {
         Self {
             count,
@@ -76,6 +85,7 @@ impl PlanOptions {
             cup_diameter: 10.0,
             insertion: true,
             candidates: 8,
+            max_candidates: default_max_candidates(),
             max_resting_poses: 3,
             nest_allowance: 5.0,
         }
@@ -118,6 +128,9 @@ pub struct PlanStats {
     pub searches: usize,
     /// Interference-free candidates checked for stability, grasp and insertion.
     pub candidates_checked: usize,
+    /// Searches repeated with more candidates because every candidate failed the checks.
+    #[serde(default)]
+    pub repeated_searches: usize,
     /// Component pairs whose obstacle was built, over all searches.
     pub pairs_evaluated: u64,
     /// Obstacles constructed (cache misses).
@@ -212,6 +225,9 @@ pub fn plan_stack_with_progress(
     if !(options.candidates >= 1 && options.max_resting_poses >= 1) {
         return Err(PlanError::BadOption("candidates and max_resting_poses must be at least 1".into()));
     }
+    if options.max_candidates < options.candidates {
+        return Err(PlanError::BadOption("max_candidates must be at least candidates".into()));
+    }
     if !(options.cup_diameter > 0.0 && options.cup_diameter.is_finite()) {
         return Err(PlanError::BadOption(format!("the cup diameter must be positive, got {}", options.cup_diameter)));
     }
@@ -274,6 +290,7 @@ pub fn plan_stack_with_progress(
         let mut last_reason = String::from("no interference-free position");
         // the first acceptable candidate of each stage: (stage, candidate, rejected before it, grasp radius)
         let mut accepted: Vec<(u8, Placement, usize, f64)> = Vec::new();
+        let last_stage = stages.last().map_or(2, |s| s.0);
         for (stage, floor) in stages {
             let mut request = PlacementRequest::new(part, stack.clone(), floor);
             request.resting_rotations = rests.clone();
@@ -282,40 +299,63 @@ pub fn plan_stack_with_progress(
             request.horizontal_clearance = true;
             request.cost = Cost::Stacking { w: options.w, origin };
             request.insertion = options.insertion;
-            request.k = options.candidates;
-            let started = std::time::Instant::now();
-            let result = match place_with_caches(&request, &cache, &mut caches) {
-                Ok(r) => r,
-                // stage 1's clipped floor may be malformed (a sliver): fall through to stage 2
-                Err(PlacementError::BadFloor(msg)) if stage == 1 => {
-                    tracing::debug!(index, "stage 1 floor rejected: {msg}");
-                    continue;
-                }
-                Err(e) => return Err(e.into()),
-            };
-            stats.seconds_search += started.elapsed().as_secs_f64();
-            stats.searches += 1;
-            stats.pairs_evaluated += result.stats.pairs_evaluated;
-            stats.obstacles_constructed += result.stats.obstacles_constructed;
-            if result.placements.is_empty() {
-                last_reason = match result.exhausted {
-                    Some(NoPlacement::EmptyOmega) => "the floor volume is too small for the part".into(),
-                    _ => "no interference-free position inside the floor volume".into(),
-                };
-                continue;
-            }
-            let started = std::time::Instant::now();
-            for (rejected, candidate) in result.placements.iter().enumerate() {
-                stats.candidates_checked += 1;
-                match accept(part, &placed, candidate, &check_options)? {
-                    Ok(grasp_radius) => {
-                        accepted.push((stage, candidate.clone(), rejected, grasp_radius));
+            // candidates already rejected in this stage (by position and orientation): a repeated, larger search
+            // returns them again first
+            let mut rejected_here: Vec<([f64; 3], f64, usize)> = Vec::new();
+            let mut k = options.candidates;
+            loop {
+                request.k = k;
+                let started = std::time::Instant::now();
+                let result = match place_with_caches(&request, &cache, &mut caches) {
+                    Ok(r) => r,
+                    // stage 1's clipped floor may be malformed (a sliver): fall through to stage 2
+                    Err(PlacementError::BadFloor(msg)) if stage == 1 => {
+                        tracing::debug!(index, "stage 1 floor rejected: {msg}");
                         break;
                     }
-                    Err(reason) => last_reason = reason,
+                    Err(e) => return Err(e.into()),
+                };
+                stats.seconds_search += started.elapsed().as_secs_f64();
+                stats.searches += 1;
+                stats.pairs_evaluated += result.stats.pairs_evaluated;
+                stats.obstacles_constructed += result.stats.obstacles_constructed;
+                if result.placements.is_empty() {
+                    last_reason = match result.exhausted {
+                        Some(NoPlacement::EmptyOmega) => "the floor volume is too small for the part".into(),
+                        _ => "no interference-free position inside the floor volume".into(),
+                    };
+                    break;
                 }
+                let started = std::time::Instant::now();
+                let mut found = false;
+                for (rejected, candidate) in result.placements.iter().enumerate() {
+                    let key = (candidate.position, candidate.theta_deg, candidate.resting_pose);
+                    if rejected_here.contains(&key) {
+                        continue;
+                    }
+                    stats.candidates_checked += 1;
+                    match accept(part, &placed, candidate, &check_options)? {
+                        Ok(grasp_radius) => {
+                            accepted.push((stage, candidate.clone(), rejected, grasp_radius));
+                            found = true;
+                            break;
+                        }
+                        Err(reason) => {
+                            last_reason = reason;
+                            rejected_here.push(key);
+                        }
+                    }
+                }
+                stats.seconds_checks += started.elapsed().as_secs_f64();
+                // only the last stage, only when nothing at all was accepted, only when the search had more to give
+                let more = result.placements.len() == k && k < options.max_candidates;
+                if found || stage != last_stage || !accepted.is_empty() || !more {
+                    break;
+                }
+                k = (k * 4).min(options.max_candidates);
+                stats.repeated_searches += 1;
+                tracing::debug!(index, k, "every candidate failed the checks: searching for more");
             }
-            stats.seconds_checks += started.elapsed().as_secs_f64();
         }
         // stage 1 (compact) wins unless stage 2 is strictly cheaper: ties and near-ties keep the stack compact
         let best = accepted.iter().min_by(|a, b| {
@@ -474,6 +514,27 @@ mod tests {
             let report = check_stack(&world, &CheckOptions::default()).expect("check");
             assert!(report.parts.iter().all(|c| c.interference <= 1e-6 && c.stable.is_stable()));
         }
+    }
+
+    /// The Triangle part with 5 mm horizontal clearance: every one of the cheapest candidates for the second part
+    /// floats beside the inclined walls of the first and fails the stability check. Without the repeated search the
+    /// plan stops; with it the second part finds a stable position.
+    #[test]
+    fn a_repeated_search_finds_a_stable_position_when_every_candidate_fails() {
+        let part =
+            stackplan_geom::examples::part_by_name("triangle", stackplan_geom::sheet_metal::Decomposition::ConvexMerge)
+                .expect("example");
+        let floor = FloorVolume::rectangle(-340.0, -340.0, 340.0, 340.0, 400.0);
+        let mut options = PlanOptions { w: 0.9, dtheta: 5f64.to_radians(), ..PlanOptions::new(2, floor) };
+        options.max_candidates = options.candidates;
+        let once = plan_stack(&part, &options).expect("plan");
+        assert_eq!(once.parts.len(), 1, "the first {} candidates all fail", options.candidates);
+        assert!(once.stopped.as_deref().is_some_and(|r| r.contains("part 2 of 2")), "{:?}", once.stopped);
+        options.max_candidates = 1024;
+        let repeated = plan_stack(&part, &options).expect("plan");
+        assert_eq!(repeated.parts.len(), 2, "{:?}", repeated.stopped);
+        assert!(repeated.stats.repeated_searches >= 1);
+        assert!(repeated.parts[1].rejected_candidates >= options.candidates);
     }
 
     #[test]

@@ -111,6 +111,8 @@ impl PlannerArgs {
         options.mu = self.mu;
         options.cup_diameter = self.cup_diameter;
         options.candidates = self.candidates;
+        // (the repeated search never asks for fewer than the user's own candidate count)
+        options.max_candidates = options.max_candidates.max(self.candidates);
         Ok(options)
     }
 }
