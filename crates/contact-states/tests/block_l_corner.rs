@@ -8,7 +8,7 @@
 //! One ACSG is generated (GA population 30, 20 generations, polish 800, 6 witness attempts, extremal budget 150 for
 //! test time; about 25 s in the test profile on the loaded 2-core machine) and checked:
 //! * regression: the number of feasible states per level is printed with the Table I-style extremal table (recorded
-//!   in BENCHMARKS.md: seed 2004 gives [0, 27, 90, 89, 34, 11], 251 states, against the seed's 63 for its own
+//!   in docs/benchmarks.md: seed 2004 gives [0, 27, 90, 89, 34, 11], 251 states, against the seed's 63 for its own
 //!   geometry, which has one wall where the `l-corner` fixture has two);
 //! * every reported state is verified **independently** at its witness (`common::independent_check`: parry3d-f64
 //!   element distances, plane checks, c-space interference; the state's PCs hold, nothing penetrates, and exactly
