@@ -284,6 +284,29 @@ fn a_failing_write_leaves_no_file_and_keeps_the_old_one() {
     assert!(!missing_dir.exists());
 }
 
+/// An atomically written file gets the permissions an ordinary new file gets (not the temporary file's owner-only
+/// mode), and an overwritten file keeps its own.
+#[cfg(unix)]
+#[test]
+fn atomic_writes_keep_ordinary_permissions() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mode = |p: &std::path::Path| std::fs::metadata(p).expect("metadata").permissions().mode() & 0o7777;
+    let ordinary = dir.path().join("ordinary.json");
+    std::fs::write(&ordinary, b"{}").expect("write");
+    let atomic_new = dir.path().join("atomic.json");
+    atomic::write_atomic(&atomic_new, b"{}").expect("write");
+    assert_eq!(mode(&atomic_new), mode(&ordinary), "same mode as a file made by File::create (same umask)");
+    let private = dir.path().join("private.json");
+    std::fs::write(&private, b"old").expect("write");
+    std::fs::set_permissions(&private, std::fs::Permissions::from_mode(0o600)).expect("chmod");
+    atomic::write_atomic(&private, b"new").expect("write");
+    assert_eq!(mode(&private), 0o600, "an overwritten file keeps its mode");
+    std::fs::set_permissions(&private, std::fs::Permissions::from_mode(0o640)).expect("chmod");
+    atomic::write_atomic(&private, b"newer").expect("write");
+    assert_eq!(mode(&private), 0o640);
+}
+
 #[test]
 fn unsupported_extensions() {
     let e = io::read_part("part.step", &ReadOptions::default()).expect_err("step");

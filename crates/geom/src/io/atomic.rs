@@ -2,6 +2,10 @@
 //! the target. A rename within one directory (one file system) is atomic on POSIX and Windows, so readers see either
 //! the old file or the complete new one, and a failure at any step leaves no partial file (the temporary file is
 //! removed when it is dropped). O(size of the data).
+//!
+//! Permissions: the temporary file is created with the mode an ordinary new file would get (`0o666` less the
+//! process umask), or with the existing target's mode when it is overwritten, so the rename does not leave an
+//! owner-only file behind (the temporary-file default).
 
 use super::IoError;
 use std::io::Write;
@@ -24,7 +28,16 @@ pub fn write_atomic_with(
         _ => Path::new("."),
     };
     let err = |e: std::io::Error| IoError::os(path, e);
-    let mut tmp = tempfile::Builder::new().prefix(".stackplan-").suffix(".tmp").tempfile_in(dir).map_err(err)?;
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".stackplan-").suffix(".tmp");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        // open(2) applies the umask to this mode, exactly as for a file created by `File::create`
+        let mode = std::fs::metadata(path).map(|m| m.permissions().mode() & 0o7777).unwrap_or(0o666);
+        builder.permissions(std::fs::Permissions::from_mode(mode));
+    }
+    let mut tmp = builder.tempfile_in(dir).map_err(err)?;
     {
         let mut buffered = std::io::BufWriter::new(tmp.as_file_mut());
         fill(&mut buffered).map_err(err)?;
