@@ -86,8 +86,10 @@ pub enum PairContact {
     },
 }
 
+/// The interval `[min, max]` of `u . v` over `vertices` (the projection of a convex set onto an axis, the basic step
+/// of a separating-axis test). O(n).
 #[inline]
-fn project(vertices: &[DVec3], u: DVec3) -> (f64, f64) {
+pub fn project(vertices: &[DVec3], u: DVec3) -> (f64, f64) {
     let mut lo = f64::INFINITY;
     let mut hi = f64::NEG_INFINITY;
     for v in vertices {

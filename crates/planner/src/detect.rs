@@ -18,7 +18,7 @@
 use crate::orientation::Orientation;
 use glam::{DMat3, DVec3};
 use stackplan_cspace::PlacedConvex;
-use stackplan_cspace::interference::{PairContact, gjk_distance};
+use stackplan_cspace::interference::{PairContact, gjk_distance, project};
 use stackplan_geom::polytope::ConvexPolytope;
 use stackplan_geom::{Part, Pose};
 use std::collections::HashMap;
@@ -303,18 +303,6 @@ impl std::hash::Hasher for KeyHasher {
 
 /// The separating-axis data of the pairs tested so far, by (orientation index, moving component, stack component).
 pub type AxesCache = HashMap<(usize, usize, usize), PairEntry, std::hash::BuildHasherDefault<KeyHasher>>;
-
-#[inline]
-fn project(vertices: &[DVec3], u: DVec3) -> (f64, f64) {
-    let mut lo = f64::INFINITY;
-    let mut hi = f64::NEG_INFINITY;
-    for v in vertices {
-        let x = u.dot(*v);
-        lo = lo.min(x);
-        hi = hi.max(x);
-    }
-    (lo, hi)
-}
 
 /// A pair whose normal axes did not decide it: the running maximum so far (an upper bound of its violation follows
 /// from it) and whether its scan runs on the fly or on cached axes.
@@ -643,19 +631,10 @@ mod tests {
     use super::*;
     use crate::request::Cost;
     use stackplan_cspace::interference::classify_pair;
-    use stackplan_geom::{PartOrigin, convex_hull};
+    use stackplan_geom::PartOrigin;
 
     fn cuboid(lo: DVec3, hi: DVec3) -> ConvexPolytope {
-        let pts: Vec<DVec3> = (0..8)
-            .map(|i| {
-                DVec3::new(
-                    if i & 1 == 0 { lo.x } else { hi.x },
-                    if i & 2 == 0 { lo.y } else { hi.y },
-                    if i & 4 == 0 { lo.z } else { hi.z },
-                )
-            })
-            .collect();
-        convex_hull(&pts).expect("box").polytope
+        ConvexPolytope::cuboid(lo, hi).expect("box")
     }
 
     fn l_part(a: f64, t: f64, h: f64) -> Part {

@@ -301,7 +301,7 @@ pub fn plan_stack_with_progress(
             request.insertion = options.insertion;
             // candidates already rejected in this stage (by position and orientation): a repeated, larger search
             // returns them again first
-            let mut rejected_here: Vec<([f64; 3], f64, usize)> = Vec::new();
+            let mut rejected_here: std::collections::HashSet<([u64; 3], u64, usize)> = Default::default();
             let mut k = options.candidates;
             loop {
                 request.k = k;
@@ -329,7 +329,8 @@ pub fn plan_stack_with_progress(
                 let started = std::time::Instant::now();
                 let mut found = false;
                 for (rejected, candidate) in result.placements.iter().enumerate() {
-                    let key = (candidate.position, candidate.theta_deg, candidate.resting_pose);
+                    let key =
+                        (candidate.position.map(f64::to_bits), candidate.theta_deg.to_bits(), candidate.resting_pose);
                     if rejected_here.contains(&key) {
                         continue;
                     }
@@ -342,7 +343,7 @@ pub fn plan_stack_with_progress(
                         }
                         Err(reason) => {
                             last_reason = reason;
-                            rejected_here.push(key);
+                            rejected_here.insert(key);
                         }
                     }
                 }

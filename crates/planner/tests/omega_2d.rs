@@ -4,41 +4,19 @@
 //! free sample may beat the search's optimum; when the search finds nothing, no sample may be free; every returned
 //! placement lies at `fixed_z`, inside the floor volume and free of interference.
 
+mod common;
+
 use glam::{DMat3, DVec3};
 use proptest::prelude::*;
 use stackplan_cspace::interference::{PairContact, PlacedScene, Placement as CsPlacement};
-use stackplan_geom::{Part, PartOrigin, Pose, convex_hull};
+use stackplan_geom::{Part, Pose};
 use stackplan_planner::orientation::Orientation;
 use stackplan_planner::reference::violations;
 use stackplan_planner::{Cost, FloorVolume, NoPlacement, PlacementRequest, StackPart, place, uniform_thetas};
 
-fn cuboid(lo: DVec3, hi: DVec3) -> stackplan_geom::ConvexPolytope {
-    let pts: Vec<DVec3> = (0..8)
-        .map(|i| {
-            DVec3::new(
-                if i & 1 == 0 { lo.x } else { hi.x },
-                if i & 2 == 0 { lo.y } else { hi.y },
-                if i & 4 == 0 { lo.z } else { hi.z },
-            )
-        })
-        .collect();
-    convex_hull(&pts).expect("box").polytope
-}
-
-fn boxes(name: &str, b: &[(DVec3, DVec3)]) -> Part {
-    Part::from_components(name, b.iter().map(|(l, h)| cuboid(*l, *h)).collect(), 1.0, PartOrigin::ConvexPieces)
-        .expect("part")
-}
-
 /// A box or an L of two boxes (concave, two components).
 fn part_strategy() -> impl Strategy<Value = Part> {
-    (10.0f64..35.0, 10.0f64..35.0, 5.0f64..25.0, any::<bool>(), 5.0f64..15.0).prop_map(|(a, b, c, l, t)| {
-        if l {
-            boxes("l", &[(DVec3::ZERO, DVec3::new(a, t, c)), (DVec3::new(0.0, t, 0.0), DVec3::new(t, t + b, c))])
-        } else {
-            boxes("box", &[(DVec3::ZERO, DVec3::new(a, b, c))])
-        }
-    })
+    common::box_or_l(10.0..35.0, 5.0..25.0, 5.0..15.0)
 }
 
 #[derive(Debug)]

@@ -1,24 +1,15 @@
 //! Placement of one part: golden cases by hand, errors, symmetry, determinism.
 
 use glam::{DMat3, DVec3};
-use stackplan_geom::{Part, PartOrigin, Pose, convex_hull};
+use stackplan_geom::{ConvexPolytope, Part, PartOrigin, Pose};
 use stackplan_planner::reference::violations;
 use stackplan_planner::{
     Contact, Cost, FloorVolume, NoPlacement, PlacementError, PlacementRequest, StackPart, place, uniform_thetas,
 };
 
 fn cuboid_part(lo: DVec3, hi: DVec3) -> Part {
-    let pts: Vec<DVec3> = (0..8)
-        .map(|i| {
-            DVec3::new(
-                if i & 1 == 0 { lo.x } else { hi.x },
-                if i & 2 == 0 { lo.y } else { hi.y },
-                if i & 4 == 0 { lo.z } else { hi.z },
-            )
-        })
-        .collect();
-    Part::from_components("box", vec![convex_hull(&pts).expect("box").polytope], 1.0, PartOrigin::ConvexPieces)
-        .expect("part")
+    let component = ConvexPolytope::cuboid(lo, hi).expect("box");
+    Part::from_components("box", vec![component], 1.0, PartOrigin::ConvexPieces).expect("part")
 }
 
 #[test]

@@ -7,16 +7,7 @@ use stackplan_stability::PlacedPart;
 
 /// The box `[lo, hi]`.
 pub fn cuboid(lo: DVec3, hi: DVec3) -> ConvexPolytope {
-    let pts: Vec<DVec3> = (0..8)
-        .map(|i| {
-            DVec3::new(
-                if i & 1 == 0 { lo.x } else { hi.x },
-                if i & 2 == 0 { lo.y } else { hi.y },
-                if i & 4 == 0 { lo.z } else { hi.z },
-            )
-        })
-        .collect();
-    convex_hull(&pts).expect("box").polytope
+    ConvexPolytope::cuboid(lo, hi).expect("box")
 }
 
 /// A box part `[0, size]` with density 1.
