@@ -145,8 +145,8 @@ pub struct ConvexPolytope {
     vertices: Vec<DVec3>,
     faces: Vec<Face>,
     edges: Vec<Edge>,
-    /// `face_edges[f][k]` is the edge from `faces[f].vertices[k]` to `faces[f].vertices[k + 1]`.
-    face_edges: Vec<Vec<usize>>,
+    /// `face_edges.of(f)[k]` is the edge from `faces[f].vertices[k]` to `faces[f].vertices[k + 1]`.
+    face_edges: FaceEdgeTable,
 }
 
 /// Where a point is relative to a polytope, under a tolerance.
@@ -187,60 +187,8 @@ impl ConvexPolytope {
     /// and face planes (Newell normal, offset = the largest `n . v` over the face's vertices, so every face vertex
     /// satisfies its own inequality). Convexity is checked by [`Self::validate`], not here.
     pub fn new(vertices: Vec<DVec3>, faces: Vec<Vec<usize>>) -> Result<Self, PolytopeError> {
-        for (i, v) in vertices.iter().enumerate() {
-            if !v.is_finite() {
-                return Err(PolytopeError::NonFinite { vertex: i });
-            }
-        }
-        if vertices.len() > MAX_VERTICES {
-            return Err(PolytopeError::TooManyVertices { count: vertices.len() });
-        }
-        // half-edges (a, b, face, position), grouped by undirected edge by sorting: each group must be exactly one
-        // a -> b and one b -> a (closed, consistently oriented 2-manifold). O(H log H) for H half-edges, no hashing.
-        // The undirected edge and the direction are packed into one integer key, (min << 33) | (max << 1) | (a > b),
-        // so the sort compares plain integers.
-        let mut half: Vec<(u64, u32, u32)> = Vec::with_capacity(faces.iter().map(Vec::len).sum());
-        for (f, face) in faces.iter().enumerate() {
-            if face.len() < 3 {
-                return Err(PolytopeError::FaceTooSmall { face: f, count: face.len() });
-            }
-            for (k, &a) in face.iter().enumerate() {
-                if a >= vertices.len() {
-                    return Err(PolytopeError::BadVertexIndex { face: f, vertex: a, len: vertices.len() });
-                }
-                let b = face[(k + 1) % face.len()];
-                if a == b {
-                    return Err(PolytopeError::NotManifold { a, b });
-                }
-                let key = ((a.min(b) as u64) << 33) | ((a.max(b) as u64) << 1) | u64::from(a > b);
-                half.push((key, f as u32, k as u32));
-            }
-        }
-        half.sort_unstable_by_key(|h| h.0);
-        let ends = |key: u64| -> (usize, usize) {
-            let (lo, hi) = ((key >> 33) as usize, ((key >> 1) & 0xFFFF_FFFF) as usize);
-            if key & 1 == 1 { (hi, lo) } else { (lo, hi) }
-        };
-        let mut edges = Vec::with_capacity(half.len() / 2);
-        let mut face_edges: Vec<Vec<usize>> = faces.iter().map(|f| vec![usize::MAX; f.len()]).collect();
-        let mut i = 0;
-        while i < half.len() {
-            let (key, f, k) = half[i];
-            let (a, b) = ends(key);
-            let Some(&(key2, g, j)) = half.get(i + 1) else {
-                return Err(PolytopeError::NotManifold { a, b });
-            };
-            // the pair must be a -> b and b -> a, and no third half-edge on the same vertices
-            let third = half.get(i + 2).is_some_and(|h| h.0 >> 1 == key >> 1);
-            if key2 != key ^ 1 || key & 1 == 1 || third {
-                return Err(PolytopeError::NotManifold { a, b });
-            }
-            let e = edges.len();
-            edges.push(Edge { vertices: [a, b], faces: [f as usize, g as usize] });
-            face_edges[f as usize][k as usize] = e;
-            face_edges[g as usize][j as usize] = e;
-            i += 2;
-        }
+        check_vertices(&vertices)?;
+        let (edges, face_edges) = edge_table(vertices.len(), &faces, |f| f.as_slice())?;
         let mut out = Vec::with_capacity(faces.len());
         for (f, face) in faces.into_iter().enumerate() {
             let plane = plane_of(&vertices, &face).ok_or(PolytopeError::DegenerateFace { face: f })?;
@@ -287,11 +235,37 @@ impl ConvexPolytope {
         faces: Vec<Vec<usize>>,
         planes: Vec<Plane>,
     ) -> Result<Self, PolytopeError> {
-        let mut p = Self::new(vertices, faces)?;
-        for (face, plane) in p.faces.iter_mut().zip(planes) {
-            face.plane = plane;
+        check_vertices(&vertices)?;
+        let (edges, face_edges) = edge_table(vertices.len(), &faces, |f| f.as_slice())?;
+        let mut out = Vec::with_capacity(faces.len());
+        let mut planes = planes.into_iter();
+        for (f, face) in faces.into_iter().enumerate() {
+            // the same degenerate-face check as `new`; the computed plane is only kept where none is given
+            let plane = match planes.next() {
+                Some(given) if has_area(&vertices, &face) => given,
+                given => {
+                    let computed = plane_of(&vertices, &face).ok_or(PolytopeError::DegenerateFace { face: f })?;
+                    given.unwrap_or(computed)
+                }
+            };
+            out.push(Face { vertices: face, plane });
         }
-        Ok(p)
+        Ok(Self { vertices, faces: out, edges, face_edges })
+    }
+
+    /// Builds a polytope from vertices and faces that carry their planes: the same result and checks as
+    /// [`Self::with_planes`] with the faces' vertex cycles and planes as separate lists (the planes' normals must be
+    /// unit length), without allocating those lists.
+    pub fn from_faces(vertices: Vec<DVec3>, faces: Vec<Face>) -> Result<Self, PolytopeError> {
+        check_vertices(&vertices)?;
+        let (edges, face_edges) = edge_table(vertices.len(), &faces, |f| f.vertices.as_slice())?;
+        for (f, face) in faces.iter().enumerate() {
+            // the same degenerate-face check as `new`
+            if !has_area(&vertices, &face.vertices) && plane_of(&vertices, &face.vertices).is_none() {
+                return Err(PolytopeError::DegenerateFace { face: f });
+            }
+        }
+        Ok(Self { vertices, faces, edges, face_edges })
     }
 
     /// The same topology (faces, edges) with new vertex coordinates and face planes, in O(V + F) without any
@@ -323,7 +297,7 @@ impl ConvexPolytope {
 
     /// Edge indices of face `f`, aligned with its vertex cycle (`face_edges(f)[k]` joins vertex `k` and `k + 1`).
     pub fn face_edges(&self, f: usize) -> &[usize] {
-        &self.face_edges[f]
+        self.face_edges.of(f)
     }
 
     /// The face planes, in face order.
@@ -509,6 +483,168 @@ impl ConvexPolytope {
     }
 }
 
+/// The edge indices of every face in one flat list: face `f`'s are `edges[starts[f]..starts[f + 1]]` (two allocations
+/// instead of one per face). Serialised and debug-printed exactly as the list of per-face lists it replaces.
+#[derive(Clone, PartialEq, Eq)]
+struct FaceEdgeTable {
+    edges: Vec<usize>,
+    starts: Vec<usize>,
+}
+
+impl FaceEdgeTable {
+    fn of(&self, f: usize) -> &[usize] {
+        &self.edges[self.starts[f]..self.starts[f + 1]]
+    }
+
+    fn lists(&self) -> impl Iterator<Item = &[usize]> + '_ {
+        self.starts.windows(2).map(|w| &self.edges[w[0]..w[1]])
+    }
+}
+
+impl std::fmt::Debug for FaceEdgeTable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_list().entries(self.lists()).finish()
+    }
+}
+
+impl Serialize for FaceEdgeTable {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_seq(self.lists())
+    }
+}
+
+impl<'de> Deserialize<'de> for FaceEdgeTable {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let lists = Vec::<Vec<usize>>::deserialize(deserializer)?;
+        let mut starts = Vec::with_capacity(lists.len() + 1);
+        starts.push(0);
+        let mut edges = Vec::with_capacity(lists.iter().map(Vec::len).sum());
+        for list in lists {
+            edges.extend_from_slice(&list);
+            starts.push(edges.len());
+        }
+        Ok(Self { edges, starts })
+    }
+}
+
+/// Finite coordinates and at most [`MAX_VERTICES`] vertices.
+fn check_vertices(vertices: &[DVec3]) -> Result<(), PolytopeError> {
+    for (i, v) in vertices.iter().enumerate() {
+        if !v.is_finite() {
+            return Err(PolytopeError::NonFinite { vertex: i });
+        }
+    }
+    if vertices.len() > MAX_VERTICES {
+        return Err(PolytopeError::TooManyVertices { count: vertices.len() });
+    }
+    Ok(())
+}
+
+/// The edges and the per-face edge indices of a face list, checking that it is a closed, consistently oriented
+/// 2-manifold.
+///
+/// Half-edges `(a, b, face, position)` are grouped by undirected edge by sorting: each group must be exactly one
+/// `a -> b` and one `b -> a`. The undirected edge and the direction are packed into one integer key,
+/// `(min << 33) | (max << 1) | (a > b)`; edges come out in increasing key order, i.e. ordered by (smaller vertex,
+/// larger vertex), each with the face traversing it from the smaller to the larger vertex first. The sort is a
+/// counting sort on the smaller vertex followed by an insertion sort (which only moves half-edges within one
+/// vertex's bucket): O(V + H + sum of squared bucket sizes) for H half-edges, linear for bounded vertex degree, no
+/// hashing.
+fn edge_table<F>(
+    nv: usize,
+    faces: &[F],
+    cycle: impl Fn(&F) -> &[usize],
+) -> Result<(Vec<Edge>, FaceEdgeTable), PolytopeError> {
+    let mut small_counts = [0u32; 129];
+    let mut large_counts = Vec::new();
+    let counts: &mut [u32] = if nv < small_counts.len() {
+        &mut small_counts[..=nv]
+    } else {
+        large_counts.resize(nv + 1, 0u32);
+        &mut large_counts
+    };
+    // pass 1: checks in face order (the first failure is reported) and bucket sizes by the smaller vertex
+    let mut total = 0usize;
+    for (f, face) in faces.iter().enumerate() {
+        let face = cycle(face);
+        if face.len() < 3 {
+            return Err(PolytopeError::FaceTooSmall { face: f, count: face.len() });
+        }
+        for (k, &a) in face.iter().enumerate() {
+            if a >= nv {
+                return Err(PolytopeError::BadVertexIndex { face: f, vertex: a, len: nv });
+            }
+            let b = face[(k + 1) % face.len()];
+            if a == b {
+                return Err(PolytopeError::NotManifold { a, b });
+            }
+            counts[a.min(b) + 1] += 1;
+        }
+        total += face.len();
+    }
+    for v in 0..nv {
+        counts[v + 1] += counts[v];
+    }
+    // pass 2: place every half-edge in its bucket, then sort by the full key (moves stay inside buckets)
+    let mut half: Vec<(u64, u32, u32)> = vec![(0, 0, 0); total];
+    for (f, face) in faces.iter().enumerate() {
+        let face = cycle(face);
+        for (k, &a) in face.iter().enumerate() {
+            let b = face[(k + 1) % face.len()];
+            let key = ((a.min(b) as u64) << 33) | ((a.max(b) as u64) << 1) | u64::from(a > b);
+            let slot = &mut counts[a.min(b)];
+            half[*slot as usize] = (key, f as u32, k as u32);
+            *slot += 1;
+        }
+    }
+    for i in 1..half.len() {
+        let h = half[i];
+        let mut j = i;
+        while j > 0 && half[j - 1].0 > h.0 {
+            half[j] = half[j - 1];
+            j -= 1;
+        }
+        half[j] = h;
+    }
+    let ends = |key: u64| -> (usize, usize) {
+        let (lo, hi) = ((key >> 33) as usize, ((key >> 1) & 0xFFFF_FFFF) as usize);
+        if key & 1 == 1 { (hi, lo) } else { (lo, hi) }
+    };
+    let mut starts = Vec::with_capacity(faces.len() + 1);
+    starts.push(0);
+    for face in faces {
+        starts.push(starts[starts.len() - 1] + cycle(face).len());
+    }
+    let mut face_edges = FaceEdgeTable { edges: vec![usize::MAX; total], starts };
+    let mut edges = Vec::with_capacity(half.len() / 2);
+    let mut i = 0;
+    while i < half.len() {
+        let (key, f, k) = half[i];
+        let (a, b) = ends(key);
+        let Some(&(key2, g, j)) = half.get(i + 1) else {
+            return Err(PolytopeError::NotManifold { a, b });
+        };
+        // the pair must be a -> b and b -> a, and no third half-edge on the same vertices
+        let third = half.get(i + 2).is_some_and(|h| h.0 >> 1 == key >> 1);
+        if key2 != key ^ 1 || key & 1 == 1 || third {
+            return Err(PolytopeError::NotManifold { a, b });
+        }
+        let e = edges.len();
+        edges.push(Edge { vertices: [a, b], faces: [f as usize, g as usize] });
+        face_edges.edges[face_edges.starts[f as usize] + k as usize] = e;
+        face_edges.edges[face_edges.starts[g as usize] + j as usize] = e;
+        i += 2;
+    }
+    Ok((edges, face_edges))
+}
+
+/// Whether [`plane_of`] finds a plane for the face because its Newell normal is non-zero (the usual case; when it is
+/// zero, `plane_of` tries a fallback, so `false` means "ask `plane_of`", not "degenerate").
+fn has_area(vertices: &[DVec3], face: &[usize]) -> bool {
+    let len = newell_normal(face.iter().map(|&i| vertices[i])).length();
+    !len.is_nan() && len > 0.0 && len.is_finite()
+}
+
 fn plane_of(vertices: &[DVec3], face: &[usize]) -> Option<Plane> {
     let mut n = newell_normal(face.iter().map(|&i| vertices[i]));
     let mut len = n.length();
@@ -607,6 +743,79 @@ mod tests {
         d.validate().expect("valid");
         assert!((d.volume() - 8.0).abs() < 1e-12);
         assert!(c.with_geometry(vec![DVec3::ZERO], Vec::new()).is_none());
+    }
+
+    #[test]
+    fn face_edge_table_keeps_the_nested_list_format() {
+        let c = unit_cube();
+        let nested: Vec<Vec<usize>> = (0..c.faces().len()).map(|f| c.face_edges(f).to_vec()).collect();
+        // Debug and JSON show the per-face lists exactly as a `Vec<Vec<usize>>` field did
+        assert_eq!(format!("{:?}", c.face_edges), format!("{nested:?}"));
+        let json = serde_json::to_value(&c).expect("serialise");
+        assert_eq!(json["face_edges"], serde_json::to_value(&nested).expect("serialise lists"));
+        let back: ConvexPolytope = serde_json::from_value(json).expect("deserialise");
+        assert_eq!(back, c);
+        assert_eq!(back.face_edges(5), c.face_edges(5));
+    }
+
+    #[test]
+    fn edge_table_orders_edges_by_their_vertices() {
+        // edges sorted by (smaller vertex, larger vertex), faces[0] traversing smaller -> larger, for any face order
+        let c = unit_cube();
+        let keys: Vec<[usize; 2]> = c.edges().iter().map(|e| e.vertices).collect();
+        assert!(keys.windows(2).all(|w| w[0] < w[1]));
+        assert!(keys.iter().all(|k| k[0] < k[1]));
+        let mut faces: Vec<Vec<usize>> = c.faces().iter().map(|f| f.vertices.clone()).collect();
+        faces.reverse();
+        let r = ConvexPolytope::new(c.vertices().to_vec(), faces).expect("cube");
+        assert_eq!(r.edges().iter().map(|e| e.vertices).collect::<Vec<_>>(), keys);
+        // more vertices than the on-stack bucket table holds: a prism over a 100-gon
+        let n = 100;
+        let mut vertices = Vec::new();
+        for k in 0..n {
+            let t = std::f64::consts::TAU * k as f64 / n as f64;
+            vertices.push(DVec3::new(t.cos(), t.sin(), 0.0));
+            vertices.push(DVec3::new(t.cos(), t.sin(), 1.0));
+        }
+        let mut faces = vec![(0..n).rev().map(|k| 2 * k).collect::<Vec<_>>(), (0..n).map(|k| 2 * k + 1).collect()];
+        for k in 0..n {
+            let m = (k + 1) % n;
+            faces.push(vec![2 * k, 2 * m, 2 * m + 1, 2 * k + 1]);
+        }
+        let p = ConvexPolytope::new(vertices, faces).expect("prism");
+        p.validate().expect("valid");
+        assert_eq!(p.edges().len(), 3 * n);
+        assert!(p.edges().windows(2).all(|w| w[0].vertices < w[1].vertices));
+    }
+
+    #[test]
+    fn from_faces_equals_with_planes() {
+        let c = unit_cube();
+        let planes: Vec<Plane> = c.planes().map(|p| Plane { normal: p.normal, offset: p.offset + 0.5 }).collect();
+        let faces: Vec<Vec<usize>> = c.faces().iter().map(|f| f.vertices.clone()).collect();
+        let a = ConvexPolytope::with_planes(c.vertices().to_vec(), faces.clone(), planes.clone()).expect("cube");
+        let given: Vec<Face> =
+            faces.iter().zip(&planes).map(|(v, p)| Face { vertices: v.clone(), plane: *p }).collect();
+        let b = ConvexPolytope::from_faces(c.vertices().to_vec(), given.clone()).expect("cube");
+        assert_eq!(a, b);
+        // fewer planes than faces: the rest are computed, as `new` does
+        let c2 = ConvexPolytope::with_planes(c.vertices().to_vec(), faces.clone(), planes[..2].to_vec()).expect("cube");
+        assert_eq!(c2.faces()[1].plane, planes[1]);
+        assert_eq!(c2.faces()[2].plane, c.faces()[2].plane);
+        // the same errors: a zero-area face, a non-manifold list
+        let mut flat = c.vertices().to_vec();
+        for v in [1, 3, 5, 7] {
+            flat[v].x = 0.0;
+        }
+        let with_planes = ConvexPolytope::with_planes(flat.clone(), faces.clone(), planes.clone());
+        assert!(matches!(with_planes, Err(PolytopeError::DegenerateFace { face: 0 })), "{with_planes:?}");
+        assert_eq!(ConvexPolytope::from_faces(flat, given.clone()), with_planes);
+        let mut open = given;
+        open.pop();
+        assert!(matches!(
+            ConvexPolytope::from_faces(c.vertices().to_vec(), open),
+            Err(PolytopeError::NotManifold { .. })
+        ));
     }
 
     #[test]
