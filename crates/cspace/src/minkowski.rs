@@ -42,7 +42,7 @@
 
 use glam::{DMat3, DVec2, DVec3};
 use serde::{Deserialize, Serialize};
-use stackplan_geom::polytope::{Containment, ConvexPolytope, Plane, PolytopeError};
+use stackplan_geom::polytope::{Containment, ConvexPolytope, Face, Plane, PolytopeError};
 use stackplan_geom::predicates::orient2d;
 use stackplan_geom::tolerance::{RELATIVE, Tolerance};
 use stackplan_geom::{HullError, convex_hull};
@@ -356,6 +356,7 @@ pub enum OverlayFailure {
     Euler,
 }
 
+#[derive(Clone, Copy)]
 struct Arc {
     /// Unit circle normal, oriented so that the arc runs counter-clockwise about it from `from` to `to`.
     circle: DVec3,
@@ -367,17 +368,15 @@ struct Arc {
     vertices: [usize; 2],
 }
 
-/// Arcs of a polytope whose vertices are `vertices` and face normals `normals` (edge topology from `p`).
-fn arcs(p: &ConvexPolytope, vertices: &[DVec3], normals: &[DVec3]) -> Vec<Arc> {
-    p.edges()
-        .iter()
-        .map(|e| {
-            let d = (vertices[e.vertices[1]] - vertices[e.vertices[0]]).normalize();
-            let (n0, n1) = (normals[e.faces[0]], normals[e.faces[1]]);
-            let circle = if n0.cross(n1).dot(d) >= 0.0 { d } else { -d };
-            Arc { circle, from: e.faces[0], to: e.faces[1], vertices: e.vertices }
-        })
-        .collect()
+/// Arcs of a polytope whose vertices are `vertices` and face normals `normals` (edge topology from `p`), into `out`.
+fn arcs(p: &ConvexPolytope, vertices: &[DVec3], normals: &[DVec3], out: &mut Vec<Arc>) {
+    out.clear();
+    out.extend(p.edges().iter().map(|e| {
+        let d = (vertices[e.vertices[1]] - vertices[e.vertices[0]]).normalize();
+        let (n0, n1) = (normals[e.faces[0]], normals[e.faces[1]]);
+        let circle = if n0.cross(n1).dot(d) >= 0.0 { d } else { -d };
+        Arc { circle, from: e.faces[0], to: e.faces[1], vertices: e.vertices }
+    }));
 }
 
 #[inline]
@@ -397,30 +396,97 @@ fn strictly_inside_arc(arc: &Arc, normals: &[DVec3], u: DVec3) -> bool {
     normals[arc.from].cross(u).dot(arc.circle) > 0.0 && u.cross(normals[arc.to]).dot(arc.circle) > 0.0
 }
 
+/// Working buffers of one overlay, kept per thread between calls: the overlay itself allocates nothing once they
+/// have grown; only the result's own vectors are allocated.
+#[derive(Default)]
+struct Scratch {
+    ra: Vec<DVec3>,
+    neg_ra: Vec<DVec3>,
+    am: Vec<DVec3>,
+    bn: Vec<DVec3>,
+    a_arcs: Vec<Arc>,
+    b_arcs: Vec<Arc>,
+    s_ab: Vec<i8>,
+    s_ba: Vec<i8>,
+    merged_with_b: Vec<Option<usize>>,
+    merged_with_a: Vec<Option<usize>>,
+    specs: Vec<FaceSpec>,
+    index_of: Vec<u32>,
+    cycle: Vec<[usize; 2]>,
+    planar: PlanarScratch,
+}
+
+thread_local! {
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
+}
+
 /// The Gauss-map route alone, without the hull fallback (for tests and benchmarks).
 pub fn gauss_map_obstacle(
     moving: &ConvexPolytope,
     rotation: DMat3,
     fixed: &ConvexPolytope,
 ) -> Result<Obstacle, OverlayFailure> {
-    let ra: Vec<DVec3> = moving.vertices().iter().map(|a| rotation * *a).collect();
+    // the per-thread buffers, or fresh ones when they are in use (re-entrant call) or gone (thread exit)
+    SCRATCH
+        .try_with(|cell| match cell.try_borrow_mut() {
+            Ok(mut scratch) => Some(overlay(moving, rotation, fixed, &mut scratch)),
+            Err(_) => None,
+        })
+        .ok()
+        .flatten()
+        .unwrap_or_else(|| overlay(moving, rotation, fixed, &mut Scratch::default()))
+}
+
+fn overlay(
+    moving: &ConvexPolytope,
+    rotation: DMat3,
+    fixed: &ConvexPolytope,
+    scratch: &mut Scratch,
+) -> Result<Obstacle, OverlayFailure> {
+    let Scratch {
+        ra,
+        neg_ra,
+        am,
+        bn,
+        a_arcs,
+        b_arcs,
+        s_ab,
+        s_ba,
+        merged_with_b,
+        merged_with_a,
+        specs: faces,
+        index_of,
+        cycle,
+        planar,
+    } = scratch;
+    ra.clear();
+    ra.extend(moving.vertices().iter().map(|a| rotation * *a));
     // -RA: vertices -ra, normals -R n; edge arcs computed from -ra.
-    let neg_ra: Vec<DVec3> = ra.iter().map(|r| -*r).collect();
-    let am: Vec<DVec3> = moving.faces().iter().map(|f| -(rotation * f.plane.normal).normalize()).collect();
+    neg_ra.clear();
+    neg_ra.extend(ra.iter().map(|r| -*r));
+    am.clear();
+    am.extend(moving.faces().iter().map(|f| -(rotation * f.plane.normal).normalize()));
     let bv = fixed.vertices();
-    let bn: Vec<DVec3> = fixed.faces().iter().map(|f| f.plane.normal).collect();
-    let a_arcs = arcs(moving, &neg_ra, &am);
-    let b_arcs = arcs(fixed, bv, &bn);
+    bn.clear();
+    bn.extend(fixed.faces().iter().map(|f| f.plane.normal));
+    arcs(moving, neg_ra, am, a_arcs);
+    arcs(fixed, bv, bn, b_arcs);
+    let (am, bn, a_arcs, b_arcs) = (&*am, &*bn, &*a_arcs, &*b_arcs);
     let (fa, fb) = (am.len(), bn.len());
 
     // sides: s_ab[e * fb + g] = side of B's normal g w.r.t. the circle of A-arc e; s_ba[e * fa + f] likewise.
-    let s_ab: Vec<i8> = a_arcs.iter().flat_map(|arc| bn.iter().map(move |n| tol_sign(arc.circle.dot(*n)))).collect();
-    let s_ba: Vec<i8> = b_arcs.iter().flat_map(|arc| am.iter().map(move |n| tol_sign(arc.circle.dot(*n)))).collect();
+    s_ab.clear();
+    s_ab.extend(a_arcs.iter().flat_map(|arc| bn.iter().map(move |n| tol_sign(arc.circle.dot(*n)))));
+    s_ba.clear();
+    s_ba.extend(b_arcs.iter().flat_map(|arc| am.iter().map(move |n| tol_sign(arc.circle.dot(*n)))));
+    let (s_ab, s_ba) = (&*s_ab, &*s_ba);
 
     // parallel faces: merged_with_b[f] = Some(g) when -R n_f == n_g within half the tolerance.
     let merge_sq = (0.5 * ANGULAR_TOLERANCE) * (0.5 * ANGULAR_TOLERANCE);
-    let mut merged_with_b: Vec<Option<usize>> = vec![None; fa];
-    let mut merged_with_a: Vec<Option<usize>> = vec![None; fb];
+    merged_with_b.clear();
+    merged_with_b.resize(fa, None);
+    merged_with_a.clear();
+    merged_with_a.resize(fb, None);
     for (f, m) in am.iter().enumerate() {
         for (g, n) in bn.iter().enumerate() {
             if (*m - *n).length_squared() <= merge_sq {
@@ -430,7 +496,7 @@ pub fn gauss_map_obstacle(
         }
     }
 
-    let mut faces: Vec<FaceSpec> = Vec::with_capacity(fa + fb + 16);
+    faces.clear();
     // 1. faces of B
     for (g, &u) in bn.iter().enumerate() {
         let moving_feature = if let Some(f) = merged_with_a[g] {
@@ -438,7 +504,7 @@ pub fn gauss_map_obstacle(
         } else {
             let mut found = None;
             for (e, arc) in a_arcs.iter().enumerate() {
-                if s_ab[e * fb + g] == 0 && strictly_inside_arc(arc, &am, u) {
+                if s_ab[e * fb + g] == 0 && strictly_inside_arc(arc, am, u) {
                     if found.is_some() {
                         return Err(OverlayFailure::AmbiguousSupport);
                     }
@@ -447,7 +513,7 @@ pub fn gauss_map_obstacle(
             }
             match found {
                 Some(e) => Feature::Edge(e),
-                None => Feature::Vertex(argmax(&neg_ra, u)),
+                None => Feature::Vertex(argmax(neg_ra, u)),
             }
         };
         faces.push(FaceSpec { normal: u, fixed: Feature::Face(g), moving: moving_feature });
@@ -459,7 +525,7 @@ pub fn gauss_map_obstacle(
         }
         let mut found = None;
         for (e, arc) in b_arcs.iter().enumerate() {
-            if s_ba[e * fa + f] == 0 && strictly_inside_arc(arc, &bn, u) {
+            if s_ba[e * fa + f] == 0 && strictly_inside_arc(arc, bn, u) {
                 if found.is_some() {
                     return Err(OverlayFailure::AmbiguousSupport);
                 }
@@ -494,7 +560,8 @@ pub fn gauss_map_obstacle(
             faces.push(FaceSpec { normal: x.normalize(), fixed: Feature::Edge(eb), moving: Feature::Edge(ea) });
         }
     }
-    assemble(moving, fixed, rotation, &ra, &a_arcs, &b_arcs, faces)
+    let buffers = AssemblyBuffers { index_of, cycle, planar };
+    assemble(moving, fixed, rotation, ra, a_arcs, b_arcs, faces, buffers)
 }
 
 struct FaceSpec {
@@ -535,7 +602,7 @@ fn feature_vertices(p: &ConvexPolytope, feature: Feature, arcs: &[Arc], reflect:
 /// A labelled point of a planar sum: its coordinates in the face plane and the vertex pair `[i, j]`.
 type Labelled = (f64, f64, [usize; 2]);
 
-/// Buffers reused by every merged face of one obstacle (no allocation per face).
+/// Buffers reused by every merged face (no allocation per face).
 #[derive(Default)]
 struct PlanarScratch {
     is: Vec<usize>,
@@ -545,6 +612,16 @@ struct PlanarScratch {
     hull: Vec<Labelled>,
 }
 
+/// The scratch buffers [`assemble`] works in.
+struct AssemblyBuffers<'a> {
+    /// `index_of[i * nB + j]`: the obstacle vertex of the pair `(i, j)`, `u32::MAX` if none yet.
+    index_of: &'a mut Vec<u32>,
+    /// The vertex-pair cycle of the face being built.
+    cycle: &'a mut Vec<[usize; 2]>,
+    planar: &'a mut PlanarScratch,
+}
+
+#[allow(clippy::too_many_arguments)]
 fn assemble(
     moving: &ConvexPolytope,
     fixed: &ConvexPolytope,
@@ -552,19 +629,19 @@ fn assemble(
     ra: &[DVec3],
     a_arcs: &[Arc],
     b_arcs: &[Arc],
-    specs: Vec<FaceSpec>,
+    specs: &[FaceSpec],
+    buffers: AssemblyBuffers<'_>,
 ) -> Result<Obstacle, OverlayFailure> {
+    let AssemblyBuffers { index_of, cycle, planar: scratch } = buffers;
     let bv = fixed.vertices();
     let nb = bv.len();
-    let mut index_of: Vec<u32> = vec![u32::MAX; ra.len() * nb];
+    index_of.clear();
+    index_of.resize(ra.len() * nb, u32::MAX);
     let mut vertices: Vec<DVec3> = Vec::with_capacity(specs.len() * 2);
     let mut vertex_pairs: Vec<[usize; 2]> = Vec::with_capacity(specs.len() * 2);
-    let mut faces: Vec<Vec<usize>> = Vec::with_capacity(specs.len());
-    let mut planes: Vec<Plane> = Vec::with_capacity(specs.len());
+    let mut faces: Vec<Face> = Vec::with_capacity(specs.len());
     let mut kinds: Vec<FaceKind> = Vec::with_capacity(specs.len());
-    let mut cycle: Vec<[usize; 2]> = Vec::with_capacity(16);
-    let mut scratch = PlanarScratch::default();
-    for spec in &specs {
+    for spec in specs {
         cycle.clear();
         match (spec.fixed, spec.moving) {
             (Feature::Face(g), Feature::Vertex(i)) => {
@@ -590,7 +667,7 @@ fn assemble(
                 let mut js = std::mem::take(&mut scratch.js);
                 feature_vertices(fixed, fixed_feature, b_arcs, false, &mut js);
                 feature_vertices(moving, moving_feature, a_arcs, true, &mut is);
-                planar_sum(&is, &js, ra, bv, spec.normal, &mut scratch, &mut cycle);
+                planar_sum(&is, &js, ra, bv, spec.normal, scratch, cycle);
                 (scratch.is, scratch.js) = (is, js);
             }
         }
@@ -599,7 +676,7 @@ fn assemble(
         }
         let mut face = Vec::with_capacity(cycle.len());
         let mut offset = f64::NEG_INFINITY;
-        for &[i, j] in &cycle {
+        for &[i, j] in cycle.iter() {
             let slot = &mut index_of[i * nb + j];
             if *slot == u32::MAX {
                 *slot = vertices.len() as u32;
@@ -610,16 +687,30 @@ fn assemble(
             offset = offset.max(spec.normal.dot(vertices[v]));
             face.push(v);
         }
-        faces.push(face);
-        planes.push(Plane { normal: spec.normal, offset });
+        faces.push(Face { vertices: face, plane: Plane { normal: spec.normal, offset } });
         kinds.push(FaceKind::from_features(spec.fixed, spec.moving).unwrap_or(FaceKind::Unclassified));
     }
     let (v, f) = (vertices.len(), faces.len());
-    let polytope = ConvexPolytope::with_planes(vertices, faces, planes).map_err(OverlayFailure::Assembly)?;
+    let polytope = ConvexPolytope::from_faces(vertices, faces).map_err(OverlayFailure::Assembly)?;
     if v + f != polytope.edges().len() + 2 {
         return Err(OverlayFailure::Euler);
     }
     Ok(Obstacle { polytope, vertex_pairs, face_kinds: kinds, rotation, route: Route::GaussMap })
+}
+
+/// Sorts labelled points by `(x, y)` numerically, stably (equal points keep their order): the same permutation as a
+/// stable library sort with that comparison, by insertion sort, which is fastest for the few points of a face.
+/// The points must not be NaN.
+fn sort_xy(points: &mut [Labelled]) {
+    for i in 1..points.len() {
+        let p = points[i];
+        let mut k = i;
+        while k > 0 && (points[k - 1].0 > p.0 || (points[k - 1].0 == p.0 && points[k - 1].1 > p.1)) {
+            points[k] = points[k - 1];
+            k -= 1;
+        }
+        points[k] = p;
+    }
 }
 
 /// Convex polygon `sum_{i in is, j in js} (b_j - R a_i)` in the plane orthogonal to `normal`, counter-clockwise about
@@ -638,17 +729,24 @@ fn planar_sum(
     let e2 = normal.cross(e1);
     let pts = &mut scratch.points;
     pts.clear();
+    let mut any_nan = false;
     for &i in is {
         for &j in js {
             let p = bv[j] - ra[i];
-            pts.push((p.dot(e1), p.dot(e2), [i, j]));
+            let (x, y) = (p.dot(e1), p.dot(e2));
+            any_nan |= x.is_nan() || y.is_nan();
+            pts.push((x, y, [i, j]));
         }
     }
     // numeric order (not total_cmp: -0.0 and 0.0 must tie, or the chain loses its lexicographic order)
     // (stable: equal points keep their generation order, so the label kept for a duplicate is deterministic)
-    pts.sort_by(|a, b| {
-        a.0.partial_cmp(&b.0).unwrap_or(Ordering::Equal).then(a.1.partial_cmp(&b.1).unwrap_or(Ordering::Equal))
-    });
+    if any_nan {
+        pts.sort_by(|a, b| {
+            a.0.partial_cmp(&b.0).unwrap_or(Ordering::Equal).then(a.1.partial_cmp(&b.1).unwrap_or(Ordering::Equal))
+        });
+    } else {
+        sort_xy(pts);
+    }
     // Length tolerance of the policy on the polygon's extent: points closer than it are the same point (sums of
     // parallel features coincide up to rounding), and a point within it of a hull edge lies on that edge.
     let (mut lo, mut hi) = ((f64::INFINITY, f64::INFINITY), (f64::NEG_INFINITY, f64::NEG_INFINITY));
