@@ -6,10 +6,12 @@
 //!   built by `stackplan::planner::regress`): the best placement (theta, cost, position), nesting height, pairs
 //!   evaluated over the total.
 //! * `plan`: a stacking plan (`stackplan::planner::plan_stack`) of `count` parts at weight `w`: parts placed, height,
-//!   footprint, total cost, layers (distinct c.g. heights), whether every part passed and the whole stack is stable.
+//!   footprint, total cost, layers (distinct c.g. heights), the largest release drop (a part released above inclined
+//!   supports drops onto them), whether every part passed and the whole stack is stable.
 //!   Optional assertions, checked in code (a failure is an error, whatever the golden holds): `"expect_shape"`
 //!   (`flat`, `column`, `pyramid`: the seed's Fig. 2; adds `layer_counts`, parts per layer bottom up), `"check": true`
-//!   (the finished plan passes `stackplan check` with the planner's mu, cup and clearance; adds `check_ok`) and
+//!   (the finished plan passes `stackplan check` with the planner's mu, cup and clearance, the clearance checked at
+//!   each part's release position against the parts before it; adds `check_ok`) and
 //!   `"expect_height_below"` (mm: the stack nests). These add `info_plan_seconds` (planning alone).
 //! * `obstacle`: the c-space obstacle of every convex pair of two parts (the fixed one placed by `"fixed_pose"`) at
 //!   each angle of `"theta_deg"` (`stackplan::cspace::obstacle`): per angle and pair the vertex and face counts and
@@ -200,6 +202,7 @@ fn plan(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
     f.insert("layers".into(), layers.len().into());
     f.insert("stack_stable".into(), plan.stack_stable.into());
     f.insert("stage_1_parts".into(), plan.parts.iter().filter(|p| p.stage == 1).count().into());
+    f.insert("max_release_drop".into(), plan.parts.iter().map(|p| p.release_drop).fold(0.0, f64::max).into());
     f.insert("info_searches".into(), plan.stats.searches.into());
     f.insert("info_pairs_evaluated".into(), plan.stats.pairs_evaluated.into());
     // optional assertions, in code: the result fails the scenario (an error) whatever the golden says
@@ -216,7 +219,8 @@ fn plan(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
     }
     if scenario.get("check").and_then(Value::as_bool) == Some(true) {
         f.insert("info_plan_seconds".into(), ((plan_seconds * 1e3).round() / 1e3).into());
-        f.insert("check_ok".into(), check_plan(&part, &poses, &options)?.into());
+        let drops = plan.parts.iter().map(|p| p.release_drop).collect();
+        f.insert("check_ok".into(), check_plan(&part, &poses, drops, &options)?.into());
     }
     if let Some(limit) = num("expect_height_below") {
         anyhow::ensure!(
@@ -273,7 +277,12 @@ fn expect_shape(shape: &str, count: usize, placed: &usize, counts: &[usize]) -> 
 
 /// Runs the stack check on a plan with the planner's friction, cup and (horizontal) clearance less 1e-6 mm; fails
 /// the scenario naming every part that does not pass.
-fn check_plan(part: &Part, poses: &[Pose], options: &stackplan::planner::PlanOptions) -> anyhow::Result<bool> {
+fn check_plan(
+    part: &Part,
+    poses: &[Pose],
+    release_drops: Vec<f64>,
+    options: &stackplan::planner::PlanOptions,
+) -> anyhow::Result<bool> {
     use stackplan::stability::check::{CheckOptions, check_stack};
     use stackplan::stability::grasp::GraspOptions;
     use stackplan::stability::world::PlacedPart;
@@ -283,6 +292,7 @@ fn check_plan(part: &Part, poses: &[Pose], options: &stackplan::planner::PlanOpt
         mu: options.mu,
         clearance: (options.clearance - 1e-6).max(0.0),
         grasp: GraspOptions { cup_diameter: options.cup_diameter, ..GraspOptions::default() },
+        release_drops,
         ..CheckOptions::default()
     };
     let report = check_stack(&stack, &check)?;

@@ -11,6 +11,7 @@
 //! * [`obstacles`]: the pair obstacles cut out (plain, insertion, clearance) with face provenance;
 //! * [`qp`]: the QP on a free-space cell with its active constraints;
 //! * [`search`]: the best-first search and its statistics ([A] Tables I-II);
+//! * [`settle`]: the vertical drop of a part released above its supports (clearance on inclined faces);
 //! * [`reference`]: the brute-force reference (complete obstacles, complete free space) used by the tests;
 //! * [`regress`]: the scenarios of [A] Figs. 15-17 for `cargo xtask regress`;
 //! * [`stack_plan`]: the stacking planner for n identical parts ([A] II-B): placement, then stability, grasp and
@@ -24,6 +25,7 @@ pub mod reference;
 pub mod regress;
 pub mod request;
 pub mod search;
+pub mod settle;
 pub mod stack_plan;
 pub mod symmetry;
 

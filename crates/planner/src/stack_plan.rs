@@ -21,12 +21,15 @@
 //! A part that fits nowhere ends the plan with the reason; the plan keeps the parts placed so far.
 //! Cost: O(n) placements, each the search of [`crate::search`] plus at most `candidates` stack checks.
 
+use crate::detect::StackScene;
+use crate::orientation::Orientation;
 use crate::request::{Cost, FloorVolume, PlacementError, PlacementRequest, StackPart, thetas_with_step};
 use crate::search::{Contact, NoPlacement, Placement, SearchCaches, place_with_caches};
+use crate::settle::settle;
 use glam::{DMat3, DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 use stackplan_cspace::cache::ObstacleCache;
-use stackplan_geom::{Part, Pose};
+use stackplan_geom::{Part, Pose, Tolerance};
 use stackplan_stability::check::{CheckOptions, check_stack};
 use stackplan_stability::grasp::{GraspOptions, grasp_faces, is_graspable};
 use stackplan_stability::world::PlacedPart;
@@ -109,8 +112,13 @@ pub struct PlannedPart {
     pub stage: u8,
     /// The part's term of cost (1).
     pub cost: f64,
-    /// Contacts named by the active constraints at the optimum.
+    /// What it touches: the active constraints at the search's optimum or, after a drop, what stopped the drop.
     pub contacts: Vec<Contact>,
+    /// How far the part drops after the robot releases it (mm): the search's position with the horizontal clearance
+    /// floats this far above an inclined support ([`crate::settle`]); `position` is where it comes to rest and the
+    /// robot releases it at `position + release_drop z`. 0 for a part that rests where it is released.
+    #[serde(default)]
+    pub release_drop: f64,
     /// Interference-free candidates tested before this one passed (0 = the cheapest passed).
     pub rejected_candidates: usize,
     /// Height of the c.g. (mm).
@@ -266,9 +274,15 @@ pub fn plan_stack_with_progress(
         margin_directions: 0,
         contact_tolerance: None,
         prefix_stability: false,
+        release_drops: Vec::new(),
     };
     // shared by every search of the plan: the stack only grows and its parts never move
     let cache = ObstacleCache::new();
+    // the searches' tolerance (every part of the stack is this part, so the scale is its diagonal)
+    let tol = {
+        let (lo, hi) = part.aabb();
+        Tolerance::for_scale((hi - lo).length()).linear
+    };
     let mut caches = SearchCaches::new();
     let mut placed: Vec<Pose> = Vec::new();
     let mut planned: Vec<PlannedPart> = Vec::new();
@@ -276,6 +290,7 @@ pub fn plan_stack_with_progress(
     let mut stopped = None;
     'parts: for index in 0..options.count {
         let stack: Vec<StackPart<'_>> = placed.iter().map(|&pose| StackPart { part, pose }).collect();
+        let scene = StackScene::new(&placed.iter().map(|&pose| (part, pose)).collect::<Vec<_>>());
         // stage 1: within the stack's footprint (grown by the nesting allowance); stage 2: the whole floor
         let mut stages: Vec<(u8, FloorVolume)> = Vec::new();
         if !placed.is_empty() {
@@ -289,7 +304,7 @@ pub fn plan_stack_with_progress(
         stages.push((2, options.floor.clone()));
         let mut last_reason = String::from("no interference-free position");
         // the first acceptable candidate of each stage: (stage, candidate, rejected before it, grasp radius)
-        let mut accepted: Vec<(u8, Placement, usize, f64)> = Vec::new();
+        let mut accepted: Vec<(u8, (Placement, f64), usize, f64)> = Vec::new();
         let last_stage = stages.last().map_or(2, |s| s.0);
         for (stage, floor) in stages {
             let mut request = PlacementRequest::new(part, stack.clone(), floor);
@@ -335,7 +350,8 @@ pub fn plan_stack_with_progress(
                         continue;
                     }
                     stats.candidates_checked += 1;
-                    match accept(part, &placed, candidate, &check_options)? {
+                    let candidate = &settled(part, &rests, candidate, &scene, &cache, tol, &request.cost)?;
+                    match accept(part, &placed, &candidate.0, &check_options)? {
                         Ok(grasp_radius) => {
                             accepted.push((stage, candidate.clone(), rejected, grasp_radius));
                             found = true;
@@ -360,11 +376,11 @@ pub fn plan_stack_with_progress(
         }
         // stage 1 (compact) wins unless stage 2 is strictly cheaper: ties and near-ties keep the stack compact
         let best = accepted.iter().min_by(|a, b| {
-            let (ca, cb) = (a.1.cost, b.1.cost);
+            let (ca, cb) = (a.1.0.cost, b.1.0.cost);
             let tie = (ca - cb).abs() <= 1e-9 * (1.0 + ca.abs().max(cb.abs()));
             if tie { a.0.cmp(&b.0) } else { ca.total_cmp(&cb) }
         });
-        if let Some((stage, candidate, rejected, grasp_radius)) = best.cloned() {
+        if let Some((stage, (candidate, release_drop), rejected, grasp_radius)) = best.cloned() {
             let pose = candidate.pose();
             placed.push(pose);
             planned.push(PlannedPart {
@@ -376,6 +392,7 @@ pub fn plan_stack_with_progress(
                 stage,
                 cost: candidate.cost,
                 contacts: candidate.contacts.clone(),
+                release_drop,
                 rejected_candidates: rejected,
                 cg_height: pose.apply(part.mass.center_of_gravity).z,
                 stability_margin: None,
@@ -426,6 +443,30 @@ fn footprint(part: &Part, placed: &[Pose]) -> (DVec2, DVec2) {
         }
     }
     (lo, hi)
+}
+
+/// The candidate settled ([`crate::settle`]): at its resting position, with its cost there and what stopped it, and
+/// the drop from the release position.
+fn settled(
+    part: &Part,
+    rests: &[DMat3],
+    candidate: &Placement,
+    scene: &StackScene,
+    cache: &ObstacleCache,
+    tol: f64,
+    cost: &Cost,
+) -> Result<(Placement, f64), PlanError> {
+    let pose = candidate.pose();
+    let s = settle(part, pose.rotation, pose.position, scene, cache, tol)?;
+    let Some(contacts) = s.contacts else {
+        return Ok((candidate.clone(), 0.0));
+    };
+    let rest = rests.get(candidate.resting_pose).copied().unwrap_or(DMat3::IDENTITY);
+    let quadratic =
+        Orientation::without_components(part, 0, candidate.resting_pose, 0, candidate.theta, rest, cost).quadratic;
+    let settled =
+        Placement { position: s.position.to_array(), cost: quadratic.value(s.position), contacts, ..candidate.clone() };
+    Ok((settled, s.drop))
 }
 
 /// Tests one candidate: `Ok(Ok(grasp radius))` when it passes, `Ok(Err(reason))` when it does not.
@@ -517,25 +558,61 @@ mod tests {
         }
     }
 
-    /// The Triangle part with 5 mm horizontal clearance: every one of the cheapest candidates for the second part
-    /// floats beside the inclined walls of the first and fails the stability check. Without the repeated search the
-    /// plan stops; with it the second part finds a stable position.
+    /// The L-corner part at w = 0.9 with one candidate per search: the fourth part's cheapest interference-free
+    /// position is not stable on its supports. Without the repeated search the plan stops there; with it the fourth
+    /// part finds a stable position further down the list.
     #[test]
     fn a_repeated_search_finds_a_stable_position_when_every_candidate_fails() {
+        let part =
+            stackplan_geom::examples::part_by_name("l-corner", stackplan_geom::sheet_metal::Decomposition::ConvexMerge)
+                .expect("example");
+        let floor = FloorVolume::rectangle(-200.0, -200.0, 200.0, 200.0, 400.0);
+        let mut options = PlanOptions { w: 0.9, dtheta: 15f64.to_radians(), ..PlanOptions::new(4, floor) };
+        options.candidates = 1;
+        options.max_candidates = 1;
+        let once = plan_stack(&part, &options).expect("plan");
+        assert_eq!(once.parts.len(), 3, "the cheapest candidate of the fourth part fails");
+        assert!(once.stopped.as_deref().is_some_and(|r| r.contains("part 4 of 4")), "{:?}", once.stopped);
+        options.max_candidates = 1024;
+        let repeated = plan_stack(&part, &options).expect("plan");
+        assert_eq!(repeated.parts.len(), 4, "{:?}", repeated.stopped);
+        assert!(repeated.stats.repeated_searches >= 1);
+        assert!(repeated.parts[3].rejected_candidates >= options.candidates);
+        assert_eq!(&repeated.parts[..3], &once.parts[..3]);
+    }
+
+    /// The Triangle part with the seed's 5 mm horizontal clearance nests ([A] Fig. 19): the search's position floats
+    /// above the first part's inclined walls (the clearance lifts them), and the part drops onto them.
+    #[test]
+    fn triangle_parts_with_clearance_drop_into_the_nest() {
         let part =
             stackplan_geom::examples::part_by_name("triangle", stackplan_geom::sheet_metal::Decomposition::ConvexMerge)
                 .expect("example");
         let floor = FloorVolume::rectangle(-340.0, -340.0, 340.0, 340.0, 400.0);
-        let mut options = PlanOptions { w: 0.9, dtheta: 5f64.to_radians(), ..PlanOptions::new(2, floor) };
-        options.max_candidates = options.candidates;
-        let once = plan_stack(&part, &options).expect("plan");
-        assert_eq!(once.parts.len(), 1, "the first {} candidates all fail", options.candidates);
-        assert!(once.stopped.as_deref().is_some_and(|r| r.contains("part 2 of 2")), "{:?}", once.stopped);
-        options.max_candidates = 1024;
-        let repeated = plan_stack(&part, &options).expect("plan");
-        assert_eq!(repeated.parts.len(), 2, "{:?}", repeated.stopped);
-        assert!(repeated.stats.repeated_searches >= 1);
-        assert!(repeated.parts[1].rejected_candidates >= options.candidates);
+        let options = PlanOptions { w: 0.9, dtheta: 5f64.to_radians(), ..PlanOptions::new(3, floor) };
+        assert_eq!(options.clearance, 5.0);
+        let plan = plan_stack(&part, &options).expect("plan");
+        assert_eq!(plan.parts.len(), 3, "{:?}", plan.stopped);
+        let (lo, hi) = part.aabb();
+        let part_height = (hi - lo).z.min((hi - lo).x).min((hi - lo).y);
+        assert!(plan.height < 2.0 * part_height, "nested: height {} vs part {}", plan.height, part_height);
+        assert_eq!(plan.parts[0].release_drop, 0.0);
+        for p in &plan.parts[1..] {
+            assert!(p.release_drop > 1.0, "dropped into the nest: {}", p.release_drop);
+            assert!(p.contacts.iter().all(|c| matches!(c, Contact::Stack { .. })), "{:?}", p.contacts);
+        }
+        // at rest every part touches and nothing penetrates
+        let world: Vec<PlacedPart<'_>> = plan
+            .parts
+            .iter()
+            .map(|p| {
+                let pose = Pose::from_rows(p.rotation, DVec3::from_array(p.position)).expect("a proper rotation");
+                PlacedPart { part: &part, rotation: pose.rotation, position: pose.position }
+            })
+            .collect();
+        let report = check_stack(&world, &CheckOptions::default()).expect("check");
+        assert!(report.parts.iter().all(|c| c.interference <= 1e-6 && c.stable.is_stable()), "{report:?}");
+        assert!(plan.stack_stable);
     }
 
     #[test]

@@ -5,7 +5,10 @@
 //! * **interference**: the worst penetration depth between a component of `i` and a component of any other part or
 //!   the floor (exact separating-axis depth, [`crate::contacts`]); 0 when only touching;
 //! * **clearance**: the smallest horizontal distance to the other parts' components whose z-ranges overlap
-//!   ([`crate::clearance`]), met when at least `clearance - tol`;
+//!   ([`crate::clearance`]), met when at least `clearance - tol`. With [`CheckOptions::release_drops`] (a stacking
+//!   plan whose parts are released above their supports and drop into place) it is the placement clearance instead:
+//!   part `i` at its release position (resting position raised by its drop) against the parts `0..i` already
+//!   placed, which is what the robot's positioning error meets;
 //! * **stable** (the new part on fixed supports): part `i` movable, the floor and parts `0..i` fixed, contacts among
 //!   them ([`crate::equilibrium`]), with a margin and forces;
 //! * **stack stable** (after placing `i`): the sub-stack `0..=i` with every part movable and the floor fixed. The last
@@ -48,6 +51,11 @@ pub struct CheckOptions {
     pub contact_tolerance: Option<f64>,
     /// Check stability of every intermediate stack `0..=i` (else only the whole stack).
     pub prefix_stability: bool,
+    /// Per part, how far above its position the robot releases it (mm; a plan's `release_drop`). Empty: the
+    /// clearance is checked symmetrically at the given positions; otherwise each part at its release position
+    /// against the parts placed before it (one entry per part).
+    #[serde(default)]
+    pub release_drops: Vec<f64>,
 }
 
 impl Default for CheckOptions {
@@ -59,6 +67,7 @@ impl Default for CheckOptions {
             margin_directions: 8,
             contact_tolerance: None,
             prefix_stability: true,
+            release_drops: Vec::new(),
         }
     }
 }
@@ -128,6 +137,25 @@ pub fn check_stack(stack: &[PlacedPart<'_>], options: &CheckOptions) -> Result<S
         )));
     }
     let parts = world_stack(stack)?;
+    let released = if options.release_drops.is_empty() {
+        None
+    } else {
+        if options.release_drops.len() != stack.len()
+            || !options.release_drops.iter().all(|d| *d >= 0.0 && d.is_finite())
+        {
+            return Err(StabilityError::BadOption(format!(
+                "release drops: one finite non-negative value per part ({} parts), got {:?}",
+                stack.len(),
+                options.release_drops
+            )));
+        }
+        let lifted: Vec<PlacedPart<'_>> = stack
+            .iter()
+            .zip(&options.release_drops)
+            .map(|(p, d)| PlacedPart { position: p.position + glam::DVec3::Z * *d, ..*p })
+            .collect();
+        Some(world_stack(&lifted)?)
+    };
     let tol = match options.contact_tolerance {
         Some(t) if t >= 0.0 && t.is_finite() => t,
         Some(t) => return Err(StabilityError::BadOption(format!("contact tolerance must be >= 0, got {t}"))),
@@ -202,7 +230,15 @@ pub fn check_stack(stack: &[PlacedPart<'_>], options: &CheckOptions) -> Result<S
                 }
             }
         }
-        let (min_clear, clearance_met) = clearance_of(&parts, i, options.clearance, tol);
+        let (min_clear, clearance_met) = match &released {
+            None => clearance_of(
+                &parts[i],
+                parts.iter().enumerate().filter(|(j, _)| *j != i).map(|(_, p)| p),
+                options.clearance,
+                tol,
+            ),
+            Some(lifted) => clearance_of(&lifted[i], parts[..i].iter(), options.clearance, tol),
+        };
         let sub: Vec<ContactPatch> = patches.iter().filter(|p| patch_within(p, i)).cloned().collect();
         let movable: Vec<bool> = (0..n).map(|k| k == i).collect();
         let alone = solve_equilibrium(&parts, &movable, &sub, &eq_with_margin)?;
@@ -327,19 +363,24 @@ fn patch_within(p: &ContactPatch, i: usize) -> bool {
         }
 }
 
-/// Smallest horizontal distance from part `i` to other parts' components sharing its height range, and whether it
+/// Smallest horizontal distance from `part` to the `others`' components sharing its height range, and whether it
 /// meets `delta`.
-fn clearance_of(parts: &[WorldPart], i: usize, delta: f64, tol: f64) -> (Option<f64>, bool) {
+fn clearance_of<'p>(
+    part: &WorldPart,
+    others: impl Iterator<Item = &'p WorldPart>,
+    delta: f64,
+    tol: f64,
+) -> (Option<f64>, bool) {
     if delta <= 0.0 {
         return (None, true);
     }
     let mut smallest: Option<f64> = None;
     let mut unknown = false;
-    for (j, other) in parts.iter().enumerate() {
-        if j == i || !aabb_overlap(&parts[i].aabb, &other.aabb, delta) {
+    for other in others {
+        if !aabb_overlap(&part.aabb, &other.aabb, delta) {
             continue;
         }
-        for a in &parts[i].components {
+        for a in &part.components {
             if !aabb_overlap(&a.aabb, &other.aabb, delta) {
                 continue;
             }

@@ -48,6 +48,19 @@ pub struct CheckJson {
     pub report: StackCheck,
 }
 
+/// The placements' `release_drop` (a plan file's parts released above their supports), or none when no placement
+/// has one (then the clearance is checked symmetrically at the given positions).
+fn release_drops(extras: &[serde_json::Map<String, serde_json::Value>]) -> Vec<f64> {
+    if extras.iter().all(|e| !e.contains_key("release_drop")) {
+        return Vec::new();
+    }
+    // a malformed value is passed on as NaN, which the check rejects with a typed error
+    extras
+        .iter()
+        .map(|e| e.get("release_drop").map_or(Some(0.0), serde_json::Value::as_f64).unwrap_or(f64::NAN))
+        .collect()
+}
+
 /// Runs `check`.
 pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let file = stackplan::geom::io::stack::read_stack(&args.stack)
@@ -64,6 +77,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         margin_directions: args.margin_directions,
         contact_tolerance: args.contact_tolerance,
         prefix_stability: true,
+        release_drops: release_drops(&file.extras),
     };
     let report = check_stack(&stack, &options)?;
     let ok = report.ok;

@@ -1,0 +1,217 @@
+//! Settling a released part: the vertical drop from the position the search found, where the robot releases the
+//! part, to where it comes to rest ([A] VII-B; DESIGN.md section 7).
+//!
+//! **Why.** With the seed's clearance for robot positioning error ("the parts are separated in the plane by at least
+//! 5 mm", [A] VII-B, grown as in eq. 10-11) an obstacle face of unit normal `n` moves out by `delta |n_xy|`. A
+//! horizontal face does not move, so a part resting on a flat top rests exactly; an upward-facing *inclined* face
+//! (the walls a Triangle part nests on) is lifted by `delta |n_xy| / n_z`, and the search's optimum floats that
+//! far above its support. That is where the robot lets go; the part then drops straight down until it touches.
+//! The plan records the resting position (what the stack is, what the checks and every later part see) and the
+//! drop (the release height above it).
+//!
+//! **The drop.** For the moving component `A_i` and a stack component `B_j` with zero-clearance c-space obstacle
+//! `C_ij = {n_k . p <= d_k}` ([A] App. B, from the shared [`ObstacleCache`]), the downward ray `q(s) = p - s z`
+//! lies in the interior of `C_ij` (by more than the tolerance, the search's test) iff for every face
+//! `n_k . p - s n_{k,z} < d_k - tol`: a lower bound on `s` for faces with `n_{k,z} > 0`, an upper bound for
+//! `n_{k,z} < 0`, a fixed test for vertical faces. The ray enters at `s_ij = max(0, max lower bounds)` when that is
+//! below every upper bound and the vertical faces hold. The floor stops the part at `s_floor = p_z + min_v (R v)_z`.
+//! The drop is `g = min(s_floor, min_ij s_ij)`, so `p - g z` touches what stopped it and no obstacle's interior is
+//! crossed on the way (the segment is free, so a part insertable from above stays insertable). A drop of at most the
+//! tolerance is none: the position is kept bit for bit.
+//!
+//! **Contacts.** After a drop, the contacts are what stopped the part: every pair whose entry is within the tolerance
+//! of `g` (with the kind of the face it enters through) and the floor if it is; the release position's active
+//! constraints (side faces held at the clearance) no longer touch.
+//!
+//! Cost: O(sum of the faces of the pairs whose xy boxes overlap), plus the construction of any of their obstacles
+//! the search did not build.
+
+use crate::detect::StackScene;
+use crate::request::PlacementError;
+use crate::search::Contact;
+use glam::{DMat3, DVec3};
+use stackplan_cspace::{ObstacleCache, PlacedConvex};
+use stackplan_geom::Part;
+
+/// A settled position.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Settled {
+    /// The resting position (`release - drop z`).
+    pub position: DVec3,
+    /// The drop from the release position (mm, `>= 0`; exactly 0 when the part rests where it is released).
+    pub drop: f64,
+    /// What stopped the drop (`None` when there was no drop: the search's contacts stand).
+    pub contacts: Option<Vec<Contact>>,
+}
+
+/// Where the downward ray from `p` first touches the convex set `{n_k . q <= d_k}` on its way into the interior
+/// (the interior by more than `tol`, the search's interference test), if it enters it: `(s, k)` with `k` the face it
+/// enters through (`None` when `p` is already inside). The ray enters iff the open interval of `s` where every
+/// `n_k . q(s) < d_k - tol` is not empty; `s` itself is the exact touching value `max(0, max_k (n_k . p - d_k) /
+/// n_{k,z})` over the faces with `n_{k,z} > 0`, so the settled part touches and does not sink by the tolerance.
+fn ray_entry(planes: impl Iterator<Item = (DVec3, f64)>, p: DVec3, tol: f64) -> Option<(f64, Option<usize>)> {
+    // vertical component below which a face counts as vertical: its bound would lie beyond any stack
+    const VERTICAL: f64 = 1e-12;
+    let (mut touch, mut entry_face) = (0.0f64, None);
+    let (mut inner_lower, mut inner_upper) = (0.0f64, f64::INFINITY);
+    for (k, (n, d)) in planes.enumerate() {
+        let gap = n.dot(p) - d;
+        if n.z > VERTICAL {
+            let s = gap / n.z;
+            if s > touch {
+                touch = s;
+                entry_face = Some(k);
+            }
+            inner_lower = inner_lower.max((gap + tol) / n.z);
+        } else if n.z < -VERTICAL {
+            inner_upper = inner_upper.min((gap + tol) / n.z);
+        } else if gap + tol >= 0.0 {
+            return None;
+        }
+    }
+    (inner_lower < inner_upper).then_some((touch, entry_face))
+}
+
+/// Settles the part released at `release` with `rotation` among the stack `scene` (see the module documentation).
+/// `cache` is the plan's obstacle cache (keys: moving piece, stack part, stack piece, rotation bits); `tol` the
+/// search's linear tolerance. `Err` names the pair whose obstacle could not be built.
+pub fn settle(
+    part: &Part,
+    rotation: DMat3,
+    release: DVec3,
+    scene: &StackScene,
+    cache: &ObstacleCache,
+    tol: f64,
+) -> Result<Settled, PlacementError> {
+    let lowest = part.all_vertices().map(|v| (rotation * v).z).fold(f64::INFINITY, f64::min);
+    let floor_drop = release.z + lowest;
+    let mut drop = floor_drop.max(0.0);
+    // (drop, contact) of every stop found, filtered to the lowest at the end
+    let mut stops: Vec<(f64, Contact)> = vec![(floor_drop, Contact::Floor)];
+    for (mi, component) in part.components.iter().enumerate() {
+        let moving = PlacedConvex::new(component, rotation, release);
+        let (lo, hi) = moving.aabb;
+        for sc in &scene.components {
+            let (slo, shi) = sc.placed.aabb;
+            // only what lies under the component's xy box and starts below its top can stop it
+            let overlaps_xy =
+                slo.x < hi.x + tol && lo.x < shi.x + tol && slo.y < hi.y + tol && lo.y < shi.y + tol && slo.z < hi.z;
+            if !overlaps_xy {
+                continue;
+            }
+            let obstacle = cache.get_or_build(mi, sc.part, sc.piece, component, rotation, &sc.world).map_err(|e| {
+                PlacementError::Obstacle {
+                    moving_piece: mi,
+                    fixed_part: sc.part,
+                    fixed_piece: sc.piece,
+                    reason: e.to_string(),
+                }
+            })?;
+            let planes = obstacle.planes().map(|pl| (pl.normal, pl.offset));
+            let Some((s, face)) = ray_entry(planes, release, tol) else {
+                continue;
+            };
+            let face_kind = face.map_or("interior", |k| obstacle.face_kinds()[k].name()).to_string();
+            stops.push((
+                s,
+                Contact::Stack { our_component: mi, stack_part: sc.part, stack_component: sc.piece, face_kind },
+            ));
+            drop = drop.min(s);
+        }
+    }
+    if drop <= tol {
+        return Ok(Settled { position: release, drop: 0.0, contacts: None });
+    }
+    let contacts = stops.into_iter().filter(|(s, _)| *s <= drop + tol).map(|(_, c)| c).collect();
+    Ok(Settled { position: release - DVec3::Z * drop, drop, contacts: Some(contacts) })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use stackplan_geom::Pose;
+    use stackplan_geom::part::PartOrigin;
+    use stackplan_geom::polytope::ConvexPolytope;
+
+    fn cube_part(size: f64) -> Part {
+        let c = ConvexPolytope::cuboid(DVec3::ZERO, DVec3::splat(size)).expect("cube");
+        Part::from_components("cube", vec![c], 1.0, PartOrigin::ConvexPieces).expect("part")
+    }
+
+    #[test]
+    fn ray_entry_of_a_box_from_above() {
+        // the box [0,1]^3: the ray from (0.5, 0.5, 3) enters through the top at s = 2
+        let planes = [
+            (DVec3::X, 1.0),
+            (DVec3::NEG_X, 0.0),
+            (DVec3::Y, 1.0),
+            (DVec3::NEG_Y, 0.0),
+            (DVec3::Z, 1.0),
+            (DVec3::NEG_Z, 0.0),
+        ];
+        let (s, face) = ray_entry(planes.into_iter(), DVec3::new(0.5, 0.5, 3.0), 0.0).expect("enters");
+        assert_eq!(s, 2.0);
+        assert_eq!(face, Some(4));
+        // with a tolerance the touching value is kept (the interior is entered a tolerance later)
+        assert_eq!(ray_entry(planes.into_iter(), DVec3::new(0.5, 0.5, 3.0), 1e-3).map(|e| e.0), Some(2.0));
+        // beside the box (on a vertical face's plane): never enters the interior
+        assert!(ray_entry(planes.into_iter(), DVec3::new(1.0, 0.5, 3.0), 1e-9).is_none());
+        // below the box: the interval lies at negative s
+        assert!(ray_entry(planes.into_iter(), DVec3::new(0.5, 0.5, -1.0), 0.0).is_none());
+    }
+
+    #[test]
+    fn a_cube_released_above_another_drops_onto_it_and_one_beside_it_to_the_floor() {
+        let part = cube_part(10.0);
+        let stack = [(&part, Pose { rotation: DMat3::IDENTITY, position: DVec3::ZERO })];
+        let scene = StackScene::new(&stack);
+        let cache = ObstacleCache::new();
+        let tol = 1e-9 * 20.0;
+        // above the placed cube, 7 mm over its top
+        let s = settle(&part, DMat3::IDENTITY, DVec3::new(2.0, 3.0, 17.0), &scene, &cache, tol).expect("settles");
+        assert!((s.drop - 7.0).abs() <= 1e-12, "drop {}", s.drop);
+        assert!((s.position - DVec3::new(2.0, 3.0, 10.0)).length() <= 1e-12);
+        let contacts = s.contacts.expect("dropped");
+        assert!(
+            matches!(&contacts[..], [Contact::Stack { stack_part: 0, face_kind, .. }] if face_kind == "face_face"),
+            "{contacts:?}"
+        );
+        // beside it (touching its side face): down to the floor
+        let s = settle(&part, DMat3::IDENTITY, DVec3::new(10.0, 0.0, 4.0), &scene, &cache, tol).expect("settles");
+        assert_eq!(s.drop, 4.0);
+        assert_eq!(s.contacts, Some(vec![Contact::Floor]));
+        // already resting: kept bit for bit
+        let p = DVec3::new(1.0 / 3.0, 0.1, 10.0);
+        let s = settle(&part, DMat3::IDENTITY, p, &scene, &cache, tol).expect("settles");
+        assert_eq!((s.position, s.drop, s.contacts), (p, 0.0, None));
+    }
+
+    #[test]
+    fn a_wedge_released_above_a_v_groove_drops_until_it_touches_both_walls() {
+        // a V groove of two slabs inclined at 45 degrees and a square bar turned 45 degrees about x (a diamond):
+        // released above the groove, the diamond drops until its lower faces rest on both walls
+        let wall = |sign: f64| {
+            let pts: Vec<DVec3> = [(0.0, 0.0), (sign * 20.0, 20.0), (sign * 22.0, 18.0), (sign * 2.0, -2.0)]
+                .iter()
+                .flat_map(|&(y, z)| [DVec3::new(0.0, y, z + 2.0), DVec3::new(10.0, y, z + 2.0)])
+                .collect();
+            stackplan_geom::convex_hull(&pts).expect("wall").polytope
+        };
+        let groove = Part::from_components("groove", vec![wall(1.0), wall(-1.0)], 1.0, PartOrigin::ConvexPieces)
+            .expect("groove");
+        let bar = cube_part(4.0);
+        let stack = [(&groove, Pose { rotation: DMat3::IDENTITY, position: DVec3::ZERO })];
+        let scene = StackScene::new(&stack);
+        let cache = ObstacleCache::new();
+        let rotation = DMat3::from_rotation_x(std::f64::consts::FRAC_PI_4);
+        // the bar's lowest edge (its local y = 0, z = 0 edge stays at the origin) centred over the groove
+        let release = DVec3::new(3.0, 0.0, 30.0);
+        let s = settle(&bar, rotation, release, &scene, &cache, 1e-9 * 40.0).expect("settles");
+        // resting, the bar's two lower faces lie on the walls' upper faces (the planes y = z - 2 and -y = z - 2
+        // through the groove's apex at z = 2): the bar's lowest edge is at the apex
+        assert!((s.position.z - 2.0).abs() <= 1e-9, "rest z {}", s.position.z);
+        assert!((s.drop - 28.0).abs() <= 1e-9);
+        let contacts = s.contacts.expect("dropped");
+        assert_eq!(contacts.len(), 2, "{contacts:?}");
+    }
+}
