@@ -651,6 +651,251 @@ impl Problem<'_> {
     }
 }
 
+impl Problem<'_> {
+    /// Whether the closed-form path applies: `n` is 2 or 3 and every `h_i > 0` (finite).
+    fn strictly_convex(&self) -> bool {
+        (2..=3).contains(&self.n) && (0..self.n).all(|i| self.h[i] > 0.0 && self.h[i].is_finite())
+    }
+
+    /// The Newton step `d` of `f` at `p` within the null space of the working rows, `min f(p + d)` subject to
+    /// `a_w . d = 0`, in closed form (positive diagonal Hessian, `n` = 2 or 3):
+    ///
+    /// * no working row: `d = -H^-1 grad`;
+    /// * a null space of dimension 1 spanned by `z` (`a_1 x a_2` in 3-D, `a_1` turned by 90 degrees in 2-D):
+    ///   `d = -(z . grad) / (z^T H z) z`;
+    /// * one row in 3-D: an orthonormal basis `z_1 = a x e / |.|` (`e` the coordinate axis least aligned with `a`),
+    ///   `z_2 = a x z_1 / |.|` of the plane and the 2x2 system `(Z^T H Z) t = -Z^T grad`, `d = Z t`;
+    /// * `n` rows: `d = 0`.
+    ///
+    /// The step lies in the null space up to the rounding of a few products, as the general method's does, so the
+    /// iterate stays on its working planes. `None` when a reduced Hessian is not positive (underflow).
+    fn null_space_step(&self, w: &WorkSet, grad: &V4) -> Option<V4> {
+        let n = self.n;
+        let k = w.len;
+        let row = |a: usize| &self.rows[w.idx[a]];
+        let mut d = [0.0; MAX_N];
+        if k == 0 {
+            for i in 0..n {
+                d[i] = -grad[i] / self.h[i];
+            }
+            return Some(d);
+        }
+        if k >= n {
+            return Some(d);
+        }
+        let along = |z: &V4| {
+            let mut zhz = 0.0;
+            for i in 0..n {
+                zhz += self.h[i] * z[i] * z[i];
+            }
+            if !(zhz > 0.0 && zhz.is_finite()) {
+                return None;
+            }
+            let t = -dot4(z, grad) / zhz;
+            Some(z.map(|c| c * t))
+        };
+        if n == 2 {
+            let a = row(0);
+            return along(&[-a[1], a[0], 0.0, 0.0]);
+        }
+        if k == 2 {
+            return along(&cross3(row(0), row(1)));
+        }
+        // n = 3, one working row
+        let a = row(0);
+        let axis = if a[0].abs() <= a[1].abs() && a[0].abs() <= a[2].abs() {
+            0
+        } else if a[1].abs() <= a[2].abs() {
+            1
+        } else {
+            2
+        };
+        let z1 = normalized(&cross3(a, &unit(axis)))?;
+        let z2 = normalized(&cross3(a, &z1))?;
+        let (mut m11, mut m12, mut m22) = (0.0, 0.0, 0.0);
+        for i in 0..3 {
+            m11 += self.h[i] * z1[i] * z1[i];
+            m12 += self.h[i] * z1[i] * z2[i];
+            m22 += self.h[i] * z2[i] * z2[i];
+        }
+        let det = m11 * m22 - m12 * m12;
+        if !(det > 0.0 && det.is_finite()) {
+            return None;
+        }
+        let (r1, r2) = (-dot4(&z1, grad), -dot4(&z2, grad));
+        let t1 = (r1 * m22 - r2 * m12) / det;
+        let t2 = (r2 * m11 - r1 * m12) / det;
+        for i in 0..3 {
+            d[i] = t1 * z1[i] + t2 * z2[i];
+        }
+        Some(d)
+    }
+
+    /// Multipliers of the working rows at a stationary point: the least-squares solution of `A_W^T lambda = -r`
+    /// (`r` the gradient at the stationary point), by the Gram system of order `k <= 2` or, for `n` rows, Cramer's
+    /// rule (cross products in 3-D). `None` when the rows are numerically dependent.
+    fn multipliers(&self, w: &WorkSet, r: &V4) -> Option<V4> {
+        let n = self.n;
+        let k = w.len;
+        let row = |a: usize| &self.rows[w.idx[a]];
+        let mut lambda = [0.0; MAX_N];
+        let ok = |x: f64| x.abs() > 0.0 && x.is_finite();
+        match k {
+            0 => {}
+            1 => {
+                let a = row(0);
+                let aa = dot4(a, a);
+                if !ok(aa) {
+                    return None;
+                }
+                lambda[0] = -dot4(a, r) / aa;
+            }
+            2 if n == 2 => {
+                let (a1, a2) = (row(0), row(1));
+                let det = a1[0] * a2[1] - a1[1] * a2[0];
+                if !ok(det) {
+                    return None;
+                }
+                lambda[0] = -(r[0] * a2[1] - r[1] * a2[0]) / det;
+                lambda[1] = -(a1[0] * r[1] - a1[1] * r[0]) / det;
+            }
+            2 => {
+                let (a1, a2) = (row(0), row(1));
+                let (g11, g12, g22) = (dot4(a1, a1), dot4(a1, a2), dot4(a2, a2));
+                let det = g11 * g22 - g12 * g12;
+                if !(det > 0.0 && det.is_finite()) {
+                    return None;
+                }
+                let (r1, r2) = (-dot4(a1, r), -dot4(a2, r));
+                lambda[0] = (r1 * g22 - r2 * g12) / det;
+                lambda[1] = (r2 * g11 - r1 * g12) / det;
+            }
+            _ => {
+                // n = 3 rows in 3-D: the inverse of A_W^T has the rows (a_2 x a_3, a_3 x a_1, a_1 x a_2) / det
+                let (a1, a2, a3) = (row(0), row(1), row(2));
+                let c23 = cross3(a2, a3);
+                let det = dot4(a1, &c23);
+                if !ok(det) {
+                    return None;
+                }
+                lambda[0] = -dot4(r, &c23) / det;
+                lambda[1] = -dot4(r, &cross3(a3, a1)) / det;
+                lambda[2] = -dot4(r, &cross3(a1, a2)) / det;
+            }
+        }
+        Some(lambda)
+    }
+
+    /// The fast path of [`Problem::solve`] for a strictly convex objective (every `h_i > 0`, `n` = 2 or 3): the same
+    /// primal active-set iteration from `start` (working-set rules, ratio test, multiplier test, anti-cycling), with
+    /// the null-space Newton step and the multipliers in closed form ([`Problem::null_space_step`],
+    /// [`Problem::multipliers`]) instead of a Gram-Schmidt split with Cholesky factors and lexicographic stages. The
+    /// tie-break is moot (the minimiser is unique), so only the objective's multipliers are tested. O(m) per
+    /// iteration (the ratio test) plus O(1).
+    ///
+    /// Returns `None` (the caller then runs the general [`Problem::solve`]) when the path does not apply, a system
+    /// becomes numerically singular, or the iteration limit is reached; it never reports unboundedness (a strictly
+    /// convex quadratic is bounded below).
+    pub(crate) fn solve_strictly_convex(&self, start: V4) -> Option<Outcome> {
+        if !self.strictly_convex() {
+            return None;
+        }
+        let n = self.n;
+        let m = self.rows.len();
+        let bland_after = 4 * m + 20;
+        let limit = 40 * (m + 5);
+        let stationary = 1e-12 * self.length_scale;
+        let mult_tol = MULT_TOL * self.gradient_scale();
+        let mut p = start;
+        let mut w = WorkSet::default();
+        let mut banned: Vec<usize> = Vec::new();
+        let mut last_dropped: Option<usize> = None;
+        for iter in 0..limit {
+            let grad = self.gradient(&p);
+            let dir = self.null_space_step(&w, &grad)?;
+            let len = norm4(&dir);
+            if !len.is_finite() {
+                return None;
+            }
+            if len <= stationary {
+                // the multiplier test at the gradient of the subspace minimiser p + dir
+                let mut r = grad;
+                for i in 0..n {
+                    r[i] += self.h[i] * dir[i];
+                }
+                let lambda = self.multipliers(&w, &r)?;
+                let bland = iter >= bland_after;
+                let mut choice: Option<usize> = None;
+                for a in 0..w.len {
+                    if lambda[a] < -mult_tol && !banned.contains(&w.idx[a]) {
+                        choice = match choice {
+                            None => Some(a),
+                            Some(c) => {
+                                let better = if bland { w.idx[a] < w.idx[c] } else { lambda[a] < lambda[c] };
+                                Some(if better { a } else { c })
+                            }
+                        };
+                    }
+                }
+                match choice {
+                    Some(a) => {
+                        last_dropped = Some(w.idx[a]);
+                        w.remove_at(a);
+                    }
+                    None => {
+                        return Some(Outcome::Optimal {
+                            point: p,
+                            working: w,
+                            multipliers: lambda,
+                            iterations: iter + 1,
+                        });
+                    }
+                }
+                continue;
+            }
+            let threshold = BLOCK_TOL * len;
+            let mut alpha = 1.0;
+            let mut blocking = None;
+            for (j, a) in self.rows.iter().enumerate() {
+                let ad = dot4(a, &dir);
+                if ad > threshold && self.enabled(j) && !w.contains(j) {
+                    let slack = (self.offsets[j] - dot4(a, &p)).max(0.0);
+                    let t = slack / ad;
+                    if t < alpha {
+                        alpha = t;
+                        blocking = Some(j);
+                    }
+                }
+            }
+            axpy(&mut p, alpha, &dir);
+            if alpha * len > 1e-13 * self.length_scale {
+                banned.clear();
+            } else if blocking.is_some() && blocking == last_dropped {
+                banned.extend(blocking);
+            }
+            last_dropped = None;
+            if let Some(j) = blocking {
+                if w.len >= n {
+                    return None;
+                }
+                w.push(j);
+            }
+        }
+        None
+    }
+}
+
+#[inline]
+fn normalized(x: &V4) -> Option<V4> {
+    let l = norm4(x);
+    if l > 0.0 && l.is_finite() { Some(x.map(|c| c / l)) } else { None }
+}
+
+#[inline]
+fn cross3(a: &V4, b: &V4) -> V4 {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0], 0.0]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
