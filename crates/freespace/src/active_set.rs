@@ -982,4 +982,113 @@ mod tests {
         assert!((p[0] - 0.5).abs() < 1e-12 && (p[1] - 0.5).abs() < 1e-12 && p[2].abs() < 1e-14, "{p:?}");
         assert!(w.contains(&6) ^ w.contains(&7));
     }
+
+    /// A random bounded problem around a centre `c` (inside): a box, cuts, and by `kind` duplicate rows, a flat pair
+    /// (a face), or an apex where 4-5 planes meet, with a random strictly convex diagonal Hessian.
+    fn random_problem(seed: u64, n: usize, kind: u8, cuts: usize) -> (Vec<V4>, Vec<f64>, V4, V4, V4) {
+        let mut state = seed;
+        let mut next = move || {
+            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let unit_row = |next: &mut dyn FnMut() -> f64| loop {
+            let mut v = [0.0; MAX_N];
+            for x in v.iter_mut().take(n) {
+                *x = 2.0 * next() - 1.0;
+            }
+            let l = norm4(&v);
+            if l > 0.2 && l <= 1.0 {
+                return v.map(|x| x / l);
+            }
+        };
+        let mut c = [0.0; MAX_N];
+        for x in c.iter_mut().take(n) {
+            *x = 10.0 * next() - 5.0;
+        }
+        let (mut rows, mut b) = (Vec::new(), Vec::new());
+        for i in 0..n {
+            rows.push(unit(i));
+            b.push(c[i] + 1.0 + 5.0 * next());
+            rows.push(unit(i).map(|x| -x));
+            b.push(-c[i] + 1.0 + 5.0 * next());
+        }
+        for _ in 0..cuts {
+            let a = unit_row(&mut next);
+            b.push(dot4(&a, &c) + 0.3 + 3.0 * next());
+            rows.push(a);
+        }
+        match kind % 4 {
+            1 => {
+                let j = (next() * rows.len() as f64) as usize % rows.len();
+                rows.push(rows[j]);
+                b.push(b[j]);
+            }
+            2 => {
+                let a = unit_row(&mut next);
+                rows.push(a);
+                b.push(dot4(&a, &c));
+                rows.push(a.map(|x| -x));
+                b.push(-dot4(&a, &c));
+            }
+            3 => {
+                // planes through q = c + 0.5 (1, ..) whose normals surround the axis (1, 1, ..)/sqrt(n)
+                let mut q = c;
+                for x in q.iter_mut().take(n) {
+                    *x += 0.5;
+                }
+                for k in 0..(2 + n) {
+                    let mut a = [0.0; MAX_N];
+                    for i in 0..n {
+                        a[i] = 1.0 + 0.9 * ((k * 7 + i * 3) as f64 * 1.3).sin();
+                    }
+                    let a = a.map(|x| x / norm4(&a));
+                    rows.push(a);
+                    b.push(dot4(&a, &q));
+                }
+            }
+            _ => {}
+        }
+        let mut h = [0.0; MAX_N];
+        let mut g = [0.0; MAX_N];
+        for i in 0..n {
+            h[i] = 10f64.powf(3.0 * next() - 2.0);
+            g[i] = 60.0 * next() - 30.0;
+        }
+        (rows, b, h, g, c)
+    }
+
+    proptest::proptest! {
+        /// The closed-form path on its own (no fallback): it must finish, and agree with the general method.
+        #[test]
+        fn strictly_convex_path_agrees_with_the_general_method(
+            seed in proptest::prelude::any::<u64>(), n in 2usize..4, kind in 0u8..4, cuts in 0usize..10,
+        ) {
+            let (rows, b, h, g, c) = random_problem(seed, n, kind, cuts);
+            let prob = Problem { n, rows: &rows, offsets: &b, mask: None, h, g, tie: [2, 1, 0, 3], length_scale: 10.0 };
+            let fast = prob.solve_strictly_convex(c);
+            let general = prob.solve(c).expect("general");
+            let (Some(Outcome::Optimal { point: pf, working: wf, multipliers: lf, .. }), Outcome::Optimal { point: pg, .. }) =
+                (fast, general)
+            else {
+                return Err(proptest::test_runner::TestCaseError::fail(format!("fast {fast:?} general {general:?}")));
+            };
+            for i in 0..n {
+                proptest::prop_assert!((pf[i] - pg[i]).abs() <= 1e-9, "{pf:?} vs {pg:?}");
+            }
+            // KKT of the fast path's own answer: feasible, working rows tight, multipliers >= 0, stationary
+            for (j, a) in rows.iter().enumerate() {
+                proptest::prop_assert!(dot4(a, &pf) - b[j] <= 1e-9);
+            }
+            let mut r = prob.gradient(&pf);
+            for (k, &j) in wf.as_slice().iter().enumerate() {
+                proptest::prop_assert!((dot4(&rows[j], &pf) - b[j]).abs() <= 1e-9);
+                proptest::prop_assert!(lf[k] >= -1e-9 * prob.gradient_scale());
+                axpy(&mut r, lf[k], &rows[j]);
+            }
+            proptest::prop_assert!(norm4(&r) <= 1e-9 * prob.gradient_scale(), "residual {r:?}");
+        }
+    }
 }
