@@ -4,7 +4,7 @@
 //!   bounding box, boundary face count.
 //! * `place`: one of the placement scenarios of [A] Figs. 15-17 (`"scenario"`: `channel`, `triangle`, `complex`;
 //!   built by `stackplan::planner::regress`): the best placement (theta, cost, position), nesting height, pairs
-//!   evaluated over the total.
+//!   evaluated over the total, obstacles constructed and extrapolated ([A] Table I).
 //! * `plan`: a stacking plan (`stackplan::planner::plan_stack`) of `count` parts at weight `w`: parts placed, height,
 //!   footprint, total cost, layers (distinct c.g. heights), the largest release drop (a part released above inclined
 //!   supports drops onto them), whether every part passed and the whole stack is stable.
@@ -90,6 +90,7 @@ fn place(scenario: &Value) -> anyhow::Result<Fields> {
     f.insert("pairs_evaluated".into(), report.stats.pairs_evaluated.into());
     f.insert("total_pairs".into(), report.stats.total_pairs.into());
     f.insert("obstacles_constructed".into(), report.stats.obstacles_constructed.into());
+    f.insert("obstacles_extrapolated".into(), report.stats.obstacles_extrapolated.into());
     if let Some((e, t)) = report.seed_pairs {
         f.insert("info_seed_fraction_evaluated".into(), (e as f64 / t as f64).into());
     }

@@ -8,6 +8,7 @@
 //! * [`orientation`]: per orientation the permissible set `Omega` ([A] eq. 3) and the cost as a separable quadratic;
 //! * [`symmetry`]: rotational symmetry about z in a resting pose (one period searched);
 //! * [`detect`]: interference pairs at a configuration (broad phase + exact narrow phase, insertion sweeps);
+//! * [`interval_obstacles`]: obstacles constructed at interval starts and extrapolated inside ([A] IV-B);
 //! * [`obstacles`]: the pair obstacles cut out (plain, insertion, clearance) with face provenance;
 //! * [`qp`]: the QP on a free-space cell with its active constraints;
 //! * [`search`]: the best-first search and its statistics ([A] Tables I-II);
@@ -18,6 +19,7 @@
 //!   insertion checks, in the seed's two stages.
 
 pub mod detect;
+pub mod interval_obstacles;
 pub mod obstacles;
 pub mod orientation;
 pub mod qp;

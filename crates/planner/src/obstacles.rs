@@ -1,5 +1,6 @@
 //! The obstacles the search cuts out: the c-space obstacle of one (moving component, stack component) pair at one
-//! orientation ([A] App. B, built by `stackplan-cspace`'s Gauss-map overlay through its [`ObstacleCache`]), turned
+//! orientation ([A] App. B, built by `stackplan-cspace`'s Gauss-map overlay through its [`ObstacleCache`], or
+//! extrapolated within its constant-topology interval by [`crate::interval_obstacles`]), turned
 //! into the half-spaces the search subtracts:
 //!
 //! * plain: the obstacle's face planes `n_k . p <= d_k`;
@@ -16,6 +17,7 @@
 use crate::detect::StackScene;
 use crate::orientation::Orientation;
 use serde::{Deserialize, Serialize};
+use stackplan_cspace::minkowski::Obstacle;
 use stackplan_cspace::{FaceKind, ObstacleCache, insertion};
 use stackplan_geom::Part;
 use stackplan_geom::polytope::Plane;
@@ -59,7 +61,9 @@ pub struct DerivedObstacle {
 }
 
 impl DerivedObstacle {
-    /// Builds the obstacle of a pair (see the module documentation). `Err` carries the builder's message.
+    /// Builds the obstacle of a pair (see the module documentation), constructing the pair's c-space obstacle
+    /// through `cache`. `Err` carries the builder's message.
+    #[allow(clippy::too_many_arguments)]
     pub fn build(
         part: &Part,
         orientation: &Orientation,
@@ -75,6 +79,19 @@ impl DerivedObstacle {
         let raw = cache
             .get_or_build(moving, sc.part, sc.piece, &part.components[moving], orientation.rotation, &sc.world)
             .map_err(|e| e.to_string())?;
+        Ok(Self::from_obstacle(&raw, orientation.index, moving, fixed, clearance, horizontal_clearance, with_insertion))
+    }
+
+    /// The derived obstacle of the pair's c-space obstacle `raw` (constructed or extrapolated).
+    pub fn from_obstacle(
+        raw: &Obstacle,
+        orientation: usize,
+        moving: usize,
+        fixed: usize,
+        clearance: f64,
+        horizontal_clearance: bool,
+        with_insertion: bool,
+    ) -> Self {
         let (mut planes, origins): (Vec<Plane>, Vec<PlaneOrigin>) = if with_insertion {
             let poly = raw.polytope();
             let ins = insertion(poly);
@@ -101,7 +118,7 @@ impl DerivedObstacle {
                 };
             }
         }
-        Ok(Self { orientation: orientation.index, moving, fixed, planes, origins })
+        Self { orientation, moving, fixed, planes, origins }
     }
 
     /// Whether `p` lies in the interior by more than `tol` (interference).

@@ -106,6 +106,9 @@ pub struct PlacementRequest<'a> {
     pub k: usize,
     /// Search one period of the part's rotational symmetry about z only (when the theta set allows it).
     pub use_symmetry: bool,
+    /// Extrapolate obstacles within their constant-topology intervals instead of constructing each one
+    /// ([`crate::interval_obstacles`], [A] IV-B). Off: every obstacle is constructed (the reference route).
+    pub extrapolate: bool,
     /// Largest number of search nodes popped before giving up with [`PlacementError::NodeBudget`].
     pub node_budget: usize,
 }
@@ -126,7 +129,7 @@ pub fn thetas_with_step(step: f64) -> Vec<f64> {
 
 impl<'a> PlacementRequest<'a> {
     /// Defaults: the part as it lies, 1-degree steps, no clearance, cost (1) with `w = 0.5` about the floor centre,
-    /// no insertion, `k = 1`, symmetry on, 3-D permissible set.
+    /// no insertion, `k = 1`, symmetry on, extrapolation on, 3-D permissible set.
     pub fn new(part: &'a Part, stack: Vec<StackPart<'a>>, floor: FloorVolume) -> Self {
         let origin = floor.centre();
         Self {
@@ -142,6 +145,7 @@ impl<'a> PlacementRequest<'a> {
             insertion: false,
             k: 1,
             use_symmetry: true,
+            extrapolate: true,
             node_budget: 2_000_000,
         }
     }

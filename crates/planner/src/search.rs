@@ -39,6 +39,7 @@
 //! loop itself is sequential, so the result does not depend on the thread count.
 
 use crate::detect::{AxesCache, CandidateQueue, DetectCounts, StackScene, SweepAxes};
+use crate::interval_obstacles::{IntervalObstacles, ObstacleRoute};
 use crate::obstacles::DerivedObstacle;
 use crate::orientation::{Orientation, SeparableQuadratic};
 use crate::qp::{QpOptimum, Quadratic, minimise};
@@ -137,7 +138,8 @@ pub struct PlacementStats {
     pub pairs_evaluated: u64,
     /// Obstacles constructed from scratch (Gauss-map overlay).
     pub obstacles_constructed: u64,
-    /// Obstacles extrapolated within a constant-topology interval (0 until orient-interval is integrated).
+    /// Obstacles extrapolated within a constant-topology interval ([`crate::interval_obstacles`]; 0 with
+    /// `PlacementRequest::extrapolate` off).
     pub obstacles_extrapolated: u64,
     /// Obstacle lookups answered by the cache.
     pub obstacle_cache_hits: u64,
@@ -263,6 +265,7 @@ struct Search<'r, 'a> {
     derived: HashMap<(usize, usize, usize), Arc<DerivedObstacle>>,
     obstacle_ids: HashMap<(usize, usize, usize), u32>,
     axes: AxesCache,
+    intervals: IntervalObstacles,
     stats: PlacementStats,
 }
 
@@ -281,16 +284,19 @@ pub fn place_with_cache(
 }
 
 /// What successive searches into a growing stack share beyond the [`ObstacleCache`]: the derived obstacles (insertion
-/// and clearance applied) and the separating-axis data of each (orientation, pair), both keyed by orientation index.
-/// They are reused only while the searches have the same orientations (bit-identical rotations), the same
-/// clearance, insertion and horizontal-clearance settings, and the previous search's stack components are the first
-/// components of the new stack, bit for bit (parts appended, never moved); otherwise they are cleared. Reuse changes
-/// no result: both are pure functions of those inputs.
+/// and clearance applied) and the separating-axis data of each (orientation, pair), both keyed by orientation index,
+/// and the constant-topology structures the obstacles are extrapolated from ([`IntervalObstacles`]). They are reused
+/// only while the searches have the same orientations (bit-identical rotations), the same clearance, insertion,
+/// horizontal-clearance and extrapolation settings, and the previous search's stack components are the first
+/// components of the new stack, bit for bit (parts appended, never moved); otherwise they are cleared. The first two
+/// are pure functions of those inputs; an extrapolated obstacle depends (in its last bits) on which angle its
+/// structure was built at, so a plan's results depend on its search history, deterministically.
 #[derive(Debug, Default)]
 pub struct SearchCaches {
     signature: Option<CacheSignature>,
     axes: AxesCache,
     derived: HashMap<(usize, usize, usize), Arc<DerivedObstacle>>,
+    intervals: IntervalObstacles,
 }
 
 #[derive(Debug, PartialEq)]
@@ -299,6 +305,7 @@ struct CacheSignature {
     clearance: u64,
     insertion: bool,
     horizontal: bool,
+    extrapolate: bool,
     stack: Vec<Vec<DVec3>>,
 }
 
@@ -315,12 +322,14 @@ impl SearchCaches {
                 && old.clearance == next.clearance
                 && old.insertion == next.insertion
                 && old.horizontal == next.horizontal
+                && old.extrapolate == next.extrapolate
                 && old.stack.len() <= next.stack.len()
                 && old.stack.iter().zip(&next.stack).all(|(a, b)| a == b)
         });
         if !keep {
             self.axes.clear();
             self.derived.clear();
+            self.intervals.clear();
         }
         self.signature = Some(next);
     }
@@ -389,6 +398,7 @@ pub fn place_with_caches(
         clearance: request.clearance.to_bits(),
         insertion: request.insertion,
         horizontal: request.horizontal_clearance,
+        extrapolate: request.extrapolate,
         stack: scene.components.iter().map(|c| c.placed.vertices.clone()).collect(),
     });
     let mut search = Search {
@@ -402,6 +412,7 @@ pub fn place_with_caches(
         obstacle_ids: HashMap::new(),
         axes: std::mem::take(&mut caches.axes),
         derived: std::mem::take(&mut caches.derived),
+        intervals: std::mem::take(&mut caches.intervals),
         stats,
     };
     let before = cache.stats();
@@ -413,6 +424,7 @@ pub fn place_with_caches(
     let after = cache.stats();
     caches.axes = std::mem::take(&mut search.axes);
     caches.derived = std::mem::take(&mut search.derived);
+    caches.intervals = std::mem::take(&mut search.intervals);
     let mut result = result?;
     result.stats.obstacles_constructed = after.constructions - before.constructions;
     result.stats.obstacle_cache_hits = after.hits - before.hits;
@@ -638,22 +650,37 @@ impl Search<'_, '_> {
             return Ok(id);
         }
         let o = &self.orientations[orientation];
-        let built = DerivedObstacle::build(
-            self.request.part,
-            o,
+        let sc = &self.scene.components[fixed];
+        let to_error = |reason| PlacementError::Obstacle {
+            moving_piece: moving,
+            fixed_part: sc.part,
+            fixed_piece: sc.piece,
+            reason,
+        };
+        let raw = if self.request.extrapolate {
+            let rest_rotation = self.request.resting_rotations[o.rest];
+            let (raw, route) = self
+                .intervals
+                .obstacle(self.request.part, moving, o.rest, rest_rotation, o.theta, o.rotation, fixed, sc, self.cache)
+                .map_err(to_error)?;
+            if route == ObstacleRoute::Extrapolated {
+                self.stats.obstacles_extrapolated += 1;
+            }
+            raw
+        } else {
+            self.cache
+                .get_or_build(moving, sc.part, sc.piece, &self.request.part.components[moving], o.rotation, &sc.world)
+                .map_err(|e| to_error(e.to_string()))?
+        };
+        let built = Arc::new(DerivedObstacle::from_obstacle(
+            &raw,
+            o.index,
             moving,
-            &self.scene,
             fixed,
-            self.cache,
             self.request.clearance,
             self.request.horizontal_clearance,
             self.request.insertion,
-        )
-        .map_err(|reason| {
-            let sc = &self.scene.components[fixed];
-            PlacementError::Obstacle { moving_piece: moving, fixed_part: sc.part, fixed_piece: sc.piece, reason }
-        })?;
-        let built = Arc::new(built);
+        ));
         self.derived.insert((orientation, moving, fixed), Arc::clone(&built));
         let id = self.obstacles.len() as u32;
         self.obstacles.push(built);

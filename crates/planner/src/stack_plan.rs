@@ -143,6 +143,9 @@ pub struct PlanStats {
     pub pairs_evaluated: u64,
     /// Obstacles constructed (cache misses).
     pub obstacles_constructed: u64,
+    /// Obstacles extrapolated within a constant-topology interval ([`crate::interval_obstacles`]).
+    #[serde(default)]
+    pub obstacles_extrapolated: u64,
     /// Seconds in the placement searches.
     pub seconds_search: f64,
     /// Seconds in the stack checks.
@@ -334,6 +337,7 @@ pub fn plan_stack_with_progress(
                 stats.searches += 1;
                 stats.pairs_evaluated += result.stats.pairs_evaluated;
                 stats.obstacles_constructed += result.stats.obstacles_constructed;
+                stats.obstacles_extrapolated += result.stats.obstacles_extrapolated;
                 if result.placements.is_empty() {
                     last_reason = match result.exhausted {
                         Some(NoPlacement::EmptyOmega) => "the floor volume is too small for the part".into(),
