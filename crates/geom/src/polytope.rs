@@ -574,7 +574,7 @@ fn edge_table<F>(
             if a >= nv {
                 return Err(PolytopeError::BadVertexIndex { face: f, vertex: a, len: nv });
             }
-            let b = face[(k + 1) % face.len()];
+            let b = if k + 1 < face.len() { face[k + 1] } else { face[0] };
             if a == b {
                 return Err(PolytopeError::NotManifold { a, b });
             }
@@ -590,7 +590,7 @@ fn edge_table<F>(
     for (f, face) in faces.iter().enumerate() {
         let face = cycle(face);
         for (k, &a) in face.iter().enumerate() {
-            let b = face[(k + 1) % face.len()];
+            let b = if k + 1 < face.len() { face[k + 1] } else { face[0] };
             let key = ((a.min(b) as u64) << 33) | ((a.max(b) as u64) << 1) | u64::from(a > b);
             let slot = &mut counts[a.min(b)];
             half[*slot as usize] = (key, f as u32, k as u32);
