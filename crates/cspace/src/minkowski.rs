@@ -390,6 +390,20 @@ fn tol_sign(v: f64) -> i8 {
     }
 }
 
+/// `out[e * normals.len() + f]`: the side of `normals[f]` w.r.t. the circle of `arcs[e]` ([`tol_sign`]).
+fn sign_table(arcs: &[Arc], normals: &[DVec3], out: &mut Vec<i8>) {
+    out.clear();
+    out.resize(arcs.len() * normals.len(), 0);
+    if normals.is_empty() {
+        return;
+    }
+    for (row, arc) in out.chunks_exact_mut(normals.len()).zip(arcs) {
+        for (sign, n) in row.iter_mut().zip(normals) {
+            *sign = tol_sign(arc.circle.dot(*n));
+        }
+    }
+}
+
 /// Whether `u` (already known to lie on the arc's circle) lies strictly inside the arc.
 #[inline]
 fn strictly_inside_arc(arc: &Arc, normals: &[DVec3], u: DVec3) -> bool {
@@ -475,10 +489,8 @@ fn overlay(
     let (fa, fb) = (am.len(), bn.len());
 
     // sides: s_ab[e * fb + g] = side of B's normal g w.r.t. the circle of A-arc e; s_ba[e * fa + f] likewise.
-    s_ab.clear();
-    s_ab.extend(a_arcs.iter().flat_map(|arc| bn.iter().map(move |n| tol_sign(arc.circle.dot(*n)))));
-    s_ba.clear();
-    s_ba.extend(b_arcs.iter().flat_map(|arc| am.iter().map(move |n| tol_sign(arc.circle.dot(*n)))));
+    sign_table(a_arcs, bn, s_ab);
+    sign_table(b_arcs, am, s_ba);
     let (s_ab, s_ba) = (&*s_ab, &*s_ba);
 
     // parallel faces: merged_with_b[f] = Some(g) when -R n_f == n_g within half the tolerance.
@@ -698,6 +710,10 @@ fn assemble(
     Ok(Obstacle { polytope, vertex_pairs, face_kinds: kinds, rotation, route: Route::GaussMap })
 }
 
+/// The error-bound factor of the floating-point stage of `robust::orient2d` (Shewchuk's predicate in the form of
+/// Ozaki et al., `theta = 3u - (phi - 22) u^2` for `f64`): `|det| >= theta * (|detleft + detright|)` proves the sign.
+const ORIENT2D_FILTER: f64 = 3.3306690621773722e-16;
+
 /// Sorts labelled points by `(x, y)` numerically, stably (equal points keep their order): the same permutation as a
 /// stable library sort with that comparison, by insertion sort, which is fastest for the few points of a face.
 /// The points must not be NaN.
@@ -779,8 +795,18 @@ fn planar_sum(
     };
     // the chain itself uses the exact orientation predicate (a tolerance inside the chain loses corners when nearly
     // collinear points come in non-monotone order); near-collinear corners are removed afterwards
+    // (the floating-point filter of Shewchuk's orient2d inline, as `robust` does it: where it decides, the sign of
+    // `det` is the exact sign; elsewhere the exact predicate)
     let exact_left = |o: &Labelled, a: &Labelled, b: &Labelled| {
-        orient2d(DVec2::new(o.0, o.1), DVec2::new(a.0, a.1), DVec2::new(b.0, b.1)) == Ordering::Greater
+        let detleft = (o.0 - b.0) * (a.1 - b.1);
+        let detright = (o.1 - b.1) * (a.0 - b.0);
+        let det = detleft - detright;
+        let errbound = ORIENT2D_FILTER * (detleft + detright).abs();
+        if det >= errbound || -det >= errbound {
+            det > 0.0
+        } else {
+            orient2d(DVec2::new(o.0, o.1), DVec2::new(a.0, a.1), DVec2::new(b.0, b.1)) == Ordering::Greater
+        }
     };
     let hull = &mut scratch.hull;
     hull.clear();
@@ -803,7 +829,8 @@ fn planar_sum(
     let mut k = 0;
     while hull.len() > 3 && k < hull.len() {
         let n = hull.len();
-        if turns_left(&hull[(k + n - 1) % n], &hull[k], &hull[(k + 1) % n]) {
+        let (before, after) = (if k == 0 { n - 1 } else { k - 1 }, if k + 1 == n { 0 } else { k + 1 });
+        if turns_left(&hull[before], &hull[k], &hull[after]) {
             k += 1;
         } else {
             hull.remove(k);
