@@ -256,3 +256,36 @@ fn png_distinct_colours(png: &[u8]) -> usize {
     colours.dedup();
     colours.len()
 }
+
+/// Triangle parts with the default 5 mm clearance nest ([A] Fig. 19): each is released above the inclined walls of
+/// the one below and drops onto them; `check` then measures the clearance where the robot lets go, against the parts
+/// placed before, and passes. Without the drops (a plain stack file of the resting positions) the nested parts
+/// touch and the clearance fails, as it must.
+#[test]
+fn triangle_plans_nest_with_clearance_and_check_at_the_release_positions() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let o = run_in(dir.path(), &["plan", "example:triangle", "--count", "3", "--w", "0.9", "--dtheta-deg", "5"]);
+    assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
+    let plan = read_json(&dir.path().join("out/plan.json"));
+    let drops: Vec<f64> = plan["placements"]
+        .as_array()
+        .expect("placements")
+        .iter()
+        .map(|p| p["release_drop"].as_f64().expect("release_drop"))
+        .collect();
+    assert_eq!(drops.len(), 3);
+    assert_eq!(drops[0], 0.0);
+    assert!(drops[1..].iter().all(|d| *d > 1.0), "nested parts drop into place: {drops:?}");
+    let o = run_in(dir.path(), &["check", "out/plan.json", "--clearance", "4.999", "--cup-diameter", "10", "--json"]);
+    assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
+    let report: Value = serde_json::from_str(&stdout(&o)).expect("check json");
+    assert_eq!(report["options"]["release_drops"].as_array().map(Vec::len), Some(3));
+    // the resting positions alone: the nested parts touch, so a symmetric 5 mm clearance fails
+    let mut resting = plan.clone();
+    for p in resting["placements"].as_array_mut().expect("placements") {
+        p.as_object_mut().expect("placement").remove("release_drop");
+    }
+    std::fs::write(dir.path().join("resting.json"), serde_json::to_string(&resting).expect("json")).expect("write");
+    let o = run_in(dir.path(), &["check", "resting.json", "--clearance", "4.999", "--cup-diameter", "10", "--json"]);
+    assert_eq!(o.status.code(), Some(1), "{}\n{}", stdout(&o), stderr(&o));
+}
