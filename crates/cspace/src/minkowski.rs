@@ -877,4 +877,50 @@ mod tests {
         let h = obstacle_by_hull(&a, DMat3::from_rotation_z(0.3), &b).expect("hull");
         assert!((h.polytope().volume() - o.polytope().volume()).abs() < 1e-9);
     }
+
+    #[test]
+    fn per_thread_buffers_do_not_leak_between_obstacles() {
+        // a large pair between two builds of a small one: the reused buffers must not change the result
+        let a = cuboid(DVec3::ZERO, DVec3::new(1.0, 2.0, 3.0));
+        let b = cuboid(DVec3::new(-1.0, 0.5, 0.0), DVec3::new(4.0, 5.0, 6.0));
+        let r = DMat3::from_rotation_z(0.3);
+        let first = gauss_map_obstacle(&a, r, &b).expect("obstacle");
+        let pts: Vec<DVec3> = (0..40)
+            .map(|k| {
+                let t = k as f64 * 0.7;
+                DVec3::new(t.cos() * 5.0, t.sin() * 5.0, (k % 7) as f64 - 3.0)
+            })
+            .collect();
+        let big = convex_hull(&pts).expect("hull").polytope;
+        let other = gauss_map_obstacle(&big, DMat3::from_rotation_x(0.2), &big).expect("obstacle");
+        assert!(other.polytope().vertices().len() > first.polytope().vertices().len());
+        let again = gauss_map_obstacle(&a, r, &b).expect("obstacle");
+        assert_eq!(format!("{first:?}"), format!("{again:?}"));
+    }
+
+    #[test]
+    fn insertion_sort_of_points_is_the_stable_library_sort() {
+        // many ties, both zeros, infinities: the permutation must be the stable sort's
+        let values = [-1.0, -0.0, 0.0, 0.5, 1.0, f64::INFINITY, f64::NEG_INFINITY];
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        for n in 0..40 {
+            let points: Vec<Labelled> = (0..n)
+                .map(|k| {
+                    state ^= state << 13;
+                    state ^= state >> 7;
+                    state ^= state << 17;
+                    let (x, y) = (values[(state % 7) as usize], values[((state >> 8) % 7) as usize]);
+                    (x, y, [k, n])
+                })
+                .collect();
+            let mut expected = points.clone();
+            expected.sort_by(|a, b| {
+                a.0.partial_cmp(&b.0).unwrap_or(Ordering::Equal).then(a.1.partial_cmp(&b.1).unwrap_or(Ordering::Equal))
+            });
+            let mut got = points;
+            sort_xy(&mut got);
+            let bits = |v: &[Labelled]| v.iter().map(|p| (p.0.to_bits(), p.1.to_bits(), p.2)).collect::<Vec<_>>();
+            assert_eq!(bits(&got), bits(&expected), "n = {n}");
+        }
+    }
 }
