@@ -1,6 +1,11 @@
 //! Benchmarks: time per placement QP (exact active-set vs clarabel, same cells and costs, same run) for cells of
 //! 6, 16, 32 and 64 inequalities, and time per obstacle subtraction.
 //!
+//! `exact` is `minimize` (strictly convex costs take the closed-form path of `active_set`), `general` is
+//! `qp::minimize_general` (the general active-set method alone: the solver before the closed-form path, for a
+//! before/after ratio in the same run), `clarabel` the interior-point cross-check. The on-CPU part also times
+//! w = 1 (singular Hessian: `minimize` runs the general method with the lowest-z tie-break).
+//!
 //! Run: `cargo bench -p stackplan-freespace --bench qp -- --warm-up-time 1 --measurement-time 3`.
 //!
 //! Each benchmark runs twice: with criterion's wall clock (`*_wall`) and with the thread's on-CPU time
@@ -9,6 +14,7 @@
 //! waiting for a core, CPU time is not.
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use stackplan_freespace::qp::minimize_general;
 use stackplan_freespace::{
     Cell, Halfspace, Obstacle, RotatedExtents, SeparableCost, SubtractOptions, Tag, minimize, minimize_clarabel,
     stacking_cost, subtract,
@@ -59,6 +65,11 @@ fn cell(rng: &mut Rng, m: usize) -> Cell<3> {
 
 /// Cost (1) with w = 0.7 and the reference outside the cell, so the optimum is on the boundary.
 fn cost(rng: &mut Rng) -> SeparableCost<3> {
+    cost_with_weight(rng, 0.7)
+}
+
+/// Cost (1) with weight `w` and the reference outside the cell.
+fn cost_with_weight(rng: &mut Rng, w: f64) -> SeparableCost<3> {
     let ext = RotatedExtents {
         x_max: 10.0,
         x_min: -10.0,
@@ -68,7 +79,7 @@ fn cost(rng: &mut Rng) -> SeparableCost<3> {
     };
     let t = rng.range(0.0, std::f64::consts::TAU);
     let reference = DVec3::new(120.0 * t.cos(), 120.0 * t.sin(), rng.range(-80.0, 0.0));
-    stacking_cost(0.7, &ext, reference).expect("cost")
+    stacking_cost(w, &ext, reference).expect("cost")
 }
 
 /// On-CPU time of the current thread in nanoseconds (first field of `/proc/thread-self/schedstat`).
@@ -115,6 +126,14 @@ fn qp(c: &mut Criterion, name: &str) {
                 i = (i + 1) % cases.len();
                 let (cell, cost) = &cases[i];
                 black_box(minimize(black_box(cell), black_box(cost)).expect("exact"))
+            })
+        });
+        let mut i = 0;
+        group.bench_function(BenchmarkId::new("general", m), |b| {
+            b.iter(|| {
+                i = (i + 1) % cases.len();
+                let (cell, cost) = &cases[i];
+                black_box(minimize_general(black_box(cell), black_box(cost)).expect("general"))
             })
         });
         let mut i = 0;
@@ -218,11 +237,36 @@ fn cpu(_c: &mut Criterion) {
             i = (i + 1) % cases.len();
             black_box(minimize(black_box(&cases[i].0), black_box(&cases[i].1)).expect("exact"));
         });
+        let general = cpu_median_ns(|| {
+            i = (i + 1) % cases.len();
+            black_box(minimize_general(black_box(&cases[i].0), black_box(&cases[i].1)).expect("general"));
+        });
         let clarabel = cpu_median_ns(|| {
             i = (i + 1) % cases.len();
             black_box(minimize_clarabel(black_box(&cases[i].0), black_box(&cases[i].1)).expect("clarabel"));
         });
-        println!("cpu qp m={m}: exact {:.0} ns, clarabel {:.0} ns, ratio {:.0}x", exact, clarabel, clarabel / exact);
+        println!(
+            "cpu qp m={m}: exact {exact:.0} ns, general {general:.0} ns, clarabel {clarabel:.0} ns, \
+             clarabel/exact {:.0}x, general/exact {:.2}x",
+            clarabel / exact,
+            general / exact
+        );
+    }
+    // w = 1: singular Hessian (z free), the general method with the lowest-z tie-break
+    for m in [6usize, 32] {
+        let mut rng = Rng(1000 + m as u64);
+        let cases: Vec<(Cell<3>, SeparableCost<3>)> =
+            (0..32).map(|_| (cell(&mut rng, m), cost_with_weight(&mut rng, 1.0))).collect();
+        let mut i = 0;
+        let exact = cpu_median_ns(|| {
+            i = (i + 1) % cases.len();
+            black_box(minimize(black_box(&cases[i].0), black_box(&cases[i].1)).expect("exact"));
+        });
+        let clarabel = cpu_median_ns(|| {
+            i = (i + 1) % cases.len();
+            black_box(minimize_clarabel(black_box(&cases[i].0), black_box(&cases[i].1)).expect("clarabel"));
+        });
+        println!("cpu qp w=1 m={m}: exact {exact:.0} ns, clarabel {clarabel:.0} ns, ratio {:.0}x", clarabel / exact);
     }
 }
 

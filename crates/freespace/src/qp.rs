@@ -10,6 +10,12 @@
 //!   free, `w = 0` leaves x and y free) the minimiser set is not a point; the solver returns its lexicographic
 //!   minimum: lowest z, then lowest y, then lowest x (lowest y then x in 2-D). Before returning, the KKT conditions
 //!   are verified from scratch (see [`verify_kkt`]); a failed check is an error, never a silent wrong answer.
+//!   Strictly convex costs (every `h_i > 0` within a factor 1000 of each other: cost (1) with
+//!   `0.002 <= w <= 0.9995`, the desired-position cost) run the same
+//!   iteration with closed-form linear algebra ([`crate::active_set`], "strictly convex fast path"); if that path
+//!   breaks down or its answer fails the KKT check, the general method solves the problem again. The minimiser is
+//!   unique there, so both give the same point up to rounding in the last bits; [`minimize_general`] runs the
+//!   general method alone (the reference of the tests and benchmarks).
 //! * [`minimize_clarabel`]: clarabel's interior-point QP (general path and cross-check; statuses other than
 //!   `Solved` are errors). Its point is some minimiser (no tie-break); its `active` list is the tight inequalities.
 

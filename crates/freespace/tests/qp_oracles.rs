@@ -437,6 +437,25 @@ proptest! {
     }
 }
 
+proptest! {
+    /// Nearly singular Hessians (cost (1) with w within 1e-3 of 0 or 1, min h / max h < 1e-3) keep the general
+    /// method: the minimiser is ill-determined within the multiplier tolerance there, so `minimize` must return the
+    /// general method's solution bit for bit.
+    #[test]
+    fn nearly_singular_costs_keep_the_general_method(seed in any::<u64>(), kind in 0usize..6, cuts in 0usize..5, e in -9.0f64..-3.5, near_one in any::<bool>()) {
+        let mut rng = Rng(seed);
+        let (hs, _, _) = random_cell(&mut rng, KINDS[kind], cuts);
+        let w = if near_one { 1.0 - 10f64.powf(e) } else { 10f64.powf(e) };
+        let ext = RotatedExtents {
+            x_max: 2.0, x_min: -1.0, y_max: 1.5, y_min: -2.5, center_of_gravity: DVec3::new(0.1, -0.2, 0.7),
+        };
+        let reference = DVec3::new(rng.range(-15.0, 15.0), rng.range(-15.0, 15.0), rng.range(-4.0, 8.0));
+        let cost = stacking_cost(w, &ext, reference).expect("cost");
+        let cell = Cell::new(hs, Tolerance::for_scale(30.0)).map_err(|e| TestCaseError::fail(format!("{e}")))?;
+        prop_assert_eq!(minimize(&cell, &cost), minimize_general(&cell, &cost));
+    }
+}
+
 /// Goldens: the planner's typical situations with exact answers.
 #[test]
 fn goldens_of_the_fast_path() {
