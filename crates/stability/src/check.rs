@@ -29,7 +29,7 @@
 use crate::StabilityError;
 use crate::clearance::{horizontal_distance_at_least, vertically_separated};
 use crate::contacts::{Body, ContactAnalysis, ContactPatch, analyse_contacts};
-use crate::equilibrium::{ContactForce, Equilibrium, EquilibriumOptions, Verdict, solve_equilibrium};
+use crate::equilibrium::{ContactForce, Equilibrium, EquilibriumOptions, SolveCache, Verdict, solve_equilibrium_with};
 use crate::grasp::{GraspOptions, grasp_faces_of_components, is_graspable};
 use crate::insertion::{Obstruction, insertion_obstruction};
 use crate::world::{PlacedPart, WorldPart, aabb_overlap, stack_tolerance, world_stack};
@@ -127,6 +127,22 @@ pub struct StackCheck {
 
 /// Checks a stack; see the module documentation.
 pub fn check_stack(stack: &[PlacedPart<'_>], options: &CheckOptions) -> Result<StackCheck, StabilityError> {
+    check_stack_with(stack, options, false)
+}
+
+/// [`check_stack`] with every equilibrium problem solved as one SOCP per group (and one per group and direction for
+/// the margins), without the support-tree split, the closed forms, the point reduction and the margin certificates
+/// of [`crate::equilibrium`]: the reference those shortcuts are tested against (same verdicts, margins and forces up
+/// to the solver's tolerance), several times slower.
+pub fn check_stack_reference(stack: &[PlacedPart<'_>], options: &CheckOptions) -> Result<StackCheck, StabilityError> {
+    check_stack_with(stack, options, true)
+}
+
+fn check_stack_with(
+    stack: &[PlacedPart<'_>],
+    options: &CheckOptions,
+    reference: bool,
+) -> Result<StackCheck, StabilityError> {
     if !(options.clearance >= 0.0 && options.clearance.is_finite()) {
         return Err(StabilityError::BadOption(format!("clearance must be >= 0, got {}", options.clearance)));
     }
@@ -163,7 +179,13 @@ pub fn check_stack(stack: &[PlacedPart<'_>], options: &CheckOptions) -> Result<S
     };
     let n = parts.len();
     let ContactAnalysis { patches, interferences } = analyse_contacts(&parts, tol, |_| true);
-    let eq_with_margin = EquilibriumOptions::new(options.mu, options.margin_directions);
+    // one memo for every equilibrium problem of the check (the reference solves everything afresh)
+    let cache = SolveCache::new();
+    let eq_with_margin = EquilibriumOptions {
+        margins_by_socp_only: reference,
+        equilibrium_by_socp_only: reference,
+        ..EquilibriumOptions::new(options.mu, options.margin_directions)
+    };
 
     // the whole stack, then the prefixes
     let movable_all = vec![true; n];
@@ -176,10 +198,16 @@ pub fn check_stack(stack: &[PlacedPart<'_>], options: &CheckOptions) -> Result<S
             decided_by_precheck: false,
         }
     } else {
-        solve_equilibrium(&parts, &movable_all, &patches, &eq_with_margin)?
+        solve_equilibrium_with(&parts, &movable_all, &patches, &eq_with_margin, &cache)?
     };
     let prefix_verdicts = if options.prefix_stability {
-        prefix_verdicts(&parts, &patches, &whole.verdict, options.mu)?
+        prefix_verdicts(
+            &parts,
+            &patches,
+            &whole.verdict,
+            &EquilibriumOptions { directions: 0, ..eq_with_margin },
+            &cache,
+        )?
     } else {
         let mut v = vec![Verdict::Unknown("not checked".into()); n];
         if let Some(last) = v.last_mut() {
@@ -241,7 +269,7 @@ pub fn check_stack(stack: &[PlacedPart<'_>], options: &CheckOptions) -> Result<S
         };
         let sub: Vec<ContactPatch> = patches.iter().filter(|p| patch_within(p, i)).cloned().collect();
         let movable: Vec<bool> = (0..n).map(|k| k == i).collect();
-        let alone = solve_equilibrium(&parts, &movable, &sub, &eq_with_margin)?;
+        let alone = solve_equilibrium_with(&parts, &movable, &sub, &eq_with_margin, &cache)?;
         let (grasp_radius, graspable) = grasps[grasp_class[i]];
         let obstruction = insertion_obstruction(&parts, i, tol).err();
         let insertable = obstruction.is_none();
@@ -293,7 +321,8 @@ fn prefix_verdicts(
     parts: &[WorldPart],
     patches: &[ContactPatch],
     whole: &Verdict,
-    mu: f64,
+    plain: &EquilibriumOptions,
+    cache: &SolveCache,
 ) -> Result<Vec<Verdict>, StabilityError> {
     let n = parts.len();
     if n == 0 {
@@ -319,7 +348,6 @@ fn prefix_verdicts(
         step_groups.push((0..=i).filter(|&k| label[k] == i).collect());
         labels_after.push(label[..=i].to_vec());
     }
-    let plain = EquilibriumOptions::new(mu, 0);
     let step_verdicts: Vec<Verdict> = (0..n - 1)
         .into_par_iter()
         .map(|i| {
@@ -332,7 +360,7 @@ fn prefix_verdicts(
                 })
                 .cloned()
                 .collect();
-            solve_equilibrium(parts, &movable, &sub, &plain).map(|e| e.verdict)
+            solve_equilibrium_with(parts, &movable, &sub, plain, cache).map(|e| e.verdict)
         })
         .collect::<Result<_, _>>()?;
     let mut out = Vec::with_capacity(n);

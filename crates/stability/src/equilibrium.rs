@@ -54,6 +54,12 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+mod cache;
+mod margin;
+mod tree;
+
+pub use cache::SolveCache;
+
 /// Margin directions solved one after the other with one reused solver (see `Problem::solve_loads`).
 const DIRECTIONS_PER_SOLVER: usize = 4;
 
@@ -90,12 +96,16 @@ pub struct EquilibriumOptions {
     /// cross-checking the closed form; the results agree to the solver's tolerance).
     #[serde(default)]
     pub margins_by_socp_only: bool,
+    /// Solve every group's equilibrium by one SOCP, also where it splits along a support tree or has a closed form
+    /// (for cross-checking those; the results agree to the solver's tolerance).
+    #[serde(default)]
+    pub equilibrium_by_socp_only: bool,
 }
 
 impl EquilibriumOptions {
     /// Friction `mu`, `directions` margin directions, closed-form margins where they apply.
     pub fn new(mu: f64, directions: usize) -> Self {
-        Self { mu, directions, margins_by_socp_only: false }
+        Self { mu, directions, margins_by_socp_only: false, equilibrium_by_socp_only: false }
     }
 }
 
@@ -153,12 +163,46 @@ pub enum EquilibriumError {
     Solver(String),
 }
 
+#[derive(Clone)]
 struct Point {
     patch: usize,
     p: DVec3,
     frame: [DVec3; 3],
     a: Option<usize>,
     b: usize,
+}
+
+/// What the equilibrium equations need of a body: mass, c.g. and bounding box (for the scaling and the tolerance).
+#[derive(Debug, Clone, Copy)]
+struct Rigid {
+    mass: f64,
+    cg: DVec3,
+    aabb: (DVec3, DVec3),
+}
+
+impl Rigid {
+    fn of(part: &WorldPart) -> Self {
+        Self { mass: part.mass, cg: part.center_of_gravity, aabb: part.aabb }
+    }
+
+    /// The rigid union of `bodies` (total mass, mass-weighted c.g., union of the boxes).
+    fn union(bodies: impl Iterator<Item = Rigid>) -> Self {
+        let mut out =
+            Rigid { mass: 0.0, cg: DVec3::ZERO, aabb: (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)) };
+        let mut moment = DVec3::ZERO;
+        for b in bodies {
+            out.mass += b.mass;
+            moment += b.cg * b.mass;
+            out.aabb = (out.aabb.0.min(b.aabb.0), out.aabb.1.max(b.aabb.1));
+        }
+        out.cg = moment / out.mass;
+        out
+    }
+
+    /// The length tolerance of the flat-support tests: 1e-9 times the box diagonal (at least 1e-9).
+    fn tolerance(&self) -> f64 {
+        1e-9 * (self.aabb.1 - self.aabb.0).length().max(1.0)
+    }
 }
 
 /// The equilibrium SOCP over `parts` with the given contact `patches`; `movable[i]` says whether part `i` moves.
@@ -176,6 +220,18 @@ pub fn solve_equilibrium(
     movable: &[bool],
     patches: &[ContactPatch],
     options: &EquilibriumOptions,
+) -> Result<Equilibrium, EquilibriumError> {
+    solve_equilibrium_with(parts, movable, patches, options, &SolveCache::new())
+}
+
+/// [`solve_equilibrium`] with a memo of the rigid-body problems shared by several calls on the same stack (see
+/// [`SolveCache`]; the answers are the same as without it).
+pub fn solve_equilibrium_with(
+    parts: &[WorldPart],
+    movable: &[bool],
+    patches: &[ContactPatch],
+    options: &EquilibriumOptions,
+    cache: &SolveCache,
 ) -> Result<Equilibrium, EquilibriumError> {
     if !(options.mu >= 0.0 && options.mu.is_finite()) {
         return Err(EquilibriumError::BadFriction(options.mu));
@@ -212,62 +268,114 @@ pub fn solve_equilibrium(
         decided_by_precheck,
     };
     let groups = movable_groups(parts.len(), &movers, &points, is_movable);
+    let bodies: Vec<Rigid> = parts.iter().map(Rigid::of).collect();
     // the pre-check first: one failing group decides without any solve
     for group in &groups {
         if let Some(result) = precheck(parts, &group.movers, &group.points(&points)) {
             return Ok(result);
         }
     }
-    let solved: Vec<(Problem, SolverStatus, Vec<f64>)> = groups
+    let solved: Vec<(Verdict, Vec<DVec3>)> = groups
         .par_iter()
-        .map(|group| {
-            let problem = Problem::new(parts, &group.movers, &group.points(&points), options.mu);
-            problem.solve(None).map(|(status, x)| (problem, status, x))
-        })
+        .map(|group| group_equilibrium(&bodies, &points, group, options.mu, options.equilibrium_by_socp_only, cache))
         .collect::<Result<_, _>>()?;
-    let verdicts: Vec<Verdict> = solved.iter().map(|(_, status, _)| verdict_of(*status)).collect();
-    if let Some(v) = verdicts.iter().find(|v| **v == Verdict::Unstable) {
+    if let Some((v, _)) = solved.iter().find(|(v, _)| *v == Verdict::Unstable) {
         tracing::debug!("equilibrium infeasible");
         return Ok(not_stable(v.clone(), false));
     }
-    if let Some(v) = verdicts.iter().find(|v| !v.is_stable()) {
+    if let Some((v, _)) = solved.iter().find(|(v, _)| !v.is_stable()) {
         tracing::debug!(?v, "equilibrium solve did not end Solved");
         return Ok(not_stable(v.clone(), false));
     }
     let mut forces: Vec<(usize, ContactForce)> = Vec::with_capacity(points.len());
-    for (group, (problem, _, x)) in groups.iter().zip(&solved) {
-        for (local, &k) in group.point_indices.iter().enumerate() {
+    for (group, (_, group_forces)) in groups.iter().zip(&solved) {
+        for (&k, &force) in group.point_indices.iter().zip(group_forces) {
             let pt = &points[k];
-            let force = (pt.frame[0] * x[3 * local] + pt.frame[1] * x[3 * local + 1] + pt.frame[2] * x[3 * local + 2])
-                * problem.force_scale;
             forces.push((k, ContactForce { patch: pt.patch, point: pt.p, force }));
         }
     }
     forces.sort_by_key(|(k, _)| *k);
     let forces = forces.into_iter().map(|(_, f)| f).collect();
-    let (margin, weakest_direction) = if options.directions > 0 {
-        let closed: Vec<Option<FlatSupport>> = groups
-            .iter()
-            .map(|g| {
-                if options.margins_by_socp_only { None } else { FlatSupport::of(parts, &g.movers, &g.points(&points)) }
-            })
-            .collect();
-        margins(&solved, &closed, options.directions, options.mu)?
+    let (margin, weakest_direction) = if options.directions > 0 && !options.margins_by_socp_only {
+        margin::fast_margins(&bodies, &points, &groups, options.directions, options.mu, cache)?
+    } else if options.directions > 0 {
+        let problems: Vec<Problem> =
+            groups.iter().map(|g| Problem::new(&bodies, &g.movers, &g.points(&points), options.mu)).collect();
+        margins(&problems, options.directions)?
     } else {
         (None, None)
     };
     Ok(Equilibrium { verdict: Verdict::Stable, forces, margin, weakest_direction, decided_by_precheck: false })
 }
 
+/// The verdict and the minimum-norm forces (world vectors, in the order of `group.point_indices`; empty unless
+/// stable) of one group: one SOCP for the group (`plain`), or one problem per edge of its support tree when it has
+/// one (flat edges in closed form, see [`tree`]), combined like the groups of [`solve_equilibrium`].
+fn group_equilibrium(
+    bodies: &[Rigid],
+    points: &[Point],
+    group: &Group,
+    mu: f64,
+    plain: bool,
+    cache: &SolveCache,
+) -> Result<(Verdict, Vec<DVec3>), EquilibriumError> {
+    let socp =
+        |bodies: &[Rigid], movers: &[usize], own: &[&Point]| -> Result<(Verdict, Vec<DVec3>), EquilibriumError> {
+            let problem = Problem::new(bodies, movers, own, mu);
+            let (status, x) = problem.solve(None)?;
+            let verdict = verdict_of(status);
+            if !verdict.is_stable() {
+                return Ok((verdict, Vec::new()));
+            }
+            let forces = own
+                .iter()
+                .enumerate()
+                .map(|(k, pt)| {
+                    (pt.frame[0] * x[3 * k] + pt.frame[1] * x[3 * k + 1] + pt.frame[2] * x[3 * k + 2])
+                        * problem.force_scale
+                })
+                .collect();
+            Ok((verdict, forces))
+        };
+    let edges = if plain { None } else { tree::support_tree(bodies, points, group) };
+    let Some(edges) = edges else { return socp(bodies, &group.movers, &group.points(points)) };
+    let position: std::collections::HashMap<usize, usize> =
+        group.point_indices.iter().enumerate().map(|(local, &k)| (k, local)).collect();
+    let mut forces = vec![DVec3::ZERO; group.point_indices.len()];
+    let mut verdict = Verdict::Stable;
+    for edge in &edges {
+        let own: Vec<Point> = edge.points.iter().map(|&(k, holds_b)| tree::edge_point(&points[k], holds_b)).collect();
+        let (v, on_subtree) =
+            cache.equilibrium(cache::key(&[mu], &edge.union, &own), || {
+                match tree::flat_minimum_norm(&edge.union, &own) {
+                    Some(f) => Ok((Verdict::Stable, f)),
+                    None => socp(&[edge.union], &[0], &own.iter().collect::<Vec<_>>()),
+                }
+            })?;
+        match v {
+            Verdict::Stable => {
+                for (&(k, holds_b), f) in edge.points.iter().zip(on_subtree) {
+                    forces[position[&k]] = if holds_b { f } else { -f };
+                }
+            }
+            Verdict::Unstable => return Ok((Verdict::Unstable, Vec::new())),
+            unknown => {
+                if verdict.is_stable() {
+                    verdict = unknown;
+                }
+            }
+        }
+    }
+    if !verdict.is_stable() {
+        forces.clear();
+    }
+    Ok((verdict, forces))
+}
+
 /// The robustness margin over `directions` evenly spaced horizontal load directions: per direction the smallest
 /// largest load factor over the groups, then the smallest over the directions (the first direction achieving it is
 /// the weakest). `None` when a solve does not end `Solved`.
-fn margins(
-    solved: &[(Problem, SolverStatus, Vec<f64>)],
-    closed: &[Option<FlatSupport>],
-    directions: usize,
-    mu: f64,
-) -> Result<(Option<f64>, Option<DVec3>), EquilibriumError> {
+fn margins(solved: &[Problem], directions: usize) -> Result<(Option<f64>, Option<DVec3>), EquilibriumError> {
     let direction = |j: usize| {
         let angle = std::f64::consts::TAU * j as f64 / directions as f64;
         DVec3::new(angle.cos(), angle.sin(), 0.0)
@@ -280,11 +388,8 @@ fn margins(
         .par_iter()
         .map(|&(g, first)| {
             let js: Vec<usize> = (first..directions.min(first + DIRECTIONS_PER_SOLVER)).collect();
-            if let Some(flat) = &closed[g] {
-                return Ok(js.iter().map(|&j| Some(flat.margin(direction(j), mu))).collect());
-            }
             let loads: Vec<DVec3> = js.iter().map(|&j| direction(j)).collect();
-            let results = solved[g].0.solve_loads(&loads)?;
+            let results = solved[g].solve_loads(&loads)?;
             Ok(results
                 .into_iter()
                 .zip(&js)
@@ -343,9 +448,9 @@ struct FlatSupport {
 }
 
 impl FlatSupport {
-    fn of(parts: &[WorldPart], movers: &[usize], points: &[&Point]) -> Option<Self> {
+    fn of(bodies: &[Rigid], movers: &[usize], points: &[&Point]) -> Option<Self> {
         let [i] = movers else { return None };
-        let tol = 1e-9 * parts[*i].diagonal().max(1.0);
+        let tol = bodies[*i].tolerance();
         if points.is_empty() || !points.iter().all(|p| p.b == *i && p.frame[0].z >= 1.0 - 1e-12) {
             return None;
         }
@@ -354,7 +459,7 @@ impl FlatSupport {
         if hi - lo > tol {
             return None;
         }
-        let c = parts[*i].center_of_gravity;
+        let c = bodies[*i].cg;
         let height = c.z - 0.5 * (lo + hi);
         let polygon = convex_hull_2d(&points.iter().map(|p| DVec2::new(p.p.x, p.p.y)).collect::<Vec<_>>(), tol);
         let cg = DVec2::new(c.x, c.y);
@@ -492,7 +597,7 @@ struct Problem {
 }
 
 impl Problem {
-    fn new(parts: &[WorldPart], movers: &[usize], points: &[&Point], mu: f64) -> Self {
+    fn new(parts: &[Rigid], movers: &[usize], points: &[&Point], mu: f64) -> Self {
         let force_scale: f64 = movers.iter().map(|&i| parts[i].mass).sum::<f64>().max(f64::MIN_POSITIVE);
         let mut lo = DVec3::splat(f64::INFINITY);
         let mut hi = DVec3::splat(f64::NEG_INFINITY);
@@ -517,7 +622,7 @@ impl Problem {
                 if r == usize::MAX {
                     return;
                 }
-                let arm = (pt.p - parts[body].center_of_gravity) / length_scale;
+                let arm = (pt.p - parts[body].cg) / length_scale;
                 for (c, dir) in pt.frame.iter().enumerate() {
                     let f = *dir * sign;
                     let moment = arm.cross(f);
@@ -539,7 +644,7 @@ impl Problem {
     /// Solves the equilibrium problem (`load = None`) or the margin problem `max alpha` for load direction `d`.
     /// Returns the status and the primal solution (forces in the local frames, then alpha when present).
     fn solve(&self, load: Option<DVec3>) -> Result<(SolverStatus, Vec<f64>), EquilibriumError> {
-        let mut solver = self.solver(load)?;
+        let mut solver = self.solver(load, MARGIN_CAP)?;
         solver.solve();
         Ok((solver.solution.status, solver.solution.x.clone()))
     }
@@ -549,13 +654,13 @@ impl Problem {
     /// which changes the answers only at the solver's tolerance). Per direction: the status and the clamped factor.
     fn solve_loads(&self, loads: &[DVec3]) -> Result<Vec<(SolverStatus, f64)>, EquilibriumError> {
         let Some(&first) = loads.first() else { return Ok(Vec::new()) };
-        let mut solver = self.solver(Some(first))?;
+        let mut solver = self.solver(Some(first), MARGIN_CAP)?;
         let mut out = Vec::with_capacity(loads.len());
         for (k, &d) in loads.iter().enumerate() {
             if k > 0 {
-                let (a, _) = self.constraints(Some(d));
+                let (a, _) = self.constraints(Some(d), MARGIN_CAP);
                 if solver.update_A(&a).is_err() {
-                    solver = self.solver(Some(d))?;
+                    solver = self.solver(Some(d), MARGIN_CAP)?;
                 }
             }
             solver.solve();
@@ -566,10 +671,10 @@ impl Problem {
     }
 
     /// A clarabel solver for the equilibrium problem (`load = None`) or the margin problem for direction `d`.
-    fn solver(&self, load: Option<DVec3>) -> Result<DefaultSolver<f64>, EquilibriumError> {
+    fn solver(&self, load: Option<DVec3>, cap: f64) -> Result<DefaultSolver<f64>, EquilibriumError> {
         let nf = 3 * self.n_points;
         let n = nf + usize::from(load.is_some());
-        let (a, (b, cones)) = self.constraints(load);
+        let (a, (b, cones)) = self.constraints(load, cap);
         let (p, q) = match load {
             None => {
                 let diag: Vec<usize> = (0..n).collect();
@@ -590,7 +695,7 @@ impl Problem {
 
     /// The constraint matrix `A`, right-hand side `b` and cones of the problem (see [`Problem::solver`]).
     #[allow(clippy::type_complexity)]
-    fn constraints(&self, load: Option<DVec3>) -> (CscMatrix<f64>, (Vec<f64>, Vec<SupportedConeT<f64>>)) {
+    fn constraints(&self, load: Option<DVec3>, cap: f64) -> (CscMatrix<f64>, (Vec<f64>, Vec<SupportedConeT<f64>>)) {
         let nf = 3 * self.n_points;
         let n = nf + usize::from(load.is_some());
         let n_eq = self.rhs.len();
@@ -637,7 +742,7 @@ impl Problem {
         b.extend(std::iter::repeat_n(0.0, self.n_points));
         if load.is_some() {
             b.push(0.0);
-            b.push(MARGIN_CAP);
+            b.push(cap);
         }
         cones.push(NonnegativeConeT(n_nonneg));
         row += n_nonneg;

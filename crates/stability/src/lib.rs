@@ -25,9 +25,11 @@ pub mod resting_poses;
 pub mod sat;
 pub mod world;
 
-pub use check::{CheckOptions, PartCheck, StackCheck, check_stack};
+pub use check::{CheckOptions, PartCheck, StackCheck, check_stack, check_stack_reference};
 pub use contacts::{Body, ContactAnalysis, ContactPatch, analyse_contacts};
-pub use equilibrium::{Equilibrium, EquilibriumOptions, Verdict, solve_equilibrium};
+pub use equilibrium::{
+    Equilibrium, EquilibriumOptions, SolveCache, Verdict, solve_equilibrium, solve_equilibrium_with,
+};
 pub use grasp::{GraspFace, GraspOptions, grasp_faces};
 pub use resting_poses::{RestingPose, resting_poses};
 pub use world::{PlacedPart, WorldPart, world_stack};

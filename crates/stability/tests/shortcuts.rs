@@ -7,16 +7,28 @@
 //!   which has no memory of the steps), and against the check of every column on its own: the stack is stable iff
 //!   every column is, and its margin (same load direction for all parts) is the smallest column margin;
 //! * the closed-form margin of a part on a flat horizontal support against the margin SOCPs
-//!   (`EquilibriumOptions::margins_by_socp_only`), for random boxes on random supports, off-centre and overhanging.
+//!   (`EquilibriumOptions::margins_by_socp_only`), for random boxes on random supports, off-centre and overhanging;
+//! * the fast equilibrium and margins of `solve_equilibrium` (support trees, flat supports in closed form, reduced
+//!   contact points, the triangle certificate) against one plain SOCP per group (and per group and direction), both
+//!   options `*_by_socp_only`, through `check_stack` against `check_stack_reference`: on random stacks of box columns
+//!   (flat supports, off-centre ones whose least-squares forces go negative, tipping and sliding limits, planks
+//!   bridging the columns so that the support graph has cycles) with random friction, and on columns of every
+//!   fixture part (`fixtures/parts/*.json`) in its two lowest resting poses, nested (parts lowered onto the one
+//!   below until they touch, straight and shifted sideways): identical verdicts of every kind, margins within 1e-6
+//!   relative, forces within 1e-6 of the weight.
 
 mod common;
 
 use common::{at, box_part};
 use glam::DVec3;
 use proptest::prelude::*;
-use stackplan_stability::check::{CheckOptions, check_stack};
+use stackplan_geom::Part;
+use stackplan_geom::io::{ReadOptions, read_part};
+use stackplan_stability::check::{CheckOptions, StackCheck, check_stack, check_stack_reference};
 use stackplan_stability::contacts::analyse_contacts;
+use stackplan_stability::equilibrium::{ContactForce, Equilibrium};
 use stackplan_stability::equilibrium::{EquilibriumOptions, Verdict, solve_equilibrium};
+use stackplan_stability::resting_poses::resting_poses;
 use stackplan_stability::world::{PlacedPart, stack_tolerance, world_stack};
 
 fn options() -> CheckOptions {
@@ -28,6 +40,113 @@ fn options() -> CheckOptions {
 /// Stacks the boxes given per layer and column; returns (part index -> column, lower corner) in placement order.
 /// A layer: its height and per column (centre offset x, y, size x, y).
 type Layer = (f64, Vec<(f64, f64, f64, f64)>);
+
+/// Margins agree within 1e-6 relative (both absent, or both present).
+fn same_margin(fast: Option<f64>, plain: Option<f64>) -> bool {
+    match (fast, plain) {
+        (Some(f), Some(p)) => (f - p).abs() <= 1e-6 * (1.0 + p.abs()),
+        (f, p) => f.is_none() && p.is_none(),
+    }
+}
+
+/// Same verdict, margins within 1e-6 relative, the same minimum-norm forces: the same points, the sum of squares
+/// within 1e-6 relative, every force within `1e-3 * weight` (the minimum-norm forces are unique, but a duality gap
+/// of 1e-8 relative bounds the distance of a solver's forces to them only by about `sqrt(1e-8)` of their norm).
+fn assert_equivalent(fast: &Equilibrium, plain: &Equilibrium, weight: f64, what: &str) {
+    assert_eq!(fast.verdict, plain.verdict, "{what}: verdict");
+    assert!(same_margin(fast.margin, plain.margin), "{what}: margin {:?} vs {:?}", fast.margin, plain.margin);
+    assert_same_forces(&fast.forces, &plain.forces, weight, what);
+}
+
+fn assert_same_forces(fast: &[ContactForce], plain: &[ContactForce], weight: f64, what: &str) {
+    assert_eq!(fast.len(), plain.len(), "{what}: forces");
+    for (f, p) in fast.iter().zip(plain) {
+        assert_eq!((f.patch, f.point), (p.patch, p.point), "{what}: force order");
+        assert!((f.force - p.force).length() <= 1e-3 * weight, "{what}: force {} vs {}", f.force, p.force);
+    }
+    let squares = |forces: &[ContactForce]| forces.iter().map(|f| f.force.length_squared()).sum::<f64>();
+    let (a, b) = (squares(fast), squares(plain));
+    assert!((a - b).abs() <= 1e-6 * b.max(weight * weight * 1e-6), "{what}: sum of squares {a} vs {b}");
+}
+
+/// Every verdict identical, margins and forces equivalent (see [`assert_equivalent`]).
+fn assert_checks_equivalent(fast: &StackCheck, plain: &StackCheck, weight: f64, what: &str) {
+    assert_equivalent(&fast.stack, &plain.stack, weight, &format!("{what}, whole stack"));
+    assert_eq!(fast.parts.len(), plain.parts.len());
+    for (f, p) in fast.parts.iter().zip(&plain.parts) {
+        let part = format!("{what}, part {}", f.index);
+        assert_eq!(
+            (&f.stable, &f.stack_stable, f.graspable, f.insertable, f.removable, f.ok),
+            (&p.stable, &p.stack_stable, p.graspable, p.insertable, p.removable, p.ok),
+            "{part}: verdicts"
+        );
+        assert!(same_margin(f.margin, p.margin), "{part}: margin {:?} vs {:?}", f.margin, p.margin);
+        assert_same_forces(&f.forces, &p.forces, weight, &part);
+    }
+}
+
+/// The smallest upward shift at which a copy of `placed` moved by `(dx, dy)` and lifted does not interfere with it
+/// (bisection on the interference test): the copy then rests on (or nests in) the one below.
+fn nesting_height(placed: PlacedPart<'_>, dx: f64, dy: f64, upper: f64) -> f64 {
+    let interferes = |dz: f64| {
+        let top = PlacedPart { position: placed.position + DVec3::new(dx, dy, dz), ..placed };
+        let parts = world_stack(&[placed, top]).expect("world");
+        let tol = stack_tolerance(&parts).linear;
+        !analyse_contacts(&parts, tol, |_| true).interferences.is_empty()
+    };
+    let (mut lo, mut hi) = (0.0, upper);
+    for _ in 0..50 {
+        let mid = 0.5 * (lo + hi);
+        if interferes(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    hi
+}
+
+/// Two columns of three copies of `part` in resting pose `pose`, each copy shifted by `(dx, dy)` from the one below
+/// and lowered onto it.
+fn fixture_columns(part: &Part, pose: usize, dx: f64, dy: f64) -> Vec<PlacedPart<'_>> {
+    let poses = resting_poses(part).expect("poses");
+    let pose = &poses[pose.min(poses.len() - 1)];
+    let base = PlacedPart { part, rotation: pose.rotation, position: pose.position };
+    let parts = world_stack(&[base]).expect("world");
+    let size = parts[0].aabb.1 - parts[0].aabb.0;
+    let rise = nesting_height(base, dx, dy, size.z + 1.0);
+    let mut out = Vec::new();
+    for level in 0..3 {
+        for column in 0..2 {
+            let shift =
+                DVec3::new((size.x + 20.0) * column as f64 + dx * level as f64, dy * level as f64, rise * level as f64);
+            out.push(PlacedPart { position: base.position + shift, ..base });
+        }
+    }
+    out
+}
+
+#[test]
+fn shortcuts_match_the_plain_socps_on_fixture_columns() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/parts");
+    let mut files: Vec<_> = std::fs::read_dir(dir).expect("fixtures").flatten().map(|e| e.path()).collect();
+    files.sort();
+    assert!(files.len() >= 6, "{files:?}");
+    for file in files.iter().filter(|f| f.extension().is_some_and(|e| e == "json")) {
+        let part = read_part(file, &ReadOptions::default()).expect("fixture part");
+        for pose in 0..2 {
+            for (dx, dy) in [(0.0, 0.0), (7.0, -3.0)] {
+                let stack = fixture_columns(&part, pose, dx, dy);
+                let mut options = options();
+                options.mu = 0.4;
+                let fast = check_stack(&stack, &options).expect("check");
+                let plain = check_stack_reference(&stack, &options).expect("check");
+                let what = format!("{} pose {pose} shift ({dx}, {dy})", file.display());
+                assert_checks_equivalent(&fast, &plain, part.mass.mass, &what);
+            }
+        }
+    }
+}
 
 fn build(layers: &[Layer], columns: usize) -> Vec<(usize, DVec3, DVec3)> {
     let mut out = Vec::new();
@@ -89,6 +208,32 @@ proptest! {
                 prop_assert!((m - smallest).abs() <= 1e-6 * (1.0 + smallest), "stack {} vs columns {}", m, smallest);
             }
         }
+    }
+
+    #[test]
+    fn shortcuts_match_the_plain_socps_on_random_box_stacks(
+        columns in 1usize..=3,
+        layers in prop::collection::vec(
+            (10.0f64..40.0, prop::collection::vec((-25.0f64..25.0, -25.0f64..25.0, 20.0f64..70.0, 20.0f64..70.0), 3)),
+            1..=3,
+        ),
+        bridge in prop::option::of((-30.0f64..30.0, 5.0f64..20.0)),
+        mu in 0.1f64..1.2,
+    ) {
+        let layout = build(&layers, columns);
+        let mut parts: Vec<_> = layout.iter().enumerate().map(|(k, (_, _, size))| box_part(&format!("b{k}"), *size)).collect();
+        let mut placed: Vec<DVec3> = layout.iter().map(|(_, lo, _)| *lo).collect();
+        if let Some((shift, thickness)) = bridge {
+            let top = layers.iter().map(|l| l.0).sum::<f64>();
+            parts.push(box_part("plank", DVec3::new(200.0 * (columns - 1) as f64 + 40.0, 40.0, thickness)));
+            placed.push(DVec3::new(-20.0 + shift.clamp(-10.0, 10.0), -20.0, top));
+        }
+        let stack: Vec<PlacedPart<'_>> = parts.iter().zip(&placed).map(|(p, lo)| at(p, *lo)).collect();
+        let options = CheckOptions { mu, ..options() };
+        let fast = check_stack(&stack, &options).expect("check");
+        let plain = check_stack_reference(&stack, &options).expect("check");
+        let weight: f64 = parts.iter().map(|p| p.mass.mass).sum();
+        assert_checks_equivalent(&fast, &plain, weight, "random boxes");
     }
 
     #[test]

@@ -1,0 +1,82 @@
+//! Memo of the rigid-body problems of one stack check (the support-tree edges of [`super::tree`] and the margin units
+//! of [`super::margin`]).
+//!
+//! The checks of a stack solve many identical problems: the edge "part `j` on the part below" appears in the check of
+//! `j` on fixed supports, in every prefix stack containing `j` and in the whole stack. A problem is keyed by the exact
+//! bits of everything its answer depends on (the rigid union's mass, c.g. and box, every contact point's position and
+//! frame, in order, the friction coefficient, and for margins the number of directions and the certificate's bound
+//! `m`); the answer of a problem is a deterministic function of these, so a hit returns exactly what a new solve
+//! would (the patch labels of the points are not part of the key: they do not enter the solve). Cost: O(K) per
+//! lookup; the memo lives as long as the check.
+
+use super::{Point, Rigid, Verdict};
+use glam::DVec3;
+use std::collections::HashMap;
+use std::sync::Mutex;
+
+/// A memoised equilibrium answer: the verdict and the forces on the rigid body.
+type EquilibriumAnswer = (Verdict, Vec<DVec3>);
+
+/// A memo of equilibrium and margin solves, shared by the calls of one stack check (see [`super::solve_equilibrium_with`]).
+#[derive(Debug, Default)]
+pub struct SolveCache {
+    equilibria: Mutex<HashMap<Vec<u64>, EquilibriumAnswer>>,
+    margins: Mutex<HashMap<Vec<u64>, Vec<Option<f64>>>>,
+}
+
+/// The exact key of a rigid-body problem: `extra` values, the body, then every point.
+pub(super) fn key(extra: &[f64], body: &Rigid, points: &[Point]) -> Vec<u64> {
+    let mut out = Vec::with_capacity(extra.len() + 10 + 12 * points.len());
+    out.extend(extra.iter().map(|x| x.to_bits()));
+    out.push(body.mass.to_bits());
+    for v in [body.cg, body.aabb.0, body.aabb.1] {
+        out.extend(v.to_array().map(f64::to_bits));
+    }
+    for pt in points {
+        out.extend(pt.p.to_array().map(f64::to_bits));
+        for axis in pt.frame {
+            out.extend(axis.to_array().map(f64::to_bits));
+        }
+        // the fixed side: whether there is one (the units' points have none, their groups' points may)
+        out.push(pt.a.map_or(u64::MAX, |a| a as u64));
+        out.push(pt.b as u64);
+    }
+    out
+}
+
+impl SolveCache {
+    /// An empty memo.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    pub(super) fn equilibrium(
+        &self,
+        key: Vec<u64>,
+        solve: impl FnOnce() -> Result<(Verdict, Vec<DVec3>), super::EquilibriumError>,
+    ) -> Result<(Verdict, Vec<DVec3>), super::EquilibriumError> {
+        if let Some(hit) = self.equilibria.lock().ok().and_then(|m| m.get(&key).cloned()) {
+            return Ok(hit);
+        }
+        let value = solve()?;
+        if let Ok(mut m) = self.equilibria.lock() {
+            m.insert(key, value.clone());
+        }
+        Ok(value)
+    }
+
+    pub(super) fn margin(
+        &self,
+        key: Vec<u64>,
+        solve: impl FnOnce() -> Result<Vec<Option<f64>>, super::EquilibriumError>,
+    ) -> Result<Vec<Option<f64>>, super::EquilibriumError> {
+        if let Some(hit) = self.margins.lock().ok().and_then(|m| m.get(&key).cloned()) {
+            return Ok(hit);
+        }
+        let value = solve()?;
+        if let Ok(mut m) = self.margins.lock() {
+            m.insert(key, value.clone());
+        }
+        Ok(value)
+    }
+}

@@ -1,0 +1,158 @@
+//! Support trees: the exact split of a group's equilibrium problem into one rigid-body problem per tree edge, and the
+//! closed-form minimum-norm forces of a flat support (DESIGN.md section 7; the equations of [`super`]).
+//!
+//! Contract the fixed bodies (floor, fixed parts) of a group to one node, the ground. When the graph "movable parts
+//! and ground, joined when they share a contact point" is a tree (a column of parts each resting on the one below, a
+//! part alone on its supports), let `S_v` be the parts of the subtree of part `v` (rooted at the ground) and call the
+//! contact points between `v` and its parent "edge `v`". Summing the force and moment equations of the parts of `S_v`
+//! cancels the forces of every contact inside `S_v` and leaves: the forces of edge `v`, acting on `S_v`, balance the
+//! gravity (and horizontal load) of `S_v` — the equations of one rigid body, the union of `S_v` (total mass,
+//! mass-weighted c.g.; the load `alpha m_i d` is proportional to the mass like gravity, so its resultant acts at the
+//! union's c.g.). This map of the equations is triangular and invertible (a part's equations are its subtree's minus
+//! its children's subtrees'), and every contact point belongs to exactly one edge. So:
+//!
+//! * the group is in equilibrium iff every edge problem is feasible, and resists a load iff every edge problem does;
+//! * the minimum-norm forces of the group are the edges' minimum-norm forces (the objective `sum ||f_k||^2` is a sum
+//!   over the edges and the constraints are per edge).
+//!
+//! Graphs with a cycle (a brick on two bricks on the floor) are not split.
+//!
+//! **Flat support** ([`flat_minimum_norm`]): when every point of an edge pushes the subtree straight up (normal +z,
+//! within 1e-12), the equations decouple: friction appears only in the horizontal force and torsion rows, whose
+//! right-hand sides are 0 without load, so the minimum-norm friction is 0; the normal forces `n_k` must satisfy the
+//! three rows `sum n_k = W`, `sum n_k (x_k - c_x) = 0`, `sum n_k (y_k - c_y) = 0`. Their least-squares minimum-norm
+//! solution `n = A^T (A A^T)^-1 b` is the SOCP's optimum whenever it is nonnegative (an unconstrained minimiser that
+//! satisfies the cone constraints is the constrained one), so it is taken then; otherwise (or when `A A^T` is
+//! singular: collinear points) the edge is solved as an SOCP. Cost: O(K) per flat edge.
+//!
+//! Cost of the split: union-find-free breadth-first walk, O(P E + K) for P parts, E edges, K points.
+
+use super::Group;
+use super::{Point, Rigid};
+use glam::{DMat3, DVec3};
+
+/// One edge of a support tree.
+pub(super) struct Edge {
+    /// The rigid union of the subtree (the parts held by the edge).
+    pub union: Rigid,
+    /// The edge's contact points: (index in the points of the problem, whether the subtree holds the point's `b`).
+    pub points: Vec<(usize, bool)>,
+}
+
+/// The edges of the group's support tree, `None` when the support graph is not a tree (see the module
+/// documentation). One edge per movable part, in the order of `group.movers`.
+pub(super) fn support_tree(bodies: &[Rigid], points: &[Point], group: &Group) -> Option<Vec<Edge>> {
+    let n = group.movers.len();
+    let ground = n;
+    let node = |body: Option<usize>| body.and_then(|b| group.movers.binary_search(&b).ok()).unwrap_or(ground);
+    // the edges (pairs of nodes) and their points
+    let mut edges: Vec<((usize, usize), Vec<usize>)> = Vec::new();
+    for &k in &group.point_indices {
+        let (u, v) = (node(points[k].a), node(Some(points[k].b)));
+        if u == v {
+            return None;
+        }
+        let key = (u.min(v), u.max(v));
+        match edges.iter_mut().find(|(e, _)| *e == key) {
+            Some((_, list)) => list.push(k),
+            None => edges.push((key, vec![k])),
+        }
+    }
+    if edges.len() != n {
+        return None;
+    }
+    // breadth-first from the ground: the parent of every node
+    let mut parent = vec![usize::MAX; n + 1];
+    let mut order = vec![ground];
+    parent[ground] = ground;
+    let mut head = 0;
+    while head < order.len() {
+        let x = order[head];
+        head += 1;
+        for ((u, v), _) in &edges {
+            let y = if *u == x {
+                *v
+            } else if *v == x {
+                *u
+            } else {
+                continue;
+            };
+            if parent[y] == usize::MAX {
+                parent[y] = x;
+                order.push(y);
+            }
+        }
+    }
+    if order.len() != n + 1 {
+        return None;
+    }
+    // subtree unions, leaves first
+    let mut union: Vec<Rigid> = group.movers.iter().map(|&i| bodies[i]).collect();
+    for &x in order.iter().skip(1).rev() {
+        let p = parent[x];
+        if p != ground {
+            union[p] = Rigid::union([union[x], union[p]].into_iter());
+        }
+    }
+    let mut out = Vec::with_capacity(n);
+    for (x, rigid) in union.into_iter().enumerate() {
+        let key = (x.min(parent[x]), x.max(parent[x]));
+        let (_, list) = edges.iter().find(|(e, _)| *e == key)?;
+        let oriented = list.iter().map(|&k| (k, node(Some(points[k].b)) == x)).collect();
+        out.push(Edge { union: rigid, points: oriented });
+    }
+    Some(out)
+}
+
+/// The point as a contact of the subtree's rigid union (body 0, the other side fixed): its frame is turned so that
+/// it gives the force on the subtree (`+f` when the subtree holds `b`, `-f` when it holds `a`; the friction cone is
+/// symmetric in the tangents).
+pub(super) fn edge_point(pt: &Point, holds_b: bool) -> Point {
+    let frame = if holds_b { pt.frame } else { [-pt.frame[0], pt.frame[1], pt.frame[2]] };
+    Point { patch: pt.patch, p: pt.p, frame, a: None, b: 0 }
+}
+
+/// The minimum-norm forces (world vectors, on the body) of a rigid body of weight `union.mass` at `union.cg` on
+/// points that all push straight up, when that solution has no negative normal force (see the module
+/// documentation); `None` otherwise (not flat, collinear points, or a negative normal force).
+pub(super) fn flat_minimum_norm(union: &Rigid, points: &[Point]) -> Option<Vec<DVec3>> {
+    if points.is_empty() || !points.iter().all(|p| p.b == 0 && p.a.is_none() && p.frame[0].z >= 1.0 - 1e-12) {
+        return None;
+    }
+    let scale = (union.aabb.1 - union.aabb.0).length().max(1.0);
+    let arm = |p: &Point| ((p.p.x - union.cg.x) / scale, (p.p.y - union.cg.y) / scale);
+    // A A^T with the rows (1, x_k, y_k) (scaled arms)
+    let mut gram = [[0.0f64; 3]; 3];
+    for p in points {
+        let (x, y) = arm(p);
+        let row = [1.0, x, y];
+        for (r, gr) in gram.iter_mut().enumerate() {
+            for (c, g) in gr.iter_mut().enumerate() {
+                *g += row[r] * row[c];
+            }
+        }
+    }
+    let m = DMat3::from_cols_array_2d(&gram);
+    let det = m.determinant();
+    // relative conditioning test (the Gram matrix has entries of order K)
+    if det.is_nan() || det.abs() <= 1e-12 * (points.len() as f64).powi(3) {
+        return None;
+    }
+    let lambda = m.inverse() * DVec3::new(union.mass, 0.0, 0.0);
+    let mut forces = Vec::with_capacity(points.len());
+    let (mut total, mut mx, mut my) = (0.0, 0.0, 0.0);
+    for p in points {
+        let (x, y) = arm(p);
+        let normal = lambda.x + lambda.y * x + lambda.z * y;
+        if normal.is_nan() || normal < 0.0 {
+            return None;
+        }
+        total += normal;
+        mx += normal * x;
+        my += normal * y;
+        forces.push(DVec3::Z * normal);
+    }
+    // the residual of the three rows, relative to the weight
+    let residual = (total - union.mass).abs().max(mx.abs()).max(my.abs());
+    (residual <= 1e-12 * union.mass.max(f64::MIN_POSITIVE)).then_some(forces)
+}
