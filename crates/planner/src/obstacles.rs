@@ -121,6 +121,20 @@ impl DerivedObstacle {
         Self { orientation, moving, fixed, planes, origins }
     }
 
+    /// How deep `p` lies in the interior (the smallest slack `d_k - n_k . p`, its distance to the boundary), when
+    /// it lies inside by more than `tol` ([`DerivedObstacle::interior_contains`]); `None` otherwise.
+    pub fn interior_depth(&self, p: glam::DVec3, tol: f64) -> Option<f64> {
+        let mut depth = f64::INFINITY;
+        for pl in &self.planes {
+            let slack = pl.offset - tol - pl.normal.dot(p);
+            if slack <= 0.0 {
+                return None;
+            }
+            depth = depth.min(slack);
+        }
+        Some(depth + tol)
+    }
+
     /// Whether `p` lies in the interior by more than `tol` (interference).
     pub fn interior_contains(&self, p: glam::DVec3, tol: f64) -> bool {
         self.planes.iter().all(|pl| pl.normal.dot(p) < pl.offset - tol)

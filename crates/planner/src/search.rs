@@ -5,7 +5,10 @@
 //! `p*` of the cost over `K` (`f(p*)` is the key). The roots are `(theta_k, Omega(theta_k))`. Loop:
 //!
 //! 1. pop the cheapest node (ties: lower orientation index, then lower cell id — deterministic);
-//! 2. detect the interfering component pairs at `(theta_k, p*)` ([`crate::detect`]);
+//! 2. if an obstacle of `theta_k` built earlier holds `p*` in its interior by more than the tolerance (not one
+//!    applied on the node's path), take the deepest such (any obstacle holding `p*` gives a valid split; this one
+//!    needs no detection, which halves the detections of the Triangle scenario); otherwise detect the interfering
+//!    component pairs at `(theta_k, p*)` ([`crate::detect`]);
 //! 3. take the first of them (deepest violation first) whose obstacle ([`crate::obstacles`]) contains `p*` in its
 //!    interior by more than the tolerance, and split `K` into the children
 //!    `K n {n_k . p >= d_k} n {n_j . p <= d_j, j < k}` ([A] VI-A-3). Children are pushed *lazily* keyed by a lower
@@ -145,6 +148,9 @@ pub struct PlacementStats {
     pub obstacle_cache_hits: u64,
     /// Interference detections (configurations tested).
     pub interference_tests: u64,
+    /// Popped optima cut by an obstacle of their orientation built earlier, without an interference detection.
+    #[serde(default)]
+    pub known_obstacle_cuts: u64,
     /// Exact narrow-phase pair tests.
     pub narrow_phase_tests: u64,
     /// Solved nodes popped (each tested for interference).
@@ -190,10 +196,11 @@ pub struct PlacementResult {
     pub stats: PlacementStats,
 }
 
-/// A node's cell: solved (with its optimum) or pending (the parent's cell plus the child's extra inequalities,
-/// keyed by the parent's cost, a valid lower bound: the child is only built and solved when popped).
+/// A node's cell: solved (with its optimum) or pending (the parent's cell plus the extra inequalities of child
+/// `face` of obstacle `obstacle`, rebuilt from the obstacle's planes when popped, and the parent's optimum; keyed by
+/// a lower bound of its cost: the child is only built and solved when popped).
 enum Body<const D: usize> {
-    Pending(Vec<Halfspace<D>>, [f64; D]),
+    Pending { obstacle: u32, face: u32, start: [f64; D] },
     Solved(QpOptimum<D>),
 }
 
@@ -250,8 +257,8 @@ fn restrict_quadratic<const D: usize>(q: &SeparableQuadratic, fixed_z: f64) -> Q
     Quadratic { h: std::array::from_fn(|i| q.h[i]), c: std::array::from_fn(|i| q.c[i]), constant }
 }
 
-/// A child of a split: the face's outside half-space `normal . p >= offset` and the child's extra inequalities.
-type Outside<const D: usize> = (([f64; D], f64), Vec<Halfspace<D>>);
+/// A child of a split: the face's outside half-space `normal . p >= offset` and the face's index.
+type Outside<const D: usize> = (([f64; D], f64), u32);
 
 /// The search state shared by the loop.
 struct Search<'r, 'a> {
@@ -264,6 +271,8 @@ struct Search<'r, 'a> {
     obstacles: Vec<Arc<DerivedObstacle>>,
     derived: HashMap<(usize, usize, usize), Arc<DerivedObstacle>>,
     obstacle_ids: HashMap<(usize, usize, usize), u32>,
+    /// The obstacles built (or taken from the shared caches) for each orientation, in order.
+    by_orientation: Vec<Vec<u32>>,
     axes: AxesCache,
     intervals: IntervalObstacles,
     stats: PlacementStats,
@@ -401,6 +410,7 @@ pub fn place_with_caches(
         extrapolate: request.extrapolate,
         stack: scene.components.iter().map(|c| c.placed.vertices.clone()).collect(),
     });
+    let n_orientations = orientations.len();
     let mut search = Search {
         request,
         orientations,
@@ -410,6 +420,7 @@ pub fn place_with_caches(
         cache,
         obstacles: Vec::new(),
         obstacle_ids: HashMap::new(),
+        by_orientation: vec![Vec::new(); n_orientations],
         axes: std::mem::take(&mut caches.axes),
         derived: std::mem::take(&mut caches.derived),
         intervals: std::mem::take(&mut caches.intervals),
@@ -524,10 +535,11 @@ impl Search<'_, '_> {
                 return Err(PlacementError::NodeBudget { budget: self.request.node_budget, found: placements.len() });
             }
             let optimum = match &node.body {
-                Body::Pending(extra, start) => {
+                Body::Pending { obstacle, face, start } => {
                     // build and solve the child now; push it back with its true cost (>= its key)
                     let t_cells = Instant::now();
-                    let solved = self.solve_child::<D>(&node, extra, start, fixed_z)?;
+                    let extra = self.child_inequalities::<D>(*obstacle, *face, fixed_z);
+                    let solved = self.solve_child::<D>(&node, &extra, start, fixed_z)?;
                     if let Some((cell, optimum)) = solved {
                         heap.push(Node {
                             cost: optimum.value,
@@ -555,42 +567,62 @@ impl Search<'_, '_> {
                 self.stats.time_setup_ms += ms(t_setup);
             }
             let p = lift(&optimum.point, fixed_z);
-            let t_det = Instant::now();
-            let mut counts = DetectCounts::default();
-            let mut queue = CandidateQueue::new(
-                &self.scene,
-                &self.orientations[node.orientation],
-                self.sweeps[node.orientation].as_ref(),
-                p,
-                clearance,
-                self.request.horizontal_clearance,
-                tol,
-                &mut self.axes,
-                &mut counts,
-            );
-            self.stats.interference_tests += 1;
-            self.stats.narrow_phase_tests += counts.narrow_phase;
-            self.stats.time_interference_ms += ms(t_det);
-            // the first candidate (deepest first) whose obstacle holds p* in its interior; the queue finishes the
-            // pairs' separating-axis scans only as far as this needs
-            let mut cutting: Option<u32> = None;
-            loop {
+            // an obstacle of this orientation built earlier that holds p* in its interior cuts at once (the deepest
+            // holding one, as the detection's order prefers the deepest violation): the exact interference detection
+            // below runs only when none does
+            let mut cutting: Option<u32> = {
+                let mut best: Option<(f64, u32)> = None;
+                for &id in &self.by_orientation[node.orientation] {
+                    if node.applied.contains(&id) {
+                        continue;
+                    }
+                    if let Some(depth) = self.obstacles[id as usize].interior_depth(p, tol) {
+                        if best.is_none_or(|(d, _)| depth > d) {
+                            best = Some((depth, id));
+                        }
+                    }
+                }
+                best.map(|(_, id)| id)
+            };
+            if cutting.is_some() {
+                self.stats.known_obstacle_cuts += 1;
+            } else {
                 let t_det = Instant::now();
-                let next = queue.next(
+                let mut counts = DetectCounts::default();
+                let mut queue = CandidateQueue::new(
                     &self.scene,
                     &self.orientations[node.orientation],
                     self.sweeps[node.orientation].as_ref(),
+                    p,
+                    clearance,
+                    self.request.horizontal_clearance,
+                    tol,
                     &mut self.axes,
+                    &mut counts,
                 );
+                self.stats.interference_tests += 1;
+                self.stats.narrow_phase_tests += counts.narrow_phase;
                 self.stats.time_interference_ms += ms(t_det);
-                let Some(c) = next else { break };
-                let id = self.obstacle_id(node.orientation, c.moving, c.fixed)?;
-                if node.applied.contains(&id) {
-                    continue;
-                }
-                if self.obstacles[id as usize].interior_contains(p, tol) {
-                    cutting = Some(id);
-                    break;
+                // the first candidate (deepest first) whose obstacle holds p* in its interior; the queue finishes the
+                // pairs' separating-axis scans only as far as this needs
+                loop {
+                    let t_det = Instant::now();
+                    let next = queue.next(
+                        &self.scene,
+                        &self.orientations[node.orientation],
+                        self.sweeps[node.orientation].as_ref(),
+                        &mut self.axes,
+                    );
+                    self.stats.time_interference_ms += ms(t_det);
+                    let Some(c) = next else { break };
+                    let id = self.obstacle_id(node.orientation, c.moving, c.fixed)?;
+                    if node.applied.contains(&id) {
+                        continue;
+                    }
+                    if self.obstacles[id as usize].interior_contains(p, tol) {
+                        cutting = Some(id);
+                        break;
+                    }
                 }
             }
             let Some(id) = cutting else {
@@ -613,7 +645,7 @@ impl Search<'_, '_> {
             applied.push(id);
             let applied = Arc::new(applied);
             let q = restrict_quadratic::<D>(&self.orientations[node.orientation].quadratic, fixed_z);
-            for (outside, extra) in children {
+            for (outside, face) in children {
                 self.stats.nodes_pushed += 1;
                 // key: a lower bound of the child's cost, the larger of the parent's cost and the cost's minimum
                 // over the child's half-space outside the obstacle face (slack: twice the cell tolerance)
@@ -623,7 +655,7 @@ impl Search<'_, '_> {
                     orientation: node.orientation,
                     id: next_id,
                     cell: Arc::clone(&node.cell),
-                    body: Body::Pending(extra, optimum.point),
+                    body: Body::Pending { obstacle: id, face, start: optimum.point },
                     applied: Arc::clone(&applied),
                 });
                 next_id += 1;
@@ -645,6 +677,7 @@ impl Search<'_, '_> {
             let id = self.obstacles.len() as u32;
             self.obstacles.push(Arc::clone(shared));
             self.obstacle_ids.insert((orientation, moving, fixed), id);
+            self.by_orientation[orientation].push(id);
             self.stats.pairs_evaluated += 1;
             self.stats.time_obstacles_ms += ms(t);
             return Ok(id);
@@ -685,13 +718,15 @@ impl Search<'_, '_> {
         let id = self.obstacles.len() as u32;
         self.obstacles.push(built);
         self.obstacle_ids.insert((orientation, moving, fixed), id);
+        self.by_orientation[orientation].push(id);
         self.stats.pairs_evaluated += 1;
         self.stats.time_obstacles_ms += ms(t);
         Ok(id)
     }
 
-    /// The extra inequalities of the children of a cell cut by obstacle `id` ([A] VI-A-3): child `k` adds
-    /// `n_k . p >= d_k` and `n_j . p <= d_j` for `j < k`. The children are built and solved lazily.
+    /// The children of a cell cut by obstacle `id` ([A] VI-A-3): child `k` adds `n_k . p >= d_k` and `n_j . p <= d_j`
+    /// for `j < k` ([`Search::child_inequalities`]); here only each child's outside half-space and face index. The
+    /// children are built and solved lazily.
     fn split<const D: usize>(
         &mut self,
         orientation: usize,
@@ -700,18 +735,10 @@ impl Search<'_, '_> {
     ) -> Result<Vec<Outside<D>>, PlacementError> {
         let tol = self.tol.linear;
         let obstacle = &self.obstacles[id as usize];
-        let mut inside: Vec<Halfspace<D>> = Vec::new();
-        let mut children = Vec::new();
+        let mut children = Vec::with_capacity(obstacle.planes.len());
         for (k, plane) in obstacle.planes.iter().enumerate() {
-            let face = k as u32;
             match restrict::<D>(plane.normal, plane.offset, fixed_z, tol) {
-                Ok((normal, offset)) => {
-                    let keep = Halfspace::new(normal, offset, Tag::ObstacleFace { obstacle: u64::from(id), face });
-                    let mut extra = inside.clone();
-                    extra.push(keep.flipped(Tag::ObstacleFace { obstacle: u64::from(id), face }));
-                    children.push(((normal, offset), extra));
-                    inside.push(Halfspace::new(normal, offset, Tag::ObstacleCut { obstacle: u64::from(id), face }));
-                }
+                Ok(outside) => children.push((outside, k as u32)),
                 // a horizontal plane at fixed z: satisfied everywhere (no outside child, no cut needed) or nowhere
                 // (the slice of the obstacle is empty: nothing to cut; cannot happen for an obstacle holding p*)
                 Err(true) => {}
@@ -726,6 +753,32 @@ impl Search<'_, '_> {
             }
         }
         Ok(children)
+    }
+
+    /// The extra inequalities of child `face` of obstacle `id`: the inside cuts `n_j . p <= d_j` of the faces before
+    /// it (restricted to the `D` variables; planes that do not depend on them are skipped, as in [`Search::split`])
+    /// and the outside `n_face . p >= d_face`. O(faces); the same values every time.
+    fn child_inequalities<const D: usize>(&self, id: u32, face: u32, fixed_z: f64) -> Vec<Halfspace<D>> {
+        let tol = self.tol.linear;
+        let planes = &self.obstacles[id as usize].planes;
+        let mut extra = Vec::with_capacity(face as usize + 1);
+        for (k, plane) in planes.iter().enumerate().take(face as usize + 1) {
+            let Ok((normal, offset)) = restrict::<D>(plane.normal, plane.offset, fixed_z, tol) else {
+                continue;
+            };
+            let tag_face = k as u32;
+            if tag_face == face {
+                let keep = Halfspace::new(normal, offset, Tag::ObstacleFace { obstacle: u64::from(id), face });
+                extra.push(keep.flipped(Tag::ObstacleFace { obstacle: u64::from(id), face }));
+            } else {
+                extra.push(Halfspace::new(
+                    normal,
+                    offset,
+                    Tag::ObstacleCut { obstacle: u64::from(id), face: tag_face },
+                ));
+            }
+        }
+        extra
     }
 
     /// Builds a pending child's cell and solves its QP (`None` when empty).
