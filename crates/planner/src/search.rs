@@ -576,10 +576,10 @@ impl Search<'_, '_> {
                     if node.applied.contains(&id) {
                         continue;
                     }
-                    if let Some(depth) = self.obstacles[id as usize].interior_depth(p, tol) {
-                        if best.is_none_or(|(d, _)| depth > d) {
-                            best = Some((depth, id));
-                        }
+                    if let Some(depth) = self.obstacles[id as usize].interior_depth(p, tol)
+                        && best.is_none_or(|(d, _)| depth > d)
+                    {
+                        best = Some((depth, id));
                     }
                 }
                 best.map(|(_, id)| id)
