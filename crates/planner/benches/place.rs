@@ -5,6 +5,8 @@
 //! every thread of the process, from `/proc/self/task/*/schedstat`, over 9 runs): on the shared 2-core machine the
 //! wall clock mostly measures the wait for a core.
 
+#![allow(clippy::print_stdout)] // a benchmark program reports its on-CPU medians beside criterion's figures
+
 use criterion::{Criterion, criterion_group, criterion_main};
 use stackplan_planner::regress::{SCENARIOS, run, scenario};
 
