@@ -1,6 +1,7 @@
 //! Times the ACSG of the block / L-corner example ([P] V) and prints the states per level, the counters and the
 //! Table I-style extremal table. `cargo run --profile dev -p stackplan-contact-states --example block_l_corner --
-//! [population generations polish seed extremal_budget]` (defaults: the crate's default GA settings, seed 2004).
+//! [population generations polish seed extremal_budget analytic_steps]` (defaults: the crate's default settings, seed
+//! 2004).
 
 #![allow(clippy::print_stdout)] // a command-line timing tool: printing is its output
 
@@ -29,7 +30,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let bounds = ConfigBox::new([-5.0, -5.0, 0.0, -d, -d, -d], [5.0, 5.0, 240.0, d, d, d])?;
     let start = Instant::now();
     let extremal_budget = args.get(4).map_or(AcsgSettings::default().extremal_budget, |&v| v as usize);
-    let g = generate(&fixed, &moving, bounds, AcsgSettings { ga, extremal_budget, ..AcsgSettings::default() });
+    let analytic_steps = args.get(5).map_or(AcsgSettings::default().analytic_steps, |&v| v as usize);
+    let g = generate(
+        &fixed,
+        &moving,
+        bounds,
+        AcsgSettings { ga, extremal_budget, analytic_steps, ..AcsgSettings::default() },
+    );
     let seconds = start.elapsed().as_secs_f64();
     let per_level = g.counts_per_level();
     println!("GA {ga:?}");

@@ -19,12 +19,13 @@
 //! Cost: one GA run per hypothesis surviving the pruning plus 12 per feasible state; hypotheses per level are at most
 //! (feasible states of lower levels) x (feasible PPCs).
 
+use crate::analytic_seeds::edge_edge_candidates;
 use crate::criteria::{ContactPart, Objective, Weights, face_point_distance_2d};
 use crate::extremal::{Extremal, extremals, range_of};
 use crate::ga::{GaSettings, minimise_with_polish, mix_seed};
 use crate::manifold::{Manifolds, Rejection, StrictTolerances, segment_segment_distance};
 use crate::pose::{Config, ConfigBox, VARIABLE_NAMES};
-use crate::principal_contact::{ContactState, PrincipalContact, all_ppcs};
+use crate::principal_contact::{ContactState, PcType, PrincipalContact, all_ppcs};
 use crate::surface::{Element, ElementKind, SurfaceElements};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -49,6 +50,13 @@ pub struct AcsgSettings {
     pub widen: f64,
     /// Highest level hypothesised.
     pub max_level: usize,
+    /// Grid values per angle of the analytic edge-edge candidates ([`crate::analytic_seeds`]; 0 disables them).
+    #[serde(default = "default_analytic_steps")]
+    pub analytic_steps: usize,
+}
+
+fn default_analytic_steps() -> usize {
+    5
 }
 
 impl Default for AcsgSettings {
@@ -61,6 +69,7 @@ impl Default for AcsgSettings {
             extremal_budget: 200,
             widen: 0.05,
             max_level: 12,
+            analytic_steps: default_analytic_steps(),
         }
     }
 }
@@ -87,6 +96,9 @@ pub struct StateRecord {
     pub rejection: Option<Rejection>,
     /// Whether a GA search ran (otherwise the hypothesis was pruned or verified from a neighbour's configuration).
     pub searched_by_ga: bool,
+    /// Whether the witness is an analytic edge-edge crossing ([`crate::analytic_seeds`]), checked before any GA run.
+    #[serde(default)]
+    pub analytic_witness: bool,
     /// Why the hypothesis was rejected without a search, if it was.
     pub pruned: Option<String>,
     /// The configuration attaining `objective`.
@@ -119,6 +131,9 @@ pub struct AcsgStats {
     pub searched: usize,
     /// Hypotheses verified from a neighbour's configuration without a GA run.
     pub from_neighbours: usize,
+    /// Single e-e hypotheses verified at an analytic crossing without a GA run.
+    #[serde(default)]
+    pub analytic: usize,
     /// Hypotheses with a candidate configuration (a projected neighbour's configuration or a GA minimum below the
     /// threshold) that failed the strict check and were not verified otherwise.
     pub rejected_candidates: usize,
@@ -288,6 +303,7 @@ impl Context<'_> {
             objective: None,
             rejection: None,
             searched_by_ga: false,
+            analytic_witness: false,
             pruned: None,
             witness: None,
             search_box: None,
@@ -370,6 +386,19 @@ impl Context<'_> {
                 Err(e) => record.rejection = Some(e),
             }
         }
+        // a single e-e contact: crossings built analytically, checked in a fixed order (deterministic; the GA minimum
+        // of such a thin state usually lies in a neighbouring f-e / e-f / f-f state)
+        if witness.is_none()
+            && self.settings.analytic_steps > 0
+            && let [pc] = state.pcs.as_slice()
+            && pc.kind() == PcType::EdgeEdge
+        {
+            let steps = self.settings.analytic_steps;
+            witness = edge_edge_candidates(sa, pc.a.index, sb, pc.b.index, &self.bounds, steps, steps + 3)
+                .into_iter()
+                .find(|t| self.manifolds.verify(state, t, &self.bounds).is_ok());
+            record.analytic_witness = witness.is_some();
+        }
         if witness.is_none() {
             let f = |t: &Config| objective.value(t);
             let smooth = |t: &Config| objective.smooth_value(t);
@@ -443,6 +472,8 @@ pub fn generate(fixed: &ContactPart, moving: &ContactPart, bounds: ConfigBox, se
         for r in records {
             if r.pruned.is_some() {
                 stats.pruned += 1;
+            } else if r.analytic_witness {
+                stats.analytic += 1;
             } else if !r.searched_by_ga {
                 stats.from_neighbours += 1;
             } else {

@@ -42,13 +42,88 @@ pub struct ConvexPiece {
     pub seed: DVec3,
     /// Axis-aligned bounding box `(min, max)`.
     pub aabb: (DVec3, DVec3),
+    /// When the piece is a parallelepiped (a box, the usual sheet-metal piece): its centre (= `seed`) and half edge
+    /// vectors, for the closed-form support `h(n) = n.c + sum |n.a_i|`.
+    pub parallelepiped: Option<Parallelepiped>,
+}
+
+/// A parallelepiped `c + sum s_i a_i`, `s_i in [-1, 1]`: centre and half edge vectors.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Parallelepiped {
+    /// Centre.
+    pub centre: DVec3,
+    /// Half edge vectors.
+    pub half_axes: [DVec3; 3],
+    /// Per face normal `n_f` (in the order of [`ConvexPiece::normals`]), the half width `sum |n_f.a_i|` (rotation
+    /// invariant: unchanged by [`ConvexPiece::transform_into`]).
+    pub face_half_widths: [f64; 6],
+}
+
+impl Parallelepiped {
+    /// Recognises a parallelepiped from its vertices and (unit) edge directions: three direction classes, and every
+    /// vertex at `c + sum +-a_i` within `1e-12` of the piece's size. O(V).
+    fn recognise(vertices: &[DVec3], normals: &[DVec3], edge_directions: &[DVec3], centre: DVec3) -> Option<Self> {
+        if vertices.len() != 8 || normals.len() != 6 || edge_directions.len() != 3 {
+            return None;
+        }
+        // half extent along each direction class: the half width of the vertices' projections
+        let mut half_axes = [DVec3::ZERO; 3];
+        let (d0, d1, d2) = (edge_directions[0], edge_directions[1], edge_directions[2]);
+        // the vertex v - c = sum s_i a_i: solve with the dual basis of the directions
+        let det = d0.dot(d1.cross(d2));
+        if det.abs() < 1e-9 {
+            return None;
+        }
+        let dual = [d1.cross(d2) / det, d2.cross(d0) / det, d0.cross(d1) / det];
+        let first = vertices[0] - centre;
+        for i in 0..3 {
+            half_axes[i] = edge_directions[i] * first.dot(dual[i]).abs();
+        }
+        let size = vertices.iter().map(|v| (*v - centre).length()).fold(0.0, f64::max);
+        let tol = 1e-12 * size.max(1e-300);
+        let mut seen = [false; 8];
+        for v in vertices {
+            let r = *v - centre;
+            let mut index = 0;
+            let mut rebuilt = DVec3::ZERO;
+            for i in 0..3 {
+                let s = r.dot(dual[i]);
+                let sign = if s >= 0.0 { 1.0 } else { -1.0 };
+                index |= usize::from(s >= 0.0) << i;
+                rebuilt += half_axes[i] * sign;
+            }
+            if (rebuilt - r).length() > tol || seen[index] {
+                return None;
+            }
+            seen[index] = true;
+        }
+        let mut out = Self { centre, half_axes, face_half_widths: [0.0; 6] };
+        for (k, n) in normals.iter().enumerate() {
+            out.face_half_widths[k] = out.half_width(*n);
+        }
+        Some(out)
+    }
+
+    #[inline]
+    fn support(&self, n: DVec3) -> f64 {
+        n.dot(self.centre)
+            + n.dot(self.half_axes[0]).abs()
+            + n.dot(self.half_axes[1]).abs()
+            + n.dot(self.half_axes[2]).abs()
+    }
+
+    /// `sum |n.a_i|`, the support about the centre.
+    #[inline]
+    fn half_width(&self, n: DVec3) -> f64 {
+        n.dot(self.half_axes[0]).abs() + n.dot(self.half_axes[1]).abs() + n.dot(self.half_axes[2]).abs()
+    }
 }
 
 impl ConvexPiece {
     /// Prepares a polytope. O(V + F + E^2) for the direction classes.
     pub fn from_polytope(poly: &ConvexPolytope) -> Self {
         let vertices = poly.vertices().to_vec();
-        let normals = poly.planes().map(|p| p.normal).collect();
+        let normals: Vec<DVec3> = poly.planes().map(|p| p.normal).collect();
         let mut edge_directions: Vec<DVec3> = Vec::new();
         for e in poly.edges() {
             let d = (vertices[e.vertices[1]] - vertices[e.vertices[0]]).normalize();
@@ -58,7 +133,8 @@ impl ConvexPiece {
         }
         let seed = poly.vertex_centroid();
         let aabb = poly.aabb();
-        Self { vertices, normals, edge_directions, seed, aabb }
+        let parallelepiped = Parallelepiped::recognise(&vertices, &normals, &edge_directions, seed);
+        Self { vertices, normals, edge_directions, seed, aabb, parallelepiped }
     }
 
     /// Writes the image of `self` under `pose` into `out` (reusing its buffers).
@@ -70,6 +146,11 @@ impl ConvexPiece {
         out.edge_directions.clear();
         out.edge_directions.extend(self.edge_directions.iter().map(|n| pose.apply_vector(*n)));
         out.seed = pose.apply(self.seed);
+        out.parallelepiped = self.parallelepiped.map(|b| Parallelepiped {
+            centre: pose.apply(b.centre),
+            half_axes: b.half_axes.map(|a| pose.apply_vector(a)),
+            face_half_widths: b.face_half_widths,
+        });
         let first = out.vertices.first().copied().unwrap_or(DVec3::ZERO);
         out.aabb = out.vertices.iter().fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
     }
@@ -83,7 +164,10 @@ impl ConvexPiece {
 
     #[inline]
     fn support(&self, n: DVec3) -> f64 {
-        self.vertices.iter().fold(f64::NEG_INFINITY, |m, v| m.max(n.dot(*v)))
+        match &self.parallelepiped {
+            Some(b) => b.support(n),
+            None => self.vertices.iter().fold(f64::NEG_INFINITY, |m, v| m.max(n.dot(*v))),
+        }
     }
 }
 
@@ -106,6 +190,12 @@ pub fn growth_distance_capped(a: &ConvexPiece, p: DVec3, b: &ConvexPiece, q: DVe
     if d == DVec3::ZERO {
         return 0.0;
     }
+    if let (Some(ba), Some(bb)) = (&a.parallelepiped, &b.parallelepiped)
+        && p == ba.centre
+        && q == bb.centre
+    {
+        return parallelepipeds_capped(a, ba, b, bb, d, cap);
+    }
     let mut best: f64 = 0.0;
     let mut consider = |n: DVec3| -> bool {
         let nd = n.dot(d);
@@ -117,13 +207,14 @@ pub fn growth_distance_capped(a: &ConvexPiece, p: DVec3, b: &ConvexPiece, q: DVe
         }
         best >= cap
     };
-    for n in &b.normals {
-        if consider(*n) {
+    // A's faces first: the fixed part's pieces are the large slabs whose faces usually separate (an early exit)
+    for n in &a.normals {
+        if consider(-*n) {
             return best;
         }
     }
-    for n in &a.normals {
-        if consider(-*n) {
+    for n in &b.normals {
+        if consider(*n) {
             return best;
         }
     }
@@ -133,6 +224,61 @@ pub fn growth_distance_capped(a: &ConvexPiece, p: DVec3, b: &ConvexPiece, q: DVe
             if n.length_squared() > 1e-24 {
                 let n = if n.dot(d) >= 0.0 { n } else { -n };
                 if consider(n) {
+                    return best;
+                }
+            }
+        }
+    }
+    best
+}
+
+/// Two parallelepipeds about their centres: `h_B(n) + h_A(-n) + n.d = sum |n.a_i| + sum |n.b_j|` (the centre terms
+/// cancel exactly), so `sigma = max_n n.d / (sum |n.a_i| + sum |n.b_j|)` over the same candidate directions, the
+/// separating-axis formula. A face normal's own half width is precomputed (rotation invariant), and a cross product
+/// `a_i x b_j` is orthogonal to both its axes, so a candidate costs 4 or 5 dot products and no division unless it
+/// improves the maximum.
+fn parallelepipeds_capped(
+    a: &ConvexPiece,
+    ba: &Parallelepiped,
+    b: &ConvexPiece,
+    bb: &Parallelepiped,
+    d: DVec3,
+    cap: f64,
+) -> f64 {
+    let mut best: f64 = 0.0;
+    // n.d / h > best, without dividing unless it holds (h > 0 whenever n.d > 0 for non-degenerate pieces)
+    let mut consider = |nd: f64, h: f64| -> bool {
+        if nd > 0.0 && h > 0.0 && nd > best * h {
+            best = nd / h;
+        }
+        best >= cap
+    };
+    let [a0, a1, a2] = ba.half_axes;
+    let [b0, b1, b2] = bb.half_axes;
+    // A's faces first: the fixed part's pieces are the large slabs whose faces usually separate (an early exit)
+    for (n, w) in a.normals.iter().zip(ba.face_half_widths) {
+        let nd = -n.dot(d);
+        if nd > 0.0 && consider(nd, w + n.dot(b0).abs() + n.dot(b1).abs() + n.dot(b2).abs()) {
+            return best;
+        }
+    }
+    for (n, w) in b.normals.iter().zip(bb.face_half_widths) {
+        let nd = n.dot(d);
+        if nd > 0.0 && consider(nd, w + n.dot(a0).abs() + n.dot(a1).abs() + n.dot(a2).abs()) {
+            return best;
+        }
+    }
+    let (aa, bx) = (&ba.half_axes, &bb.half_axes);
+    for (i, ea) in a.edge_directions.iter().enumerate() {
+        for (j, eb) in b.edge_directions.iter().enumerate() {
+            let n = ea.cross(*eb);
+            if n.length_squared() > 1e-24 {
+                // n is orthogonal to a_i and b_j
+                let h = n.dot(aa[(i + 1) % 3]).abs()
+                    + n.dot(aa[(i + 2) % 3]).abs()
+                    + n.dot(bx[(j + 1) % 3]).abs()
+                    + n.dot(bx[(j + 2) % 3]).abs();
+                if consider(n.dot(d).abs(), h) {
                     return best;
                 }
             }

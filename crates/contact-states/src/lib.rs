@@ -13,11 +13,13 @@
 //! * [`ga`]: the seeded real-coded GA with a local polish; [`extremal`]: extremal configurations ([P] eq. 11-12);
 //! * [`manifold`]: projection onto a state's contact manifold, the strict check of a state at a configuration,
 //!   extremals by a compass search on the manifold;
+//! * [`analytic_seeds`]: deterministic edge-edge crossing configurations that seed the thin e-e states;
 //! * [`acsg`]: the bottom-up ACSG with CLCN/CMCN relations and search-range refinement, JSON and DOT output.
 //!
 //! Part A is the fixed part, part B the moving one; PC labels name A's element first (`f2-v3`).
 
 pub mod acsg;
+pub mod analytic_seeds;
 pub mod criteria;
 pub mod dxf_input;
 pub mod extremal;

@@ -501,7 +501,7 @@ impl<'a> Manifolds<'a> {
             self.closure_residuals(state, t, out);
             let pose = Pose::from_config(t);
             for pc in near {
-                out.push((margin - self.ppc_distance(pc, &pose)).max(0.0));
+                out.push((margin - self.ppc_distance_within(pc, &pose, margin)).max(0.0));
             }
         };
         self.least_squares(residuals, t0, bounds, &[false; 6], 1e-11 * self.weights.length, 40, None).0
@@ -569,22 +569,43 @@ impl<'a> Manifolds<'a> {
 
     /// Euclidean distance between the elements of a PPC at `pose` (mm).
     pub fn ppc_distance(&self, pc: &PrincipalContact, pose: &Pose) -> f64 {
+        self.ppc_distance_within(pc, pose, f64::INFINITY)
+    }
+
+    /// [`Self::ppc_distance`] when it is at most `limit`; otherwise some number above `limit` (a cheap lower
+    /// bound: the height over the face plane, or the distance of the segments' bounding spheres), so comparisons
+    /// with `limit` or smaller thresholds come out as with the exact distance.
+    pub fn ppc_distance_within(&self, pc: &PrincipalContact, pose: &Pose, limit: f64) -> f64 {
         let (sa, sb) = (&self.fixed.surface, &self.moving.surface);
         match pc.kind() {
             PcType::FaceVertex => {
                 let face = &sa.faces[pc.a.index];
                 let p = pose.apply(sb.vertices[pc.b.index].position);
-                face.frame.height(p).hypot(face_point_distance_2d(face, face.frame.to_2d(p)))
+                let h = face.frame.height(p);
+                if h.abs() > limit {
+                    return h.abs();
+                }
+                h.hypot(face_point_distance_2d(face, face.frame.to_2d(p)))
             }
             PcType::VertexFace => {
                 let face = &sb.faces[pc.b.index];
                 let p = pose.inverse_apply(sa.vertices[pc.a.index].position);
-                face.frame.height(p).hypot(face_point_distance_2d(face, face.frame.to_2d(p)))
+                let h = face.frame.height(p);
+                if h.abs() > limit {
+                    return h.abs();
+                }
+                h.hypot(face_point_distance_2d(face, face.frame.to_2d(p)))
             }
             PcType::EdgeEdge => {
                 let (a0, a1) = sa.edge_points(pc.a.index);
                 let (b0, b1) = sb.edge_points(pc.b.index);
-                segment_segment_distance(a0, a1, pose.apply(b0), pose.apply(b1))
+                let (b0, b1) = (pose.apply(b0), pose.apply(b1));
+                // every point of a segment is within half its length of its midpoint
+                let spheres = ((a0 + a1) - (b0 + b1)).length() * 0.5 - 0.5 * ((a1 - a0).length() + (b1 - b0).length());
+                if spheres > limit {
+                    return spheres;
+                }
+                segment_segment_distance(a0, a1, b0, b1)
             }
             // not PPCs: the full criterion (zero iff in contact)
             _ => pc_criterion(pc, self.fixed, self.moving, pose, &self.weights),
@@ -598,7 +619,7 @@ impl<'a> Manifolds<'a> {
         let mut holding = Vec::new();
         let mut ambiguous: Option<(PrincipalContact, f64)> = None;
         for pc in &self.ppcs {
-            let d = self.ppc_distance(pc, &pose);
+            let d = self.ppc_distance_within(pc, &pose, clear);
             if d <= hold {
                 holding.push(*pc);
             } else if d <= clear && ambiguous.is_none_or(|(_, best)| d < best) {
@@ -688,6 +709,19 @@ impl<'a> Manifolds<'a> {
         let (sa, sb) = (&self.fixed.surface, &self.moving.surface);
         for p in projected.iter().take(2) {
             let start_pose = Pose::from_config(p);
+            let near_limit = 0.02 * self.weights.length;
+            // the PPCs not implied by the state, with their distances at the start (computed once per start)
+            let others: Vec<(PrincipalContact, f64)> = self
+                .ppcs
+                .iter()
+                .copied()
+                .filter(|q| {
+                    let mut pcs = state.pcs.clone();
+                    pcs.push(*q);
+                    &ContactState::canonical(pcs, sa, sb) != state
+                })
+                .map(|q| (q, self.ppc_distance_within(&q, &start_pose, near_limit)))
+                .collect();
             for i in 0..attempts {
                 let mut trial = *p;
                 if i > 0 {
@@ -699,18 +733,12 @@ impl<'a> Manifolds<'a> {
                 }
                 // PPCs that may come into contact near the trial point and are not part of the state
                 let pose = Pose::from_config(&trial);
-                let near: Vec<PrincipalContact> = self
-                    .ppcs
+                let near: Vec<PrincipalContact> = others
                     .iter()
-                    .copied()
-                    .filter(|q| {
-                        self.ppc_distance(q, &pose).min(self.ppc_distance(q, &start_pose)) <= 0.02 * self.weights.length
+                    .filter(|(q, at_start)| {
+                        *at_start <= near_limit || self.ppc_distance_within(q, &pose, near_limit) <= near_limit
                     })
-                    .filter(|q| {
-                        let mut pcs = state.pcs.clone();
-                        pcs.push(*q);
-                        &ContactState::canonical(pcs, sa, sb) != state
-                    })
+                    .map(|(q, _)| *q)
                     .collect();
                 let q = self.project_clear(state, &near, &trial, bounds);
                 // the hinge terms can leave a small equality residual: finish with the plain projection
