@@ -148,6 +148,28 @@ fn shortcuts_match_the_plain_socps_on_fixture_columns() {
     }
 }
 
+/// The planner's 15-part Channel stack (flipped channels straddling a flange of the one below: flat supports at two
+/// heights, where the minimum-norm forces need friction).
+#[test]
+fn shortcuts_match_the_plain_socps_on_the_planned_channel_stack() {
+    let plan = stackplan_geom::io::stack::read_stack(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/benches/stacks/channel-plan-15.json"
+    ))
+    .expect("plan");
+    let stack: Vec<PlacedPart<'_>> = plan
+        .placements
+        .iter()
+        .map(|p| PlacedPart { part: &plan.part, rotation: p.rotation, position: p.position })
+        .collect();
+    for mu in [0.2, 0.5, 1.0] {
+        let options = CheckOptions { mu, ..options() };
+        let fast = check_stack(&stack, &options).expect("check");
+        let plain = check_stack_reference(&stack, &options).expect("check");
+        assert_checks_equivalent(&fast, &plain, plan.part.mass.mass, &format!("planned channels, mu {mu}"));
+    }
+}
+
 fn build(layers: &[Layer], columns: usize) -> Vec<(usize, DVec3, DVec3)> {
     let mut out = Vec::new();
     let mut z = 0.0;

@@ -18,9 +18,12 @@
 //! Graphs with a cycle (a brick on two bricks on the floor) are not split.
 //!
 //! **Flat support** ([`flat_minimum_norm`]): when every point of an edge pushes the subtree straight up (normal +z,
-//! within 1e-12), the equations decouple: friction appears only in the horizontal force and torsion rows, whose
-//! right-hand sides are 0 without load, so the minimum-norm friction is 0; the normal forces `n_k` must satisfy the
-//! three rows `sum n_k = W`, `sum n_k (x_k - c_x) = 0`, `sum n_k (y_k - c_y) = 0`. Their least-squares minimum-norm
+//! within 1e-12) from one horizontal plane `z = h` (within the tolerance), the equations decouple: friction `t_k`
+//! enters the horizontal force rows, the torsion row and the moment rows about the horizontal axes, but in the latter
+//! only as `(h - c_z) z x sum t_k`, a multiple of the horizontal force rows; subtracting it leaves moment rows in the
+//! normal forces alone, and the friction rows have right-hand side 0 without load, so the minimum-norm friction is 0
+//! (with points at several heights this fails: friction then helps the moments and the minimum norm uses it). The
+//! normal forces `n_k` must satisfy the three rows `sum n_k = W`, `sum n_k (x_k - c_x) = 0`, `sum n_k (y_k - c_y) = 0`. Their least-squares minimum-norm
 //! solution `n = A^T (A A^T)^-1 b` is the SOCP's optimum whenever it is nonnegative (an unconstrained minimiser that
 //! satisfies the cone constraints is the constrained one), so it is taken then; otherwise (or when `A A^T` is
 //! singular: collinear points) the edge is solved as an SOCP. Cost: O(K) per flat edge.
@@ -117,6 +120,11 @@ pub(super) fn edge_point(pt: &Point, holds_b: bool) -> Point {
 /// documentation); `None` otherwise (not flat, collinear points, or a negative normal force).
 pub(super) fn flat_minimum_norm(union: &Rigid, points: &[Point]) -> Option<Vec<DVec3>> {
     if points.is_empty() || !points.iter().all(|p| p.b == 0 && p.a.is_none() && p.frame[0].z >= 1.0 - 1e-12) {
+        return None;
+    }
+    // one plane: with points at several heights, friction enters the moment rows and the minimum norm needs it
+    let (lo, hi) = points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.p.z), hi.max(p.p.z)));
+    if hi - lo > union.tolerance() {
         return None;
     }
     let scale = (union.aabb.1 - union.aabb.0).length().max(1.0);
