@@ -7,10 +7,11 @@
 //! per angle, the bounds included) and each point `b(u)` of B's edge (`edge_steps` interior parameters
 //! `u = (i + 1/2) / edge_steps`), the translation that puts `b(u)` on A's edge at parameter `s`,
 //! `x(s) = a0 + s (a1 - a0) - R b(u)`, is a line in translation space; its part inside the box's translation
-//! ranges (intersected with `0 < s < 1`) is an interval of `s`, whose midpoint gives the candidate. The edges
+//! ranges (intersected with `0 < s < 1`) is an interval of `s`, whose midpoint and ends (just inside, for states
+//! that exist only against a bound of the box) give the candidates. The edges
 //! then meet exactly (the e-e equality holds), and the strict check decides whether nothing else touches or
 //! penetrates. Pairs of nearly parallel edges (`|da x R db| <= 1e-6 |da| |db|`) make no crossing and are skipped.
-//! Cost: `angle_steps^3 x edge_steps` candidates, each O(1) to build; the caller checks them in order.
+//! Cost: `3 angle_steps^3 edge_steps` candidates, each O(1) to build; the caller checks them in order.
 
 use crate::pose::{Config, ConfigBox, Pose};
 use crate::surface::SurfaceElements;
@@ -70,12 +71,16 @@ pub fn edge_edge_candidates(
                     if hi <= lo || hi <= 0.0 || lo >= 1.0 {
                         continue;
                     }
-                    let s = 0.5 * (lo + hi);
-                    let x = c + da * s;
-                    let mut t = [x.x, x.y, x.z, rx, ry, rz];
-                    // rounding can leave the translation a hair outside a bound it lies on
-                    bounds.clamp(&mut t);
-                    out.push(t);
+                    // the middle of the interval, and its ends (just inside): states that exist only against a
+                    // bound of the box (a thin region at x = x_max, say) are met at the ends
+                    let margin = 1e-6 * (hi - lo);
+                    for s in [0.5 * (lo + hi), lo.max(0.0) + margin, hi.min(1.0) - margin] {
+                        let x = c + da * s;
+                        let mut t = [x.x, x.y, x.z, rx, ry, rz];
+                        // rounding can leave the translation a hair outside a bound it lies on
+                        bounds.clamp(&mut t);
+                        out.push(t);
+                    }
                 }
             }
         }

@@ -797,6 +797,10 @@ impl<'a> Manifolds<'a> {
                     if used >= budget {
                         break;
                     }
+                    // t_k itself frozen at a worse value can never improve: only its improving direction is tried
+                    if j == k && dir == sign {
+                        continue;
+                    }
                     let mut trial = best;
                     trial[j] = (trial[j] + dir * step[j] * bounds.width(j)).clamp(bounds.min[j], bounds.max[j]);
                     if trial[j] == best[j] {

@@ -172,7 +172,49 @@ fn pose() -> impl Strategy<Value = Pose> {
         .prop_map(|(x, y, z, a, b, c)| Pose::from_config(&[x, y, z, a, b, c]))
 }
 
+/// A cube sheared and scaled by a random integer matrix (a general parallelepiped; integer coordinates keep its
+/// faces exactly planar, so the hull has 6 faces), kept away from flat ones.
+fn sheared_box() -> impl Strategy<Value = ConvexPolytope> {
+    prop::array::uniform9(-3i32..=3).prop_filter_map("flat", |m| {
+        let m = m.map(f64::from);
+        let cols = [DVec3::new(m[0], m[1], m[2]), DVec3::new(m[3], m[4], m[5]), DVec3::new(m[6], m[7], m[8])];
+        if cols[0].dot(cols[1].cross(cols[2])).abs() < 1.0 {
+            return None;
+        }
+        let pts: Vec<DVec3> = (0..8)
+            .map(|i| {
+                let s = |bit: usize| if i & bit == 0 { -1.0 } else { 1.0 };
+                cols[0] * s(1) + cols[1] * s(2) + cols[2] * s(4) + DVec3::new(0.5, -0.25, 1.0)
+            })
+            .collect();
+        convex_hull(&pts).ok().map(|h| h.polytope)
+    })
+}
+
 proptest! {
+    /// The closed-form path for two parallelepipeds (`sum |n.a_i| + sum |n.b_j|`) against the vertex enumeration of
+    /// the same pieces with the parallelepiped form removed, capped and uncapped.
+    #[test]
+    fn parallelepiped_path_matches_vertex_enumeration(
+        a in sheared_box(), b in sheared_box(), pa in pose(), pb in pose(), cap in 0.5f64..2.0,
+    ) {
+        let ga = ConvexPiece::from_polytope(&a).transformed(&pa);
+        let gb = ConvexPiece::from_polytope(&b).transformed(&pb);
+        prop_assert!(ga.parallelepiped.is_some() && gb.parallelepiped.is_some());
+        let general = |p: &ConvexPiece| ConvexPiece { parallelepiped: None, ..p.clone() };
+        let (va, vb) = (general(&ga), general(&gb));
+        let fast = growth_distance(&ga, &gb);
+        let slow = growth_distance(&va, &vb);
+        prop_assert!((fast - slow).abs() <= 1e-9 * (1.0 + slow), "fast {} enumeration {}", fast, slow);
+        let fast = growth_distance_capped(&ga, ga.seed, &gb, gb.seed, cap);
+        let slow = growth_distance_capped(&va, va.seed, &vb, vb.seed, cap);
+        if slow < cap - 1e-9 {
+            prop_assert!((fast - slow).abs() <= 1e-9 * (1.0 + slow), "capped: fast {} enumeration {}", fast, slow);
+        } else {
+            prop_assert!(fast >= cap - 1e-9, "capped: fast {} enumeration {} cap {}", fast, slow, cap);
+        }
+    }
+
     #[test]
     fn matches_clarabel(a in random_polytope(), b in random_polytope(), pa in pose(), pb in pose()) {
         let ga = ConvexPiece::from_polytope(&a).transformed(&pa);
