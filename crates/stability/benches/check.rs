@@ -2,7 +2,7 @@
 //!
 //! * bricks staggered in a pyramid (one connected group: the worst case for the group decomposition);
 //! * 15 Channel parts as planned by `stackplan plan example:channel` (w = 0.5; `stacks/channel-plan-15.json`);
-//! * 15 Channel, Triangle and Complex parts in 5 columns of 3 (lowest resting pose, each part lowered straight onto
+//! * 15 copies of each fixture part (Channel, Triangle, Complex, Cube, L-corner, Block) in 5 columns of 3 (lowest resting pose, each part lowered straight onto
 //!   the one below until they touch: Channel 51 mm apart, Triangle nested 4.47 mm apart, Complex 151 mm apart). The
 //!   planner gives no 15-part plan of the Triangle or Complex part yet, so these columns stand in for plans;
 //!
@@ -92,6 +92,9 @@ fn bench_fixtures(c: &mut Criterion) {
     let channel = part_by_name("channel", Decomposition::ConvexMerge).expect("channel");
     let triangle = part_by_name("triangle", Decomposition::ConvexMerge).expect("triangle");
     let complex = part_by_name("complex", Decomposition::ConvexMerge).expect("complex");
+    let cube = part_by_name("cube", Decomposition::ConvexMerge).expect("cube");
+    let l_corner = part_by_name("l-corner", Decomposition::ConvexMerge).expect("l-corner");
+    let block = part_by_name("block", Decomposition::ConvexMerge).expect("block");
     let plan = read_stack(concat!(env!("CARGO_MANIFEST_DIR"), "/benches/stacks/channel-plan-15.json")).expect("plan");
     let planned: Vec<PlacedPart<'_>> = plan
         .placements
@@ -103,6 +106,9 @@ fn bench_fixtures(c: &mut Criterion) {
         ("check_stack 15 Channel (5 columns of 3)", columns(&channel)),
         ("check_stack 15 Triangle (5 nested columns of 3)", columns(&triangle)),
         ("check_stack 15 Complex (5 columns of 3)", columns(&complex)),
+        ("check_stack 15 Cube (5 columns of 3)", columns(&cube)),
+        ("check_stack 15 L-corner (5 columns of 3)", columns(&l_corner)),
+        ("check_stack 15 Block (5 columns of 3)", columns(&block)),
     ];
     for (name, stack) in &cases {
         assert_eq!(stack.len(), 15);

@@ -26,12 +26,12 @@
 //! 4. **Triangle certificate.** The set `L` of horizontal loads `u = alpha d` a problem resists is convex and contains
 //!    0. The stack's margin is the smallest value over all problems and directions, so a problem only matters where it
 //!    is below `m`, the smallest closed-form value (or [`MARGIN_CAP`] when there is none). When the three largest
-//!    loads along 0, 120 and 240 degrees (solved up to twice the cap) span a triangle whose inscribed distance from
+//!    loads along 0, 120 and 240 degrees (solved up to a little more than twice the cap) span a triangle whose inscribed distance from
 //!    the origin is at least `m`, the disc of radius `m` lies in `L`: the problem resists `m` in every direction and
 //!    needs no further solve (its value is `MARGIN_CAP` when `m` is the cap). Typical for nested parts, which are
 //!    locked. Otherwise the other directions are solved one by one (the 0-degree solve is reused).
 //!
-//! The SOCPs of this module bound `alpha` by twice [`MARGIN_CAP`] and clamp the answer to the cap afterwards (the
+//! The SOCPs of this module bound `alpha` by a little more than twice [`MARGIN_CAP`] and clamp the answer to the cap afterwards (the
 //! feasible `alpha` form an interval, so clamping the larger problem's optimum gives the capped optimum). One solver
 //! per problem is reused through `update_A` across its directions, as in the reference. Cost: per group a union-find
 //! and a tree walk, O(K log K) for the point reduction; the SOCPs only for edges that are not flat, three of them for a
@@ -46,8 +46,9 @@ use clarabel::solver::{IPSolver, SolverStatus};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-/// Bound of `alpha` in the margin SOCPs of this module (the triangle certificate needs loads beyond the cap).
-const SOCP_CAP: f64 = 2.0 * MARGIN_CAP;
+/// Bound of `alpha` in the margin SOCPs of this module: the triangle certificate needs loads of twice the cap, and a
+/// little more so that a solver's answer at the bound (accurate to about 1e-8) still certifies the cap.
+const SOCP_CAP: f64 = 2.0 * MARGIN_CAP * (1.0 + 1e-6);
 
 /// Relative slack of the triangle certificate (the solver's answers are accurate to about 1e-8).
 const CERTIFICATE_SLACK: f64 = 1e-9;
@@ -88,15 +89,8 @@ pub(super) fn fast_margins(
         }
     }
     let m = closed.iter().flatten().fold(MARGIN_CAP, |a, &b| a.min(b));
-    let solved: Vec<Vec<Option<f64>>> = socp
-        .par_iter()
-        .map(|unit| match unit.bodies.as_slice() {
-            [body] => cache.margin(cache::key(&[mu, directions as f64, m], body, &unit.points), || {
-                unit_margins(unit, directions, mu, m)
-            }),
-            _ => unit_margins(unit, directions, mu, m),
-        })
-        .collect::<Result<_, _>>()?;
+    let solved: Vec<Vec<Option<f64>>> =
+        socp.par_iter().map(|unit| unit_margins(unit, directions, mu, m, cache)).collect::<Result<_, _>>()?;
     let mut smallest = f64::INFINITY;
     let mut weakest = None;
     for j in 0..directions {
@@ -119,52 +113,76 @@ pub(super) fn fast_margins(
 }
 
 /// The capped largest load factor of one SOCP unit per direction (`None`: the solve did not end `Solved`; infinity:
-/// at least `m`, by the triangle certificate, with `m` below the cap).
-fn unit_margins(unit: &Unit, directions: usize, mu: f64, m: f64) -> Result<Vec<Option<f64>>, EquilibriumError> {
+/// at least `m`, by the triangle certificate, with `m` below the cap). Three memoised stages, each a fresh solver
+/// reused across its directions: the 0-degree load, the 120- and 240-degree loads (only when the certificate can
+/// succeed), the other directions; each stage's answers depend only on the problem, not on `m`, so the stages are
+/// shared between checks of the same rigid body with different bounds `m`.
+fn unit_margins(
+    unit: &Unit,
+    directions: usize,
+    mu: f64,
+    m: f64,
+    cache: &SolveCache,
+) -> Result<Vec<Option<f64>>, EquilibriumError> {
+    let problem = std::cell::OnceCell::new();
+    let sequence = |stage: f64, angles: Vec<f64>| -> Result<Vec<Option<f64>>, EquilibriumError> {
+        let run = || {
+            let problem = problem.get_or_init(|| {
+                let refs: Vec<&Point> = unit.points.iter().collect();
+                Problem::new(&unit.bodies, &unit.movers, &refs, mu)
+            });
+            solve_sequence(problem, &angles)
+        };
+        match unit.bodies.as_slice() {
+            [body] => cache.margin(cache::key(&[mu, stage, directions as f64], body, &unit.points), run),
+            _ => run(),
+        }
+    };
+    let first = sequence(0.0, vec![0.0])?[0];
+    let third = std::f64::consts::TAU / 3.0;
+    if directions > 3
+        && let Some(a0) = first
+        && a0 >= 2.0 * m * (1.0 - CERTIFICATE_SLACK)
+        && let [Some(a1), Some(a2)] = sequence(1.0, vec![third, 2.0 * third])?[..]
+    {
+        let corners = [DVec2::new(a0, 0.0), DVec2::from_angle(third) * a1, DVec2::from_angle(2.0 * third) * a2];
+        let inscribed = (0..3)
+            .map(|k| {
+                let (p, q) = (corners[k], corners[(k + 1) % 3]);
+                p.perp_dot(q).abs() / (q - p).length()
+            })
+            .fold(f64::INFINITY, f64::min);
+        if inscribed >= m * (1.0 - CERTIFICATE_SLACK) {
+            let value = if m >= MARGIN_CAP { MARGIN_CAP } else { f64::INFINITY };
+            return Ok(vec![Some(value); directions]);
+        }
+    }
+    let angles = (1..directions).map(|j| std::f64::consts::TAU * j as f64 / directions as f64).collect();
+    let rest = if directions > 1 { sequence(2.0, angles)? } else { Vec::new() };
+    let out: Vec<Option<f64>> = std::iter::once(first).chain(rest).map(|a| a.map(|a| a.min(MARGIN_CAP))).collect();
+    if out.iter().any(Option::is_none) {
+        tracing::debug!("a margin solve did not end Solved");
+    }
+    Ok(out)
+}
+
+/// The largest load factors (bounded by [`SOCP_CAP`]) for horizontal loads at `angles`, one solver created for the
+/// first and reused through `update_A` for the others; `None` where the solve does not end `Solved`.
+fn solve_sequence(problem: &Problem, angles: &[f64]) -> Result<Vec<Option<f64>>, EquilibriumError> {
     let direction = |angle: f64| DVec3::new(angle.cos(), angle.sin(), 0.0);
-    let refs: Vec<&Point> = unit.points.iter().collect();
-    let problem = Problem::new(&unit.bodies, &unit.movers, &refs, mu);
-    let mut solver = problem.solver(Some(direction(0.0)), SOCP_CAP)?;
-    let mut solve = |d: DVec3, first: bool| -> Result<Option<f64>, EquilibriumError> {
-        if !first {
-            let (a, _) = problem.constraints(Some(d), SOCP_CAP);
+    let Some(&first) = angles.first() else { return Ok(Vec::new()) };
+    let mut solver = problem.solver(Some(direction(first)), SOCP_CAP)?;
+    let mut out = Vec::with_capacity(angles.len());
+    for (k, &angle) in angles.iter().enumerate() {
+        if k > 0 {
+            let (a, _) = problem.constraints(Some(direction(angle)), SOCP_CAP);
             if solver.update_A(&a).is_err() {
-                solver = problem.solver(Some(d), SOCP_CAP)?;
+                solver = problem.solver(Some(direction(angle)), SOCP_CAP)?;
             }
         }
         solver.solve();
         let x = &solver.solution.x;
-        Ok((solver.solution.status == SolverStatus::Solved).then(|| x[x.len() - 1].clamp(0.0, SOCP_CAP)))
-    };
-    let first = solve(direction(0.0), true)?;
-    if directions > 3
-        && let Some(a0) = first
-        && a0 >= 2.0 * m * (1.0 - CERTIFICATE_SLACK)
-    {
-        let third = std::f64::consts::TAU / 3.0;
-        if let (Some(a1), Some(a2)) = (solve(direction(third), false)?, solve(direction(2.0 * third), false)?) {
-            let corners = [DVec2::new(a0, 0.0), DVec2::from_angle(third) * a1, DVec2::from_angle(2.0 * third) * a2];
-            let inscribed = (0..3)
-                .map(|k| {
-                    let (p, q) = (corners[k], corners[(k + 1) % 3]);
-                    p.perp_dot(q).abs() / (q - p).length()
-                })
-                .fold(f64::INFINITY, f64::min);
-            if inscribed >= m * (1.0 - CERTIFICATE_SLACK) {
-                let value = if m >= MARGIN_CAP { MARGIN_CAP } else { f64::INFINITY };
-                return Ok(vec![Some(value); directions]);
-            }
-        }
-    }
-    let mut out = Vec::with_capacity(directions);
-    out.push(first.map(|a| a.min(MARGIN_CAP)));
-    for j in 1..directions {
-        let d = direction(std::f64::consts::TAU * j as f64 / directions as f64);
-        let value = solve(d, false)?;
-        if value.is_none() {
-            tracing::debug!(direction = j, "margin solve did not end Solved");
-        }
-        out.push(value.map(|a| a.min(MARGIN_CAP)));
+        out.push((solver.solution.status == SolverStatus::Solved).then(|| x[x.len() - 1].clamp(0.0, SOCP_CAP)));
     }
     Ok(out)
 }
