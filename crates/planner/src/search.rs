@@ -7,7 +7,8 @@
 //! 1. pop the cheapest node (ties: lower orientation index, then lower cell id — deterministic);
 //! 2. if an obstacle of `theta_k` built earlier holds `p*` in its interior by more than the tolerance (not one
 //!    applied on the node's path), take the deepest such (any obstacle holding `p*` gives a valid split; this one
-//!    needs no detection, which halves the detections of the Triangle scenario); otherwise detect the interfering
+//!    needs no detection, which halves the detections of the Triangle scenario; in a plan the obstacles earlier
+//!    searches built at `theta_k` are known from the orientation's first expansion); otherwise detect the interfering
 //!    component pairs at `(theta_k, p*)` ([`crate::detect`]);
 //! 3. take the first of them (deepest violation first) whose obstacle ([`crate::obstacles`]) contains `p*` in its
 //!    interior by more than the tolerance, and split `K` into the children
@@ -563,6 +564,18 @@ impl Search<'_, '_> {
                 o.build_components(self.request.part);
                 if self.request.insertion {
                     self.sweeps[node.orientation] = Some(SweepAxes::new(self.request.part, o.rotation, o));
+                }
+                // the obstacles earlier searches of the plan built at this orientation are known at once (their
+                // stack parts have not moved), in a fixed order
+                let mut shared: Vec<(usize, usize)> = self
+                    .derived
+                    .keys()
+                    .filter(|(oi, _, _)| *oi == node.orientation)
+                    .map(|&(_, moving, fixed)| (moving, fixed))
+                    .collect();
+                shared.sort_unstable();
+                for (moving, fixed) in shared {
+                    self.obstacle_id(node.orientation, moving, fixed)?;
                 }
                 self.stats.time_setup_ms += ms(t_setup);
             }
