@@ -549,17 +549,22 @@ mod tests {
         assert!(column.stack_stable);
         // every plan is interference-free and passes the whole-stack check
         for plan in [&flat, &column] {
-            let world: Vec<PlacedPart<'_>> = plan
-                .parts
-                .iter()
-                .map(|p| {
-                    let pose = Pose::from_rows(p.rotation, DVec3::from_array(p.position)).expect("a proper rotation");
-                    PlacedPart { part: &part, rotation: pose.rotation, position: pose.position }
-                })
-                .collect();
-            let report = check_stack(&world, &CheckOptions::default()).expect("check");
-            assert!(report.parts.iter().all(|c| c.interference <= 1e-6 && c.stable.is_stable()));
+            assert_rests_without_interference(&part, plan);
         }
+    }
+
+    /// Every part of `plan` is interference-free and stable on its supports (the whole-stack check at rest).
+    fn assert_rests_without_interference(part: &Part, plan: &Plan) {
+        let world: Vec<PlacedPart<'_>> = plan
+            .parts
+            .iter()
+            .map(|p| {
+                let pose = Pose::from_rows(p.rotation, DVec3::from_array(p.position)).expect("a proper rotation");
+                PlacedPart { part, rotation: pose.rotation, position: pose.position }
+            })
+            .collect();
+        let report = check_stack(&world, &CheckOptions::default()).expect("check");
+        assert!(report.parts.iter().all(|c| c.interference <= 1e-6 && c.stable.is_stable()), "{report:?}");
     }
 
     /// The L-corner part at w = 0.9 with one candidate per search: the fourth part's cheapest interference-free
@@ -606,16 +611,7 @@ mod tests {
             assert!(p.contacts.iter().all(|c| matches!(c, Contact::Stack { .. })), "{:?}", p.contacts);
         }
         // at rest every part touches and nothing penetrates
-        let world: Vec<PlacedPart<'_>> = plan
-            .parts
-            .iter()
-            .map(|p| {
-                let pose = Pose::from_rows(p.rotation, DVec3::from_array(p.position)).expect("a proper rotation");
-                PlacedPart { part: &part, rotation: pose.rotation, position: pose.position }
-            })
-            .collect();
-        let report = check_stack(&world, &CheckOptions::default()).expect("check");
-        assert!(report.parts.iter().all(|c| c.interference <= 1e-6 && c.stable.is_stable()), "{report:?}");
+        assert_rests_without_interference(&part, &plan);
         assert!(plan.stack_stable);
     }
 
