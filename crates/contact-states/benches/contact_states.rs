@@ -3,7 +3,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use stackplan_contact_states::acsg::{AcsgSettings, generate};
-use stackplan_contact_states::criteria::{ContactPart, Objective, Weights};
+use stackplan_contact_states::criteria::{ContactPart, Objective, Weights, penetration};
 use stackplan_contact_states::ga::{GaSettings, minimise};
 use stackplan_contact_states::growth_distance::{ConvexPiece, growth_distance};
 use stackplan_contact_states::manifold::{Manifolds, StrictTolerances};
@@ -33,6 +33,16 @@ fn bench(c: &mut Criterion) {
     let a = fixed.pieces[0].clone();
     let b: ConvexPiece = moving.pieces[0].transformed(&Pose::from_config(&[3.0, 4.0, 10.0, 0.1, -0.05, 0.12]));
     c.bench_function("growth_distance_box_pair", |bench| bench.iter(|| growth_distance(black_box(&a), black_box(&b))));
+    // the same pair through the general vertex enumeration (the parallelepiped form removed): the previous solver
+    let (ga, gb) =
+        (ConvexPiece { parallelepiped: None, ..a.clone() }, ConvexPiece { parallelepiped: None, ..b.clone() });
+    c.bench_function("growth_distance_box_pair_vertex_enumeration", |bench| {
+        bench.iter(|| growth_distance(black_box(&ga), black_box(&gb)))
+    });
+    let pose = Pose::from_config(&[3.0, 4.0, 10.0, 0.1, -0.05, 0.12]);
+    c.bench_function("penetration_block_l_corner", |bench| {
+        bench.iter(|| penetration(black_box(&fixed), black_box(&moving), black_box(&pose)))
+    });
 
     let floor = fixed
         .surface

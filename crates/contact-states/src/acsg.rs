@@ -375,12 +375,13 @@ impl Context<'_> {
         if !seeds.is_empty() {
             // the witnesses first, then the extremals; a dozen starts are plenty
             seeds.truncate(12);
-            match self.manifolds.interior_witness(
+            match self.manifolds.interior_witness_with(
                 state,
                 &seeds,
                 &self.bounds,
                 hypothesis_seed,
                 self.settings.witness_attempts,
+                false,
             ) {
                 Ok(w) => witness = Some(w),
                 Err(e) => record.rejection = Some(e),

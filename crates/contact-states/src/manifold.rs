@@ -667,6 +667,21 @@ impl<'a> Manifolds<'a> {
         seed: u64,
         attempts: usize,
     ) -> Result<Config, Rejection> {
+        self.interior_witness_with(state, starts, bounds, seed, attempts, true)
+    }
+
+    /// [`Self::interior_witness`]; with `perturb_when_apart` false the perturbations are skipped when the first
+    /// projected start is rejected as `NotInContact` or `Penetrating` (for neighbours' configurations, which a GA
+    /// run follows: such starts rarely lead to a witness).
+    pub fn interior_witness_with(
+        &self,
+        state: &ContactState,
+        starts: &[Config],
+        bounds: &ConfigBox,
+        seed: u64,
+        attempts: usize,
+        perturb_when_apart: bool,
+    ) -> Result<Config, Rejection> {
         let mut rng = SplitMix64::new(seed);
         let mut last = Rejection::NoProjection;
         // the rejection at the first projected start is the informative one (later ones come from perturbations)
@@ -705,6 +720,10 @@ impl<'a> Manifolds<'a> {
                 }
                 projected.push(alt);
             }
+        }
+        if !perturb_when_apart && matches!(first, Some(Rejection::NotInContact { .. } | Rejection::Penetrating { .. }))
+        {
+            return Err(first.unwrap_or(last));
         }
         let (sa, sb) = (&self.fixed.surface, &self.moving.surface);
         for p in projected.iter().take(2) {
