@@ -20,7 +20,7 @@
 //!
 //! Pruning: parts and components are paired only when their bounding boxes meet (enlarged by the clearance for the
 //! clearance test). Shortcuts that decide exactly what the plain analysis decides: equilibrium problems split into
-//! groups of parts connected by part-part contacts ([`solve_equilibrium`]); prefix `i` solves only the group that part
+//! groups of parts connected by part-part contacts ([`crate::equilibrium::solve_equilibrium`]); prefix `i` solves only the group that part
 //! `i` joins and reuses the other groups' verdicts (`prefix_verdicts`); the grasp analysis runs once per class of
 //! placements of the same part with the same rotation (it depends only on the part's own material, so a translated
 //! copy has the same answer up to rounding); the per-part analyses run in parallel (rayon). Cost: dominated by the
@@ -311,7 +311,7 @@ fn check_stack_with(
 /// The verdicts of the prefix stacks `0..=i` (every part movable, the floor fixed); the last one is `whole`.
 ///
 /// A prefix stack is the product of its groups of parts connected by part-part contacts (see
-/// [`solve_equilibrium`]), and a group's problem depends only on its set of parts: its contacts are among its
+/// [`crate::equilibrium::solve_equilibrium`]), and a group's problem depends only on its set of parts: its contacts are among its
 /// parts and with the floor, and a later part touching it would have joined it. Placing part `i` changes only the
 /// group that `i` joins, so step `i` solves that group alone (the "step group" of `i`); every group of prefix `i` is
 /// the step group of its highest part. Prefix `i` is unstable when one of its groups is, else unknown when one is,

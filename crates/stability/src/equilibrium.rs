@@ -34,13 +34,25 @@
 //!
 //! Decomposition: the movable parts split into groups connected by contacts between movable parts (the floor and
 //! fixed parts do not connect); the groups share no unknown, so each is solved on its own, in parallel (rayon), and
-//! the answers combine exactly (see [`solve_equilibrium`]). A group of one part whose contacts are all supports from
-//! below in one horizontal plane gets its margin in closed form (`min(mu, s / H)`, see `FlatSupport`), the SOCP's
-//! optimum without a solve; `EquilibriumOptions::margins_by_socp_only` turns this off for cross-checks.
+//! the answers combine exactly (see [`solve_equilibrium`]). Within a group, further exact shortcuts
+//! (`EquilibriumOptions::equilibrium_by_socp_only` and `margins_by_socp_only` turn them off, giving the reference
+//! of one SOCP per group, and per group and direction, that the tests compare against):
+//!
+//! * support trees (`tree`): when the group's contact graph, with the fixed bodies contracted to one ground node, is
+//!   a tree (columns, a part alone on its supports), the problem splits into one rigid-body problem per tree edge:
+//!   the subtree above the edge as one rigid union on the edge's points. Equilibrium, minimum-norm forces and
+//!   margins are the edges' combined;
+//! * flat supports in closed form: an edge whose points all push straight up from one horizontal plane has the
+//!   margin `min(mu, s / H)` (`FlatSupport`) and, when the least-squares normal forces are nonnegative, those as its
+//!   minimum-norm forces (friction 0), without a solve;
+//! * margins (`margin`): coplanar points with the same cone reduced to their hull's vertices; a triangle certificate
+//!   (three SOCPs) for problems that resist the current smallest margin in every direction (nested, locked parts);
+//! * a memo (`SolveCache`) of identical rigid-body problems across the calls of one stack check.
 //!
 //! Cost: per group an interior-point solve with `3 K + 1` variables and `6 M` equalities (K contact points, M movable
-//! parts); a margin costs `directions` more solves per group (none for closed-form groups), four directions sharing one
-//! solver's symbolic factorisation.
+//! parts), or per tree edge one with its own points and 6 equalities (none for flat edges); a margin costs
+//! `directions` more solves per group or non-flat edge (three for a certified one), sharing one solver's symbolic
+//! factorisation per stage.
 
 use crate::contacts::{Body, ContactPatch, plane_basis};
 use crate::polygon2d::{convex_hull_2d, signed_boundary_distance};
