@@ -92,8 +92,14 @@ fn tight_set<const D: usize>(cell: &Cell<D>, p: &[f64; D]) -> Vec<usize> {
     (0..cell.len()).filter(|&j| cell.halfspaces()[j].excess(p).abs() <= tol).collect()
 }
 
-/// Exact minimum of `cost` over `cell`: see the module documentation.
-pub fn minimize<const D: usize>(cell: &Cell<D>, cost: &impl SeparableQuadratic<D>) -> Result<QpSolution<D>, QpError> {
+/// An active-set problem, its start point and the cost's `h` and `g`.
+type Prepared<'c, const D: usize> = (Problem<'c>, [f64; MAX_N], [f64; D], [f64; D]);
+
+/// The active-set problem of `cost` over `cell` and its start (the cell's interior point), with the checked cost.
+fn problem<'c, const D: usize>(
+    cell: &'c Cell<D>,
+    cost: &impl SeparableQuadratic<D>,
+) -> Result<Prepared<'c, D>, QpError> {
     let (h, g) = check_cost(cost)?;
     let start = cell.interior_point().ok_or(QpError::EmptyCell)?;
     let prob = Problem {
@@ -106,7 +112,12 @@ pub fn minimize<const D: usize>(cell: &Cell<D>, cost: &impl SeparableQuadratic<D
         tie: default_tie(D),
         length_scale: cell.length_scale(),
     };
-    let start = to_v4(&start);
+    Ok((prob, to_v4(&start), h, g))
+}
+
+/// Exact minimum of `cost` over `cell`: see the module documentation.
+pub fn minimize<const D: usize>(cell: &Cell<D>, cost: &impl SeparableQuadratic<D>) -> Result<QpSolution<D>, QpError> {
+    let (prob, start, h, g) = problem(cell, cost)?;
     // strictly convex costs: the closed-form range-space iteration; a result that fails the KKT check (or a
     // breakdown of that path) falls back to the general method, whose answer is the definition
     if let Some(outcome) = prob.solve_strictly_convex(start) {
@@ -125,19 +136,8 @@ pub fn minimize_general<const D: usize>(
     cell: &Cell<D>,
     cost: &impl SeparableQuadratic<D>,
 ) -> Result<QpSolution<D>, QpError> {
-    let (h, g) = check_cost(cost)?;
-    let start = cell.interior_point().ok_or(QpError::EmptyCell)?;
-    let prob = Problem {
-        n: D,
-        rows: cell.rows(),
-        offsets: cell.offsets(),
-        mask: None,
-        h: to_v4(&h),
-        g: to_v4(&g),
-        tie: default_tie(D),
-        length_scale: cell.length_scale(),
-    };
-    solution(cell, cost, &h, &g, prob.solve(to_v4(&start))?)
+    let (prob, start, h, g) = problem(cell, cost)?;
+    solution(cell, cost, &h, &g, prob.solve(start)?)
 }
 
 /// The solution of an outcome of the active-set solver, KKT-verified.
