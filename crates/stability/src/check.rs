@@ -205,7 +205,7 @@ fn check_stack_with(
             &parts,
             &patches,
             &whole.verdict,
-            &EquilibriumOptions { directions: 0, ..eq_with_margin },
+            &EquilibriumOptions { directions: 0, verdict_only: true, ..eq_with_margin },
             &cache,
         )?
     } else {

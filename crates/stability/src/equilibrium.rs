@@ -112,12 +112,17 @@ pub struct EquilibriumOptions {
     /// (for cross-checking those; the results agree to the solver's tolerance).
     #[serde(default)]
     pub equilibrium_by_socp_only: bool,
+    /// Only the verdict is wanted: a group without a support tree may be certified stable by any admissible force
+    /// distribution (vertical forces at its horizontal contacts, see `tree::vertical_certificate`) instead of the
+    /// minimum-norm solve; the result's forces are then empty.
+    #[serde(default)]
+    pub verdict_only: bool,
 }
 
 impl EquilibriumOptions {
     /// Friction `mu`, `directions` margin directions, closed-form margins where they apply.
     pub fn new(mu: f64, directions: usize) -> Self {
-        Self { mu, directions, margins_by_socp_only: false, equilibrium_by_socp_only: false }
+        Self { mu, directions, margins_by_socp_only: false, equilibrium_by_socp_only: false, verdict_only: false }
     }
 }
 
@@ -289,7 +294,7 @@ pub fn solve_equilibrium_with(
     }
     let solved: Vec<(Verdict, Vec<DVec3>)> = groups
         .par_iter()
-        .map(|group| group_equilibrium(&bodies, &points, group, options.mu, options.equilibrium_by_socp_only, cache))
+        .map(|group| group_equilibrium(&bodies, &points, group, options, cache))
         .collect::<Result<_, _>>()?;
     if let Some((v, _)) = solved.iter().find(|(v, _)| *v == Verdict::Unstable) {
         tracing::debug!("equilibrium infeasible");
@@ -307,7 +312,7 @@ pub fn solve_equilibrium_with(
         }
     }
     forces.sort_by_key(|(k, _)| *k);
-    let forces = forces.into_iter().map(|(_, f)| f).collect();
+    let forces = if options.verdict_only { Vec::new() } else { forces.into_iter().map(|(_, f)| f).collect() };
     let (margin, weakest_direction) = if options.directions > 0 && !options.margins_by_socp_only {
         margin::fast_margins(&bodies, &points, &groups, options.directions, options.mu, cache)?
     } else if options.directions > 0 {
@@ -327,10 +332,10 @@ fn group_equilibrium(
     bodies: &[Rigid],
     points: &[Point],
     group: &Group,
-    mu: f64,
-    plain: bool,
+    options: &EquilibriumOptions,
     cache: &SolveCache,
 ) -> Result<(Verdict, Vec<DVec3>), EquilibriumError> {
+    let (mu, plain) = (options.mu, options.equilibrium_by_socp_only);
     let socp =
         |bodies: &[Rigid], movers: &[usize], own: &[&Point]| -> Result<(Verdict, Vec<DVec3>), EquilibriumError> {
             let problem = Problem::new(bodies, movers, own, mu);
@@ -350,7 +355,16 @@ fn group_equilibrium(
             Ok((verdict, forces))
         };
     let edges = if plain { None } else { tree::support_tree(bodies, points, group) };
-    let Some(edges) = edges else { return socp(bodies, &group.movers, &group.points(points)) };
+    let Some(edges) = edges else {
+        let own = group.points(points);
+        if !plain
+            && options.verdict_only
+            && let Some(forces) = tree::vertical_certificate(bodies, &group.movers, &own)
+        {
+            return Ok((Verdict::Stable, forces));
+        }
+        return socp(bodies, &group.movers, &own);
+    };
     let position: std::collections::HashMap<usize, usize> =
         group.point_indices.iter().enumerate().map(|(local, &k)| (k, local)).collect();
     let mut forces = vec![DVec3::ZERO; group.point_indices.len()];

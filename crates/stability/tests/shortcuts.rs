@@ -14,8 +14,10 @@
 //!   (flat supports, off-centre ones whose least-squares forces go negative, tipping and sliding limits, planks
 //!   bridging the columns so that the support graph has cycles) with random friction, and on columns of every
 //!   fixture part (`fixtures/parts/*.json`) in its two lowest resting poses, nested (parts lowered onto the one
-//!   below until they touch, straight and shifted sideways): identical verdicts of every kind, margins within 1e-6
-//!   relative, forces within 1e-6 of the weight.
+//!   below until they touch, straight and shifted sideways), on the planned Channel stack (flat supports at two
+//!   heights) and on staggered brick walls (cyclic support graphs, side contacts between neighbours, overhanging
+//!   rows: the vertical certificate of the prefix verdicts): identical verdicts of every kind, margins within 1e-6
+//!   relative, the same minimum-norm forces (see `assert_equivalent`).
 
 mod common;
 
@@ -256,6 +258,28 @@ proptest! {
         let plain = check_stack_reference(&stack, &options).expect("check");
         let weight: f64 = parts.iter().map(|p| p.mass.mass).sum();
         assert_checks_equivalent(&fast, &plain, weight, "random boxes");
+    }
+
+    #[test]
+    fn shortcuts_match_the_plain_socps_on_brick_walls(
+        rows in 2usize..=4,
+        shift in 0.0f64..160.0,
+        mu in 0.2f64..1.0,
+    ) {
+        // a staggered wall of 200 x 100 x 50 bricks, row r shifted by r * shift (100 = the pyramid of the benchmark;
+        // beyond 100 the upper rows overhang): adjacent bricks touch side by side, upper bricks rest on two below, so
+        // the support graph has cycles (the vertical certificate of the prefix verdicts) and some walls topple
+        let brick = box_part("brick", DVec3::new(200.0, 100.0, 50.0));
+        let mut stack = Vec::new();
+        for row in 0..rows {
+            for k in 0..(rows - row) {
+                stack.push(at(&brick, DVec3::new(shift * row as f64 + 200.0 * k as f64, 0.0, 50.0 * row as f64)));
+            }
+        }
+        let options = CheckOptions { mu, ..options() };
+        let fast = check_stack(&stack, &options).expect("check");
+        let plain = check_stack_reference(&stack, &options).expect("check");
+        assert_checks_equivalent(&fast, &plain, brick.mass.mass * stack.len() as f64, "brick wall");
     }
 
     #[test]

@@ -164,3 +164,101 @@ pub(super) fn flat_minimum_norm(union: &Rigid, points: &[Point]) -> Option<Vec<D
     let residual = (total - union.mass).abs().max(mx.abs()).max(my.abs());
     (residual <= 1e-12 * union.mass.max(f64::MIN_POSITIVE)).then_some(forces)
 }
+
+/// An admissible force distribution (world vectors, each the force of the point's `a` on its `b`, in the order of
+/// `points`) made of vertical forces at the points with vertical normals (`|n_z| >= 1 - 1e-12`) and no force at the
+/// others, when the least-squares one has no negative normal force; `None` otherwise. It certifies equilibrium
+/// (vertical forces with `f_k >= 0` lie in their friction cones, zero forces in every cone) but is in general *not*
+/// the minimum-norm distribution (friction can lower the norm), so it serves verdicts only. Rows per movable part `i`
+/// (`s = +1` on `b`, `-1` on `a`): `sum s n_z f_k = m_i` and the moments about the two horizontal axes through `c_i`,
+/// `sum s n_z f_k (y_k - c_y) = 0`, `sum s n_z f_k (x_k - c_x) = 0` (vertical forces have no other moment and no
+/// horizontal resultant, and no load acts). Least squares through the normal equations `(A A^T) y = b` (3 M
+/// unknowns, dense Gaussian elimination with partial pivoting), O(M^3 + M K).
+pub(super) fn vertical_certificate(bodies: &[Rigid], movers: &[usize], points: &[&Point]) -> Option<Vec<DVec3>> {
+    let vertical = |p: &Point| p.frame[0].z.abs() >= 1.0 - 1e-12;
+    let rows = 3 * movers.len();
+    let union = Rigid::union(movers.iter().map(|&i| bodies[i]));
+    let scale = (union.aabb.1 - union.aabb.0).length().max(1.0);
+    let weight = union.mass.max(f64::MIN_POSITIVE);
+    // the sparse column of A of a point: up to two bodies x three rows (none for a point that is not vertical)
+    let column = |p: &Point| -> Vec<(usize, f64)> {
+        let mut out = Vec::with_capacity(6);
+        if !vertical(p) {
+            return out;
+        }
+        let nz = p.frame[0].z.signum();
+        for (body, sign) in [(Some(p.b), 1.0), (p.a, -1.0)] {
+            let Some(body) = body else { continue };
+            let Ok(m) = movers.binary_search(&body) else { continue };
+            let c = bodies[body].cg;
+            let v = sign * nz;
+            out.push((3 * m, v));
+            out.push((3 * m + 1, v * (p.p.y - c.y) / scale));
+            out.push((3 * m + 2, v * (p.p.x - c.x) / scale));
+        }
+        out
+    };
+    let columns: Vec<Vec<(usize, f64)>> = points.iter().map(|p| column(p)).collect();
+    let mut gram = vec![0.0f64; rows * rows];
+    for col in &columns {
+        for &(r, a) in col {
+            for &(c, b) in col {
+                gram[r * rows + c] += a * b;
+            }
+        }
+    }
+    let mut rhs = vec![0.0f64; rows];
+    for (m, &i) in movers.iter().enumerate() {
+        rhs[3 * m] = bodies[i].mass / weight;
+    }
+    let y = solve_dense(gram, rhs.clone(), rows)?;
+    let mut forces = Vec::with_capacity(points.len());
+    let mut residual = vec![0.0f64; rows];
+    for (p, col) in points.iter().zip(&columns) {
+        let normal: f64 = col.iter().map(|&(r, a)| a * y[r]).sum();
+        if normal.is_nan() || normal < 0.0 {
+            return None;
+        }
+        for &(r, a) in col {
+            residual[r] += a * normal;
+        }
+        forces.push(DVec3::Z * (p.frame[0].z.signum() * normal * weight));
+    }
+    residual.iter().zip(&rhs).all(|(r, b)| (r - b).abs() <= 1e-12).then_some(forces)
+}
+
+/// Solves the dense `n x n` system `a y = b` (row-major) by Gaussian elimination with partial pivoting; `None` when a
+/// pivot is below `1e-12` times the largest entry (singular or nearly so).
+fn solve_dense(mut a: Vec<f64>, mut b: Vec<f64>, n: usize) -> Option<Vec<f64>> {
+    let largest = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if largest.is_nan() || largest == 0.0 {
+        return None;
+    }
+    for k in 0..n {
+        let pivot = (k..n).max_by(|&i, &j| a[i * n + k].abs().total_cmp(&a[j * n + k].abs()))?;
+        if a[pivot * n + k].abs() <= 1e-12 * largest {
+            return None;
+        }
+        if pivot != k {
+            for c in 0..n {
+                a.swap(k * n + c, pivot * n + c);
+            }
+            b.swap(k, pivot);
+        }
+        for i in k + 1..n {
+            let f = a[i * n + k] / a[k * n + k];
+            if f != 0.0 {
+                for c in k..n {
+                    a[i * n + c] -= f * a[k * n + c];
+                }
+                b[i] -= f * b[k];
+            }
+        }
+    }
+    let mut y = vec![0.0; n];
+    for k in (0..n).rev() {
+        let s: f64 = (k + 1..n).map(|c| a[k * n + c] * y[c]).sum();
+        y[k] = (b[k] - s) / a[k * n + k];
+    }
+    Some(y)
+}
