@@ -31,6 +31,15 @@
 //!    needs no further solve (its value is `MARGIN_CAP` when `m` is the cap). Typical for nested parts, which are
 //!    locked. Otherwise the other directions are solved one by one (the 0-degree solve is reused).
 //!
+//! 5. **Parallel forces** for a group without a support tree (a brick wall) whose contacts with the fixed bodies push
+//!    straight up from one plane: summing all its equations gives the group as one rigid union on those contacts, a
+//!    relaxation, so `alpha(d) <= U(d) = min(mu, s / H)` of the union. At `alpha = U(d)` take every force at a
+//!    contact with a vertical normal parallel to the tilted gravity `z - alpha d` (on the upper body; friction
+//!    `alpha <= mu` times the normal force: inside the cone) and none at the others: the group is in equilibrium iff
+//!    every part's forces sum to its weight along that direction with the resultant through its c.g. (3 rows per
+//!    part, linear in the magnitudes). In every direction where the least-squares magnitudes are nonnegative, the
+//!    margin is exactly `U(d)` without an SOCP; the other directions are solved.
+//!
 //! The SOCPs of this module bound `alpha` by a little more than twice [`MARGIN_CAP`] and clamp the answer to the cap afterwards (the
 //! feasible `alpha` form an interval, so clamping the larger problem's optimum gives the capped optimum). One solver
 //! per problem is reused through `update_A` across its directions, as in the reference. Cost: per group a union-find
@@ -89,8 +98,27 @@ pub(super) fn fast_margins(
         }
     }
     let m = closed.iter().flatten().fold(MARGIN_CAP, |a, &b| a.min(b));
-    let solved: Vec<Vec<Option<f64>>> =
-        socp.par_iter().map(|unit| unit_margins(unit, directions, mu, m, cache)).collect::<Result<_, _>>()?;
+    let solved: Vec<Vec<Option<f64>>> = socp
+        .par_iter()
+        .map(|unit| match tilted_bounds(unit, directions, mu) {
+            Some(certified) => {
+                // the directions the certificate did not decide, by their SOCPs
+                let missing: Vec<usize> = (0..directions).filter(|&j| certified[j].is_none()).collect();
+                let mut values: Vec<Option<f64>> = certified;
+                if !missing.is_empty() {
+                    let refs: Vec<&Point> = unit.points.iter().collect();
+                    let problem = Problem::new(&unit.bodies, &unit.movers, &refs, mu);
+                    let angles: Vec<f64> =
+                        missing.iter().map(|&j| std::f64::consts::TAU * j as f64 / directions as f64).collect();
+                    for (j, value) in missing.into_iter().zip(solve_sequence(&problem, &angles)?) {
+                        values[j] = value.map(|a| a.min(MARGIN_CAP));
+                    }
+                }
+                Ok(values)
+            }
+            None => unit_margins(unit, directions, mu, m, cache),
+        })
+        .collect::<Result<_, _>>()?;
     let mut smallest = f64::INFINITY;
     let mut weakest = None;
     for j in 0..directions {
@@ -110,6 +138,41 @@ pub(super) fn fast_margins(
         }
     }
     Ok((Some(smallest), weakest))
+}
+
+/// The margins of a group without a support tree whose contacts with the fixed bodies all push straight up from one
+/// plane, per direction where the parallel-force certificate decides it (module documentation, item 5; `None` in the
+/// other directions, which the caller solves as SOCPs); `None` when the certificate does not apply (one part, other
+/// fixed contacts). Per direction `d`: the upper bound `U(d)` is the closed form of
+/// the group as one rigid union on its fixed contacts (summing the group's equations is a relaxation); the group
+/// resists `U(d)` when forces parallel to `z - U(d) d` at its horizontal contacts balance every part
+/// ([`super::tree::parallel_certificate`]); then its margin is exactly `U(d)`.
+fn tilted_bounds(unit: &Unit, directions: usize, mu: f64) -> Option<Vec<Option<f64>>> {
+    if unit.movers.len() < 2 {
+        return None;
+    }
+    let union = Rigid::union(unit.movers.iter().map(|&i| unit.bodies[i]));
+    let is_mover = |b: Option<usize>| b.is_some_and(|b| unit.movers.binary_search(&b).is_ok());
+    // the contacts with the fixed bodies, as forces on the union
+    let ground: Vec<Point> = unit
+        .points
+        .iter()
+        .filter(|p| !(is_mover(Some(p.b)) && is_mover(p.a)))
+        .map(|p| super::tree::edge_point(p, is_mover(Some(p.b))))
+        .collect();
+    let refs: Vec<&Point> = ground.iter().collect();
+    let flat = FlatSupport::of(&[union], &[0], &refs)?;
+    let all: Vec<&Point> = unit.points.iter().collect();
+    let mut out = Vec::with_capacity(directions);
+    for j in 0..directions {
+        let angle = std::f64::consts::TAU * j as f64 / directions as f64;
+        let d = DVec3::new(angle.cos(), angle.sin(), 0.0);
+        let bound = flat.margin(d, mu);
+        let certified = bound <= mu
+            && super::tree::parallel_certificate(&unit.bodies, &unit.movers, &all, DVec3::Z - d * bound).is_some();
+        out.push(certified.then_some(bound));
+    }
+    Some(out)
 }
 
 /// The capped largest load factor of one SOCP unit per direction (`None`: the solve did not end `Solved`; infinity:

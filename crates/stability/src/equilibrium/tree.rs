@@ -175,7 +175,24 @@ pub(super) fn flat_minimum_norm(union: &Rigid, points: &[Point]) -> Option<Vec<D
 /// horizontal resultant, and no load acts). Least squares through the normal equations `(A A^T) y = b` (3 M
 /// unknowns, dense Gaussian elimination with partial pivoting), O(M^3 + M K).
 pub(super) fn vertical_certificate(bodies: &[Rigid], movers: &[usize], points: &[&Point]) -> Option<Vec<DVec3>> {
+    parallel_certificate(bodies, movers, points, DVec3::Z)
+}
+
+/// [`vertical_certificate`] under the tilted gravity `g = z - alpha d` of a horizontal load `alpha d` (`alpha` at
+/// most the friction coefficient): at every point with a vertical normal the force on the upper body is `f_k g`
+/// (normal component `f_k`, friction `alpha f_k <= mu f_k`: inside the cone), zero at the others; the rows are per
+/// part `sum s n_z f_k = m_i` (then the forces balance `m_i g`) and the moments about the two axes through `c_i`
+/// perpendicular to `g`, `sum s n_z f_k (p_k - c_i) . e = 0` (a resultant along `g` through `c_i`). Nonnegative
+/// least-squares `f_k` certify that the group resists the load; `None` otherwise.
+pub(super) fn parallel_certificate(
+    bodies: &[Rigid],
+    movers: &[usize],
+    points: &[&Point],
+    gravity: DVec3,
+) -> Option<Vec<DVec3>> {
     let vertical = |p: &Point| p.frame[0].z.abs() >= 1.0 - 1e-12;
+    let g = gravity.normalize();
+    let (e1, e2) = crate::contacts::plane_basis(g);
     let rows = 3 * movers.len();
     let union = Rigid::union(movers.iter().map(|&i| bodies[i]));
     let scale = (union.aabb.1 - union.aabb.0).length().max(1.0);
@@ -193,8 +210,8 @@ pub(super) fn vertical_certificate(bodies: &[Rigid], movers: &[usize], points: &
             let c = bodies[body].cg;
             let v = sign * nz;
             out.push((3 * m, v));
-            out.push((3 * m + 1, v * (p.p.y - c.y) / scale));
-            out.push((3 * m + 2, v * (p.p.x - c.x) / scale));
+            out.push((3 * m + 1, v * (p.p - c).dot(e1) / scale));
+            out.push((3 * m + 2, v * (p.p - c).dot(e2) / scale));
         }
         out
     };
@@ -222,7 +239,7 @@ pub(super) fn vertical_certificate(bodies: &[Rigid], movers: &[usize], points: &
         for &(r, a) in col {
             residual[r] += a * normal;
         }
-        forces.push(DVec3::Z * (p.frame[0].z.signum() * normal * weight));
+        forces.push(gravity * (p.frame[0].z.signum() * normal * weight));
     }
     residual.iter().zip(&rhs).all(|(r, b)| (r - b).abs() <= 1e-12).then_some(forces)
 }
