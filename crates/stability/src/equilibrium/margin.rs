@@ -129,7 +129,14 @@ pub(super) fn fast_margins(
         for values in &solved {
             match values[j] {
                 Some(a) => alpha = alpha.min(a),
-                None => return Ok((None, None)),
+                None => {
+                    // a solve did not end `Solved`: the answer of the plain path (one SOCP per group and direction,
+                    // bounded by the cap), which may succeed where this path's problem did not, or else says None
+                    tracing::debug!("a margin solve did not end Solved; margins by the plain SOCPs");
+                    let problems: Vec<Problem> =
+                        groups.iter().map(|g| Problem::new(bodies, &g.movers, &g.points(points), mu)).collect();
+                    return super::margins(&problems, directions);
+                }
             }
         }
         if alpha < smallest {
