@@ -10,8 +10,10 @@
 //!    the intersection of the ranges of the state's single PCs evaluated as states (Proposition 2); a PC known
 //!    infeasible, or an empty intersection, makes the hypothesis infeasible without a search. The refined box is
 //!    widened by `widen` of the initial widths (the extremals are found numerically) and clipped to the initial box.
-//! 4. Feasibility (step 5): minimise eq. 8 in the refined box with the GA and polish ([`crate::ga`]); feasible iff the
-//!    minimum is at most `threshold_relative * L`.
+//! 4. Feasibility (step 5): the neighbours' witnesses and extremals projected onto the state's manifold and checked
+//!    strictly ([`crate::manifold`]); for a single e-e PC the analytic crossings ([`crate::analytic_seeds`]); else
+//!    eq. 8 minimised in the refined box with the GA and polish ([`crate::ga`]), and a minimum of at most
+//!    `threshold_relative * L` searched for a strict witness nearby. Feasible iff a strict witness is found.
 //! 5. Extremals (step 6) of feasible states ([`crate::extremal`]); step 7 repeats until no new hypothesis appears.
 //!
 //! Finally the CLCN/CMCN relations are computed among the feasible states. Every hypothesis gets its own seed

@@ -11,10 +11,16 @@
 //! that exist only against a bound of the box) give the candidates. The edges
 //! then meet exactly (the e-e equality holds), and the strict check decides whether nothing else touches or
 //! penetrates. Pairs of nearly parallel edges (`|da x R db| <= 1e-6 |da| |db|`) make no crossing and are skipped.
-//! Cost: `3 angle_steps^3 edge_steps` candidates, each O(1) to build; the caller checks them in order.
+//! After all of these, per rotation the corners of the whole crossing region: with both parameters free,
+//! `x(s, u) = a0 - R b0 + s da - u R db`, and the part of `(s, u) in [0, 1]^2` mapped into the box's translation
+//! ranges is a convex polygon (10 half-planes); its corners (pulled `1e-6` towards their mean) have two bounds
+//! active at once, where states that exist only in a corner of the box lie.
+//! Cost: `angle_steps^3 (3 edge_steps + at most 10)` candidates, O(1) each to build (the corners by intersecting the
+//! 45 pairs of constraint lines); the caller checks them in order.
 
 use crate::pose::{Config, ConfigBox, Pose};
 use crate::surface::SurfaceElements;
+use stackplan_geom::DVec3;
 
 /// Grid values of variable `k` of `bounds`: `steps` evenly spaced values including both bounds (one when the range
 /// is a point).
@@ -85,7 +91,66 @@ pub fn edge_edge_candidates(
             }
         }
     }
+    // then the corners of the crossing region: for each rotation the translations `x(s, u)` with both edges'
+    // parameters free form a parallelogram; its part inside the box is a convex polygon in `(s, u)`, whose corners
+    // put two bounds active at once (x at its maximum and z at its minimum, say), where the slivers of states that
+    // exist only in a corner of the box lie
+    for &rx in &gx {
+        for &ry in &gy {
+            for &rz in &gz {
+                let pose = Pose::from_config(&[0.0, 0.0, 0.0, rx, ry, rz]);
+                let db = pose.apply_vector(b1 - b0);
+                if da.cross(db).length() <= 1e-6 * da.length() * db.length() {
+                    continue;
+                }
+                let c0 = a0 - pose.apply(b0);
+                for (s, u) in crossing_region_corners(da, db, c0, bounds) {
+                    let x = c0 + da * s - db * u;
+                    let mut t = [x.x, x.y, x.z, rx, ry, rz];
+                    bounds.clamp(&mut t);
+                    out.push(t);
+                }
+            }
+        }
+    }
     out
+}
+
+/// Corners of the polygon `{(s, u) in [0, 1]^2 : min_k <= (c0 + s da - u db)_k <= max_k, k = x, y, z}`, each
+/// pulled towards the corners' mean by `1e-6` of the way (strictly inside: an interior crossing, bounds kept).
+fn crossing_region_corners(da: DVec3, db: DVec3, c0: DVec3, bounds: &ConfigBox) -> Vec<(f64, f64)> {
+    // lines alpha s + beta u = gamma; inside means lo <= alpha s + beta u <= hi
+    let mut constraints: Vec<(f64, f64, f64, f64)> = vec![(1.0, 0.0, 0.0, 1.0), (0.0, 1.0, 0.0, 1.0)];
+    for k in 0..3 {
+        constraints.push((da[k], -db[k], bounds.min[k] - c0[k], bounds.max[k] - c0[k]));
+    }
+    let scale = 1.0 + da.length() + db.length() + c0.length();
+    let inside = |s: f64, u: f64| {
+        constraints.iter().all(|&(a, b, lo, hi)| {
+            let v = a * s + b * u;
+            v >= lo - 1e-12 * scale && v <= hi + 1e-12 * scale
+        })
+    };
+    let lines: Vec<(f64, f64, f64)> = constraints.iter().flat_map(|&(a, b, lo, hi)| [(a, b, lo), (a, b, hi)]).collect();
+    let mut corners: Vec<(f64, f64)> = Vec::new();
+    for (i, &(a1, b1, g1)) in lines.iter().enumerate() {
+        for &(a2, b2, g2) in &lines[i + 1..] {
+            let det = a1 * b2 - a2 * b1;
+            if det.abs() <= 1e-12 * (a1.abs() + b1.abs()) * (a2.abs() + b2.abs()) {
+                continue;
+            }
+            let (s, u) = ((g1 * b2 - g2 * b1) / det, (a1 * g2 - a2 * g1) / det);
+            if inside(s, u) && !corners.iter().any(|&(p, q)| (p - s).abs() + (q - u).abs() <= 1e-12) {
+                corners.push((s, u));
+            }
+        }
+    }
+    if corners.len() < 3 {
+        return Vec::new();
+    }
+    let n = corners.len() as f64;
+    let (ms, mu) = corners.iter().fold((0.0, 0.0), |(a, b), &(s, u)| (a + s / n, b + u / n));
+    corners.into_iter().map(|(s, u)| (s + 1e-6 * (ms - s), u + 1e-6 * (mu - u))).collect()
 }
 
 #[cfg(test)]
@@ -93,7 +158,6 @@ mod tests {
     use super::*;
     use crate::criteria::tests::box_part;
     use crate::manifold::segment_segment_distance;
-    use stackplan_geom::DVec3;
 
     #[test]
     fn candidates_make_the_edges_cross_inside_the_box() {
@@ -117,6 +181,18 @@ mod tests {
                 }
             }
         }
+        // the corners of the crossing regions put two translation bounds active at once (with a box tight in x and z)
+        let tight =
+            ConfigBox::new([49.5, -60.0, -0.3, -0.3, -0.3, -0.3], [49.9, 60.0, 0.3, 0.3, 0.3, 0.3]).expect("box");
+        let active = |t: &Config| {
+            (0..3).filter(|&k| (t[k] - tight.min[k]).abs().min((t[k] - tight.max[k]).abs()) < 1e-4).count()
+        };
+        let with_two_bounds = (0..sa.edges.len())
+            .flat_map(|ea| (0..sb.edges.len()).map(move |eb| (ea, eb)))
+            .flat_map(|(ea, eb)| edge_edge_candidates(sa, ea, sb, eb, &tight, 3, 3))
+            .filter(|t| active(t) >= 2)
+            .count();
+        assert!(with_two_bounds > 0);
         // every edge of the slab can cross most of the cube's edges under some rotation of the grid
         assert!(crossing_pairs > sa.edges.len() * sb.edges.len() / 2, "{crossing_pairs}");
         // a translation box that keeps the cube far from the slab's edges gives no candidate
