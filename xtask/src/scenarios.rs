@@ -16,6 +16,10 @@
 //! * `obstacle`: the c-space obstacle of every convex pair of two parts (the fixed one placed by `"fixed_pose"`) at
 //!   each angle of `"theta_deg"` (`stackplan::cspace::obstacle`): per angle and pair the vertex and face counts and
 //!   the volume, face-kind totals, and the route (Gauss map or hull fallback); every obstacle must pass `validate()`.
+//! * `contacts`: the assembly contact state graph of `"moving"` against `"fixed"` (placed by `"fixed_pose"`) within
+//!   `"t_min"`/`"t_max"` (mm and degrees) at the default GA settings and `"seed"` ([P] V; deterministic at any
+//!   thread count): feasible states per level, their labels, and each state's extremal ranges (the [P] Table I
+//!   rows: lowest and highest x, y, z, rx, ry, rz, mm and radians).
 //! * `orient_intervals`: the constant-topology intervals and sweep counts of every convex pair of two parts over a
 //!   full turn (`stackplan::orient_interval::regress_summary`).
 
@@ -35,6 +39,7 @@ pub fn run(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
         "plan" => plan(scenario, dir),
         "orient_intervals" => orient_intervals(scenario, dir),
         "obstacle" => obstacle(scenario, dir),
+        "contacts" => contacts(scenario, dir),
         other => bail!("unknown scenario kind {other:?}"),
     }
 }
@@ -113,6 +118,41 @@ fn orient_intervals(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
         let intervals: Vec<Value> = pairs.iter().map(|p| p.get("intervals").cloned().unwrap_or(Value::Null)).collect();
         f.insert("intervals_per_pair".into(), intervals.into());
     }
+    Ok(f)
+}
+
+/// The `contacts` kind (see the module documentation).
+fn contacts(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
+    use stackplan::contact_states::acsg::{AcsgSettings, generate};
+    use stackplan::contact_states::criteria::ContactPart;
+    use stackplan::contact_states::ga::GaSettings;
+    use stackplan::contact_states::pose::ConfigBox;
+    let moving = load_part(scenario, "moving", dir)?;
+    let fixed = load_part(scenario, "fixed", dir)?;
+    let (rotation, position) = fixed_pose(scenario)?;
+    let placed = fixed.components.iter().map(|c| c.transformed(rotation, position)).collect();
+    let fixed = Part::from_components(fixed.name.clone(), placed, fixed.density, fixed.origin.clone())?;
+    let bound = |key: &str| -> anyhow::Result<[f64; 6]> {
+        let v: [f64; 6] = serde_json::from_value(scenario.get(key).cloned().with_context(|| format!("no {key:?}"))?)?;
+        Ok([v[0], v[1], v[2], v[3].to_radians(), v[4].to_radians(), v[5].to_radians()])
+    };
+    let bounds = ConfigBox::new(bound("t_min")?, bound("t_max")?)?;
+    let seed = scenario.get("seed").and_then(Value::as_u64).unwrap_or(2004);
+    let settings = AcsgSettings { ga: GaSettings { seed, ..GaSettings::default() }, ..AcsgSettings::default() };
+    let started = std::time::Instant::now();
+    let graph = generate(&ContactPart::from_part(&fixed)?, &ContactPart::from_part(&moving)?, bounds, settings);
+    let seconds = started.elapsed().as_secs_f64();
+    let per_level = graph.counts_per_level();
+    let mut ranges = serde_json::Map::new();
+    for state in graph.feasible() {
+        let range = state.range.as_ref().map(|r| [r.min, r.max]);
+        ranges.insert(state.label.clone(), serde_json::to_value(range)?);
+    }
+    let mut f = Fields::new();
+    f.insert("total_states".into(), per_level.iter().sum::<usize>().into());
+    f.insert("states_per_level".into(), per_level.into());
+    f.insert("extremal_ranges".into(), Value::Object(ranges));
+    f.insert("info_seconds".into(), ((seconds * 1e3).round() / 1e3).into());
     Ok(f)
 }
 
