@@ -92,6 +92,25 @@ fn axpy(y: &mut V4, alpha: f64, x: &V4) {
     }
 }
 
+/// Anti-cycling bookkeeping after a move of length `moved` blocked by `blocking`: a real move (longer than 1e-13 of
+/// the length scale) clears the banned constraints; a null move blocked by the constraint just dropped bans that
+/// constraint (dropping and re-adding it would cycle). The last drop is forgotten either way.
+#[inline]
+fn record_move(
+    moved: f64,
+    length_scale: f64,
+    blocking: Option<usize>,
+    last_dropped: &mut Option<usize>,
+    banned: &mut Vec<usize>,
+) {
+    if moved > 1e-13 * length_scale {
+        banned.clear();
+    } else if blocking.is_some() && blocking == *last_dropped {
+        banned.extend(blocking);
+    }
+    *last_dropped = None;
+}
+
 /// An orthonormal set of at most four vectors.
 #[derive(Debug, Clone, Copy)]
 struct Basis {
@@ -575,12 +594,7 @@ impl Problem<'_> {
                         return Ok(Seek::Reached(p));
                     }
                     axpy(&mut p, alpha, &dir);
-                    if alpha * len > 1e-13 * self.length_scale {
-                        banned.clear();
-                    } else if blocking.is_some() && blocking == last_dropped {
-                        banned.extend(blocking);
-                    }
-                    last_dropped = None;
+                    record_move(alpha * len, self.length_scale, blocking, &mut last_dropped, &mut banned);
                     if let Some(j) = blocking {
                         w.push(j);
                     }
@@ -641,12 +655,7 @@ impl Problem<'_> {
                         _ => {}
                     }
                     axpy(&mut p, alpha, &dir);
-                    if alpha * len > 1e-13 * self.length_scale {
-                        banned.clear();
-                    } else if blocking.is_some() && blocking == last_dropped {
-                        banned.extend(blocking);
-                    }
-                    last_dropped = None;
+                    record_move(alpha * len, self.length_scale, blocking, &mut last_dropped, &mut banned);
                     if let Some(j) = blocking {
                         w.push(j);
                     }
@@ -892,12 +901,7 @@ impl Problem<'_> {
                 }
             }
             axpy(&mut p, alpha, &dir);
-            if alpha * len > 1e-13 * self.length_scale {
-                banned.clear();
-            } else if blocking.is_some() && blocking == last_dropped {
-                banned.extend(blocking);
-            }
-            last_dropped = None;
+            record_move(alpha * len, self.length_scale, blocking, &mut last_dropped, &mut banned);
             if let Some(j) = blocking {
                 if w.len >= n {
                     return None;

@@ -88,18 +88,7 @@ fn random_cell(rng: &mut Rng, kind: Kind, cuts: usize) -> (Vec<Halfspace<3>>, [f
         }
         Kind::Face | Kind::Edge => {
             for _ in 0..if kind == Kind::Face { 1 } else { 2 } {
-                let n = match rng.below(3) {
-                    0 => {
-                        let mut n = [0.0; 3];
-                        n[rng.below(3)] = 1.0;
-                        n
-                    }
-                    1 => {
-                        let t = rng.range(0.0, std::f64::consts::TAU);
-                        [t.cos(), t.sin(), 0.0]
-                    }
-                    _ => rng.unit3(),
-                };
+                let n = common::sheet_normal(rng);
                 let d = dot(&n, &c);
                 hs.push(Halfspace::new(n, d, Tag::User(0)));
                 hs.push(Halfspace::new(n.map(|x| -x), -d, Tag::User(0)));
@@ -140,13 +129,7 @@ fn random_cell(rng: &mut Rng, kind: Kind, cuts: usize) -> (Vec<Halfspace<3>>, [f
 /// Cost kinds: cost (1) with `w` in (0, 1), w = 0, w = 1, the desired position, a positive Hessian with entries
 /// over three orders of magnitude, a Hessian with zero entries, a linear cost (possibly zero).
 fn random_cost(rng: &mut Rng, kind: usize) -> SeparableCost<3> {
-    let ext = RotatedExtents {
-        x_max: rng.range(0.5, 3.0),
-        x_min: rng.range(-3.0, -0.5),
-        y_max: rng.range(0.5, 3.0),
-        y_min: rng.range(-3.0, -0.5),
-        center_of_gravity: DVec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(0.0, 2.0)),
-    };
+    let ext = common::random_extents(rng);
     let reference = DVec3::new(rng.range(-15.0, 15.0), rng.range(-15.0, 15.0), rng.range(-4.0, 8.0));
     match kind % 7 {
         0 => stacking_cost(rng.range(0.02, 0.98), &ext, reference).expect("cost"),
@@ -472,17 +455,7 @@ proptest! {
 /// Goldens: the planner's typical situations with exact answers.
 #[test]
 fn goldens_of_the_fast_path() {
-    let boxed = |lo: [f64; 3], hi: [f64; 3]| {
-        let mut hs = Vec::new();
-        for i in 0..3 {
-            let mut n = [0.0; 3];
-            n[i] = 1.0;
-            hs.push(Halfspace::new(n, hi[i], Tag::User(2 * i as u64)));
-            n[i] = -1.0;
-            hs.push(Halfspace::new(n, -lo[i], Tag::User(2 * i as u64 + 1)));
-        }
-        hs
-    };
+    let boxed = common::boxed;
     let tol = Tolerance::for_scale(10.0);
     // interior optimum: the unconstrained minimiser exactly, no active constraint
     let cell = Cell::new(boxed([0.0; 3], [4.0; 3]), tol).expect("cell");

@@ -5,8 +5,8 @@ mod common;
 use common::{Rng, Shape, bbox, random_cell};
 use proptest::prelude::*;
 use stackplan_freespace::{
-    Cell, Halfspace, RotatedExtents, SeparableCost, SeparableQuadratic, desired_position_cost, minimize,
-    minimize_clarabel, omega, stacking_cost, verify_kkt,
+    Cell, Halfspace, SeparableCost, SeparableQuadratic, desired_position_cost, minimize, minimize_clarabel, omega,
+    stacking_cost, verify_kkt,
 };
 use stackplan_geom::{Containment, DVec2, DVec3};
 
@@ -20,13 +20,7 @@ enum CostKind {
 }
 
 fn random_cost(rng: &mut Rng, kind: CostKind) -> SeparableCost<3> {
-    let ext = RotatedExtents {
-        x_max: rng.range(0.5, 3.0),
-        x_min: rng.range(-3.0, -0.5),
-        y_max: rng.range(0.5, 3.0),
-        y_min: rng.range(-3.0, -0.5),
-        center_of_gravity: DVec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(0.0, 2.0)),
-    };
+    let ext = common::random_extents(rng);
     let reference = DVec3::new(rng.range(-12.0, 12.0), rng.range(-12.0, 12.0), rng.range(-2.0, 2.0));
     match kind {
         CostKind::Weighted => stacking_cost(rng.range(0.05, 0.95), &ext, reference).expect("cost"),

@@ -33,6 +33,47 @@ impl Rng {
     }
 }
 
+/// A random unit normal: axis-aligned, vertical (horizontal normal) or general — the first two are the normal case
+/// for sheet metal.
+pub fn sheet_normal(rng: &mut Rng) -> [f64; 3] {
+    match rng.below(3) {
+        0 => {
+            let mut n = [0.0; 3];
+            n[rng.below(3)] = 1.0;
+            n
+        }
+        1 => {
+            let t = rng.range(0.0, std::f64::consts::TAU);
+            [t.cos(), t.sin(), 0.0]
+        }
+        _ => rng.unit3(),
+    }
+}
+
+/// The inequalities of the box `[lo, hi]` (tags 0..6: +x, -x, +y, -y, +z, -z).
+pub fn boxed(lo: [f64; 3], hi: [f64; 3]) -> Vec<Halfspace<3>> {
+    let mut hs = Vec::new();
+    for i in 0..3 {
+        let mut n = [0.0; 3];
+        n[i] = 1.0;
+        hs.push(Halfspace::new(n, hi[i], Tag::User(2 * i as u64)));
+        n[i] = -1.0;
+        hs.push(Halfspace::new(n, -lo[i], Tag::User(2 * i as u64 + 1)));
+    }
+    hs
+}
+
+/// Random rotated extents of a part for cost (1) (x and y spans around 0, a c.g. offset).
+pub fn random_extents(rng: &mut Rng) -> stackplan_freespace::RotatedExtents {
+    stackplan_freespace::RotatedExtents {
+        x_max: rng.range(0.5, 3.0),
+        x_min: rng.range(-3.0, -0.5),
+        y_max: rng.range(0.5, 3.0),
+        y_min: rng.range(-3.0, -0.5),
+        center_of_gravity: DVec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(0.0, 2.0)),
+    }
+}
+
 pub fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
@@ -70,19 +111,7 @@ pub fn random_cell(rng: &mut Rng, extra: usize, shape: Shape) -> Cell<3> {
         Shape::Edge => 2,
     };
     for _ in 0..pairs {
-        // sometimes axis-aligned or vertical planes, the normal case for sheet metal
-        let n = match rng.below(3) {
-            0 => {
-                let mut n = [0.0; 3];
-                n[rng.below(3)] = 1.0;
-                n
-            }
-            1 => {
-                let t = rng.range(0.0, std::f64::consts::TAU);
-                [t.cos(), t.sin(), 0.0]
-            }
-            _ => rng.unit3(),
-        };
+        let n = sheet_normal(rng);
         let d = dot(&n, &c);
         hs.push(Halfspace::new(n, d, Tag::User(hs.len() as u64)));
         hs.push(Halfspace::new(n.map(|x| -x), -d, Tag::User(hs.len() as u64)));
