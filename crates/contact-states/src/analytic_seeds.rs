@@ -48,46 +48,50 @@ pub fn edge_edge_candidates(
     let da = a1 - a0;
     let mut out = Vec::new();
     let (gx, gy, gz) = (grid(bounds, 3, angle_steps), grid(bounds, 4, angle_steps), grid(bounds, 5, angle_steps));
+    // the grid's rotations at which the two edges are not parallel, in the fixed order, with B's edge turned
+    let mut rotations: Vec<([f64; 3], Pose, DVec3)> = Vec::new();
     for &rx in &gx {
         for &ry in &gy {
             for &rz in &gz {
                 let pose = Pose::from_config(&[0.0, 0.0, 0.0, rx, ry, rz]);
                 let db = pose.apply_vector(b1 - b0);
-                if da.cross(db).length() <= 1e-6 * da.length() * db.length() {
+                if da.cross(db).length() > 1e-6 * da.length() * db.length() {
+                    rotations.push(([rx, ry, rz], pose, db));
+                }
+            }
+        }
+    }
+    for &([rx, ry, rz], ref pose, _) in &rotations {
+        for i in 0..edge_steps.max(1) {
+            let u = (i as f64 + 0.5) / edge_steps.max(1) as f64;
+            // x(s) = c + s da with c = a0 - R b(u)
+            let c = a0 - pose.apply(b0 + (b1 - b0) * u);
+            let (mut lo, mut hi) = (0.0f64, 1.0f64);
+            for k in 0..3 {
+                let (bmin, bmax) = (bounds.min[k], bounds.max[k]);
+                if da[k].abs() <= 1e-300 {
+                    if c[k] < bmin || c[k] > bmax {
+                        hi = -1.0;
+                    }
                     continue;
                 }
-                for i in 0..edge_steps.max(1) {
-                    let u = (i as f64 + 0.5) / edge_steps.max(1) as f64;
-                    // x(s) = c + s da with c = a0 - R b(u)
-                    let c = a0 - pose.apply(b0 + (b1 - b0) * u);
-                    let (mut lo, mut hi) = (0.0f64, 1.0f64);
-                    for k in 0..3 {
-                        let (bmin, bmax) = (bounds.min[k], bounds.max[k]);
-                        if da[k].abs() <= 1e-300 {
-                            if c[k] < bmin || c[k] > bmax {
-                                hi = -1.0;
-                            }
-                            continue;
-                        }
-                        let (s0, s1) = ((bmin - c[k]) / da[k], (bmax - c[k]) / da[k]);
-                        lo = lo.max(s0.min(s1));
-                        hi = hi.min(s0.max(s1));
-                    }
-                    // an interior crossing: strictly inside (0, 1), not at a vertex
-                    if hi <= lo || hi <= 0.0 || lo >= 1.0 {
-                        continue;
-                    }
-                    // the middle of the interval, and its ends (just inside): states that exist only against a
-                    // bound of the box (a thin region at x = x_max, say) are met at the ends
-                    let margin = 1e-6 * (hi - lo);
-                    for s in [0.5 * (lo + hi), lo.max(0.0) + margin, hi.min(1.0) - margin] {
-                        let x = c + da * s;
-                        let mut t = [x.x, x.y, x.z, rx, ry, rz];
-                        // rounding can leave the translation a hair outside a bound it lies on
-                        bounds.clamp(&mut t);
-                        out.push(t);
-                    }
-                }
+                let (s0, s1) = ((bmin - c[k]) / da[k], (bmax - c[k]) / da[k]);
+                lo = lo.max(s0.min(s1));
+                hi = hi.min(s0.max(s1));
+            }
+            // an interior crossing: strictly inside (0, 1), not at a vertex
+            if hi <= lo || hi <= 0.0 || lo >= 1.0 {
+                continue;
+            }
+            // the middle of the interval, and its ends (just inside): states that exist only against a
+            // bound of the box (a thin region at x = x_max, say) are met at the ends
+            let margin = 1e-6 * (hi - lo);
+            for s in [0.5 * (lo + hi), lo.max(0.0) + margin, hi.min(1.0) - margin] {
+                let x = c + da * s;
+                let mut t = [x.x, x.y, x.z, rx, ry, rz];
+                // rounding can leave the translation a hair outside a bound it lies on
+                bounds.clamp(&mut t);
+                out.push(t);
             }
         }
     }
@@ -95,22 +99,13 @@ pub fn edge_edge_candidates(
     // parameters free form a parallelogram; its part inside the box is a convex polygon in `(s, u)`, whose corners
     // put two bounds active at once (x at its maximum and z at its minimum, say), where the slivers of states that
     // exist only in a corner of the box lie
-    for &rx in &gx {
-        for &ry in &gy {
-            for &rz in &gz {
-                let pose = Pose::from_config(&[0.0, 0.0, 0.0, rx, ry, rz]);
-                let db = pose.apply_vector(b1 - b0);
-                if da.cross(db).length() <= 1e-6 * da.length() * db.length() {
-                    continue;
-                }
-                let c0 = a0 - pose.apply(b0);
-                for (s, u) in crossing_region_corners(da, db, c0, bounds) {
-                    let x = c0 + da * s - db * u;
-                    let mut t = [x.x, x.y, x.z, rx, ry, rz];
-                    bounds.clamp(&mut t);
-                    out.push(t);
-                }
-            }
+    for &([rx, ry, rz], ref pose, db) in &rotations {
+        let c0 = a0 - pose.apply(b0);
+        for (s, u) in crossing_region_corners(da, db, c0, bounds) {
+            let x = c0 + da * s - db * u;
+            let mut t = [x.x, x.y, x.z, rx, ry, rz];
+            bounds.clamp(&mut t);
+            out.push(t);
         }
     }
     out
