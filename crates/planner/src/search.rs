@@ -274,6 +274,9 @@ struct Search<'r, 'a> {
     obstacle_ids: HashMap<(usize, usize, usize), u32>,
     /// The obstacles built (or taken from the shared caches) for each orientation, in order.
     by_orientation: Vec<Vec<u32>>,
+    /// Per orientation, the (moving, stack component) pairs whose derived obstacle an earlier search of the plan
+    /// built (indexed once per search; taken when the orientation is first expanded).
+    shared_pairs: Vec<Vec<(usize, usize)>>,
     axes: AxesCache,
     intervals: IntervalObstacles,
     stats: PlacementStats,
@@ -412,6 +415,13 @@ pub fn place_with_caches(
         stack: scene.components.iter().map(|c| c.placed.vertices.clone()).collect(),
     });
     let n_orientations = orientations.len();
+    // the pairs earlier searches built, by orientation (one pass over the shared derived obstacles)
+    let mut shared_pairs = vec![Vec::new(); n_orientations];
+    for &(oi, moving, fixed) in caches.derived.keys() {
+        if let Some(list) = shared_pairs.get_mut(oi) {
+            list.push((moving, fixed));
+        }
+    }
     let mut search = Search {
         request,
         orientations,
@@ -422,6 +432,7 @@ pub fn place_with_caches(
         obstacles: Vec::new(),
         obstacle_ids: HashMap::new(),
         by_orientation: vec![Vec::new(); n_orientations],
+        shared_pairs,
         axes: std::mem::take(&mut caches.axes),
         derived: std::mem::take(&mut caches.derived),
         intervals: std::mem::take(&mut caches.intervals),
@@ -567,12 +578,7 @@ impl Search<'_, '_> {
                 }
                 // the obstacles earlier searches of the plan built at this orientation are known at once (their
                 // stack parts have not moved), in a fixed order
-                let mut shared: Vec<(usize, usize)> = self
-                    .derived
-                    .keys()
-                    .filter(|(oi, _, _)| *oi == node.orientation)
-                    .map(|&(_, moving, fixed)| (moving, fixed))
-                    .collect();
+                let mut shared = std::mem::take(&mut self.shared_pairs[node.orientation]);
                 shared.sort_unstable();
                 for (moving, fixed) in shared {
                     self.obstacle_id(node.orientation, moving, fixed)?;
@@ -586,11 +592,10 @@ impl Search<'_, '_> {
             let mut cutting: Option<u32> = {
                 let mut best: Option<(f64, u32)> = None;
                 for &id in &self.by_orientation[node.orientation] {
-                    if node.applied.contains(&id) {
-                        continue;
-                    }
+                    // the interior test exits at the first plane p* is outside of: cheaper than the path lookup
                     if let Some(depth) = self.obstacles[id as usize].interior_depth(p, tol)
                         && best.is_none_or(|(d, _)| depth > d)
+                        && !node.applied.contains(&id)
                     {
                         best = Some((depth, id));
                     }
