@@ -22,8 +22,16 @@
 //! tolerance are the same direction: the faces are parallel and give ONE merged face (exactly what prisms and boxes
 //! produce all the time). A face polygon is built from the generating features: a face of `B` translated by a vertex
 //! keeps `B`'s vertex cycle, a face of `A` keeps `A`'s (reversed by the point reflection), an edge pair gives a
-//! parallelogram; only the degenerate merged faces need a 2-D convex sum (a hull of at most `|F| * |G|` labelled points
-//! in the face plane, with collinear points on merged parallel edges removed).
+//! parallelogram; only the degenerate merged faces need a 2-D convex sum `F + G` of the two generating polygons (a face,
+//! or an edge as a 2-gon). It is the classic O(|F| + |G|) merge of the two edge sequences by angle (the edges of a sum
+//! of convex polygons are the summands' edges in angular order), on vertex labels, without coordinates: an edge of `F`
+//! and an edge of `G` are ONE edge of the sum (their middle corner is not a corner) when the faces across them are
+//! merged too, or when their unit directions point the same way within half the tolerance (`|c_a x c_b| <= tol / 2`,
+//! the threshold of merged face normals, so that a rotation about a face normal by less than it merges the faces and
+//! their edges alike). Every other decision of the merge is the sign of `(v x w) . u` for two edge directions that
+//! are not parallel, which rounding cannot flip. (Until session 13 this was a labelled 2-D hull of the `|F| |G|`
+//! rounded sum points with duplicates and corners within a *length* tolerance removed; on every input away from the
+//! tolerance band both give the same faces, see `BENCHMARKS.md`.)
 //!
 //! Why a tolerance and not exact predicates: the input to this step is a *rotated* polytope whose coordinates are
 //! already rounded (`cos(pi / 2)` is not 0 in `f64`), so exact parallelism of a rotated face with a fixed one cannot be
@@ -38,15 +46,14 @@
 //!
 //! Complexity: O(FA FB + EA EB + (FA + FB)(EA + EB) + output); the pair loops are a few flops each, which for the
 //! small components of sheet-metal parts beats the O(nA + nB + output) sweep of a true overlay (CGAL's
-//! `Gaussian_map`). The face count is at most `4 m n - 9 m - 9 n + 26` for `m` and `n` facets.
+//! `Gaussian_map`); each merged face costs O(|F| + |G|). The face count is at most `4 m n - 9 m - 9 n + 26` for `m`
+//! and `n` facets.
 
-use glam::{DMat3, DVec2, DVec3};
+use glam::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
 use stackplan_geom::polytope::{Containment, ConvexPolytope, Face, Plane, PolytopeError};
-use stackplan_geom::predicates::orient2d;
 use stackplan_geom::tolerance::{RELATIVE, Tolerance};
 use stackplan_geom::{HullError, convex_hull};
-use std::cmp::Ordering;
 
 /// Angular tolerance (radians) of the Gauss-map decisions: a face normal within this of an arc's circle lies on it;
 /// two face normals within half of it are the same direction.
@@ -494,14 +501,13 @@ fn overlay(
     let (s_ab, s_ba) = (&*s_ab, &*s_ba);
 
     // parallel faces: merged_with_b[f] = Some(g) when -R n_f == n_g within half the tolerance.
-    let merge_sq = (0.5 * ANGULAR_TOLERANCE) * (0.5 * ANGULAR_TOLERANCE);
     merged_with_b.clear();
     merged_with_b.resize(fa, None);
     merged_with_a.clear();
     merged_with_a.resize(fb, None);
     for (f, m) in am.iter().enumerate() {
         for (g, n) in bn.iter().enumerate() {
-            if (*m - *n).length_squared() <= merge_sq {
+            if (*m - *n).length_squared() <= PARALLEL_SQ {
                 merged_with_b[f] = Some(g);
                 merged_with_a[g] = Some(f);
             }
@@ -572,7 +578,7 @@ fn overlay(
             faces.push(FaceSpec { normal: x.normalize(), fixed: Feature::Edge(eb), moving: Feature::Edge(ea) });
         }
     }
-    let buffers = AssemblyBuffers { index_of, cycle, planar };
+    let buffers = AssemblyBuffers { index_of, cycle, planar, merged_with_b };
     assemble(moving, fixed, rotation, ra, a_arcs, b_arcs, faces, buffers)
 }
 
@@ -595,33 +601,65 @@ fn argmax(points: &[DVec3], u: DVec3) -> usize {
     best
 }
 
-/// Vertex indices of a feature into `out` (cleared first), as a counter-clockwise cycle about the feature's outward
-/// normal for a face of `p` (reversed when `reflect`, for `-RA`), the two ends for an edge, the vertex itself.
-fn feature_vertices(p: &ConvexPolytope, feature: Feature, arcs: &[Arc], reflect: bool, out: &mut Vec<usize>) {
-    out.clear();
+/// The polygon of a feature of a merged face into `(vertices, edges)` (cleared first): a face's vertex cycle,
+/// counter-clockwise about its outward normal (reversed when `reflect`, for `-RA`, whose faces are the point
+/// reflections of `A`'s), with the edge from corner `k` to corner `k + 1`; an edge as the 2-gon `[v0, v1]` whose two
+/// sides are both that edge. Not called for vertices.
+fn feature_polygon(
+    p: &ConvexPolytope,
+    feature: Feature,
+    arcs: &[Arc],
+    reflect: bool,
+    scratch: (&mut Vec<usize>, &mut Vec<usize>, &mut Vec<usize>),
+) {
+    let (vertices, edges, across) = scratch;
+    vertices.clear();
+    edges.clear();
+    across.clear();
     match feature {
-        Feature::Vertex(v) => out.push(v),
-        Feature::Edge(e) => out.extend_from_slice(&arcs[e].vertices),
+        Feature::Vertex(v) => vertices.push(v),
+        Feature::Edge(e) => {
+            vertices.extend_from_slice(&arcs[e].vertices);
+            edges.extend_from_slice(&[e, e]);
+            across.extend_from_slice(&[usize::MAX, usize::MAX]);
+        }
         Feature::Face(f) => {
-            out.extend_from_slice(&p.faces()[f].vertices);
+            let cycle = &p.faces()[f].vertices;
+            let face_edges = p.face_edges(f);
             if reflect {
-                out.reverse();
+                // reversed cycle: corner k is cycle[n - 1 - k]; the edge to corner k + 1 joins cycle[n - 1 - k] and
+                // cycle[n - 2 - k], i.e. face_edges[n - 2 - k]; the closing edge joins cycle[0] and cycle[n - 1]
+                let n = cycle.len();
+                vertices.extend(cycle.iter().rev());
+                edges.extend(face_edges[..n - 1].iter().rev());
+                edges.push(face_edges[n - 1]);
+            } else {
+                vertices.extend_from_slice(cycle);
+                edges.extend_from_slice(face_edges);
             }
+            across.extend(edges.iter().map(|&e| {
+                let [f0, f1] = p.edges()[e].faces;
+                if f0 == f { f1 } else { f0 }
+            }));
         }
     }
 }
 
-/// A labelled point of a planar sum: its coordinates in the face plane and the vertex pair `[i, j]`.
-type Labelled = (f64, f64, [usize; 2]);
-
-/// Buffers reused by every merged face (no allocation per face).
+/// Buffers reused by every merged face (no allocation per face): the two polygons of a planar sum as vertex cycles
+/// with the edge index of every polygon edge and its direction.
 #[derive(Default)]
 struct PlanarScratch {
-    is: Vec<usize>,
-    js: Vec<usize>,
-    points: Vec<Labelled>,
-    unique: Vec<Labelled>,
-    hull: Vec<Labelled>,
+    /// `B`'s polygon: vertices of `B`, edge `k` from `pj[k]` to `pj[k + 1]` is `B`'s edge `pe[k]`, direction `pd[k]`.
+    pj: Vec<usize>,
+    pe: Vec<usize>,
+    pd: Vec<DVec3>,
+    /// The face of `B` across edge `pe[k]` from `B`'s polygon (`usize::MAX` when the polygon is an edge).
+    pn: Vec<usize>,
+    /// `-RA`'s polygon likewise (vertices of `A`, edges of `A`, directions of `-RA`).
+    qi: Vec<usize>,
+    qe: Vec<usize>,
+    qd: Vec<DVec3>,
+    qn: Vec<usize>,
 }
 
 /// The scratch buffers [`assemble`] works in.
@@ -631,6 +669,8 @@ struct AssemblyBuffers<'a> {
     /// The vertex-pair cycle of the face being built.
     cycle: &'a mut Vec<[usize; 2]>,
     planar: &'a mut PlanarScratch,
+    /// `merged_with_b[f] = Some(g)`: face `f` of `-RA` and face `g` of `B` are parallel (one face of the sum).
+    merged_with_b: &'a [Option<usize>],
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -644,7 +684,7 @@ fn assemble(
     specs: &[FaceSpec],
     buffers: AssemblyBuffers<'_>,
 ) -> Result<Obstacle, OverlayFailure> {
-    let AssemblyBuffers { index_of, cycle, planar: scratch } = buffers;
+    let AssemblyBuffers { index_of, cycle, planar: scratch, merged_with_b } = buffers;
     let bv = fixed.vertices();
     let nb = bv.len();
     index_of.clear();
@@ -675,12 +715,11 @@ fn assemble(
                 }
             }
             (fixed_feature, moving_feature) => {
-                let mut is = std::mem::take(&mut scratch.is);
-                let mut js = std::mem::take(&mut scratch.js);
-                feature_vertices(fixed, fixed_feature, b_arcs, false, &mut js);
-                feature_vertices(moving, moving_feature, a_arcs, true, &mut is);
-                planar_sum(&is, &js, ra, bv, spec.normal, scratch, cycle);
-                (scratch.is, scratch.js) = (is, js);
+                let (pj, pe, pn) = (&mut scratch.pj, &mut scratch.pe, &mut scratch.pn);
+                feature_polygon(fixed, fixed_feature, b_arcs, false, (pj, pe, pn));
+                let (qi, qe, qn) = (&mut scratch.qi, &mut scratch.qe, &mut scratch.qn);
+                feature_polygon(moving, moving_feature, a_arcs, true, (qi, qe, qn));
+                planar_merge(ra, bv, a_arcs, b_arcs, merged_with_b, spec.normal, scratch, cycle);
             }
         }
         if cycle.len() < 3 {
@@ -710,134 +749,92 @@ fn assemble(
     Ok(Obstacle { polytope, vertex_pairs, face_kinds: kinds, rotation, route: Route::GaussMap })
 }
 
-/// The error-bound factor of the floating-point stage of `robust::orient2d` (Shewchuk's predicate in the form of
-/// Ozaki et al., `theta = 3u - (phi - 22) u^2` for `f64`): `|det| >= theta * (|detleft + detright|)` proves the sign.
-const ORIENT2D_FILTER: f64 = 3.3306690621773722e-16;
-
-/// Sorts labelled points by `(x, y)` numerically, stably (equal points keep their order): the same permutation as a
-/// stable library sort with that comparison, by insertion sort, which is fastest for the few points of a face.
-/// The points must not be NaN.
-fn sort_xy(points: &mut [Labelled]) {
-    for i in 1..points.len() {
-        let p = points[i];
-        let mut k = i;
-        while k > 0 && (points[k - 1].0 > p.0 || (points[k - 1].0 == p.0 && points[k - 1].1 > p.1)) {
-            points[k] = points[k - 1];
-            k -= 1;
-        }
-        points[k] = p;
-    }
+/// Whether the edge directions `ca` (a unit edge direction of `-RA`) and `cb` (of `B`) are parallel: the sine of
+/// their angle is at most half the angular tolerance, the threshold at which two face normals are one direction.
+#[inline]
+fn parallel_edges(ca: DVec3, cb: DVec3) -> bool {
+    ca.cross(cb).length_squared() <= PARALLEL_SQ
 }
 
-/// Convex polygon `sum_{i in is, j in js} (b_j - R a_i)` in the plane orthogonal to `normal`, counter-clockwise about
-/// `normal`, as labelled corners (collinear points on merged parallel edges dropped). Andrew's monotone chain on at
-/// most `|is| |js|` points, with the angular tolerance for collinearity.
-fn planar_sum(
-    is: &[usize],
-    js: &[usize],
+/// `(ANGULAR_TOLERANCE / 2)^2`: the squared sine below which two edge directions are parallel, and the squared
+/// distance below which two unit face normals are the same direction.
+const PARALLEL_SQ: f64 = (0.5 * ANGULAR_TOLERANCE) * (0.5 * ANGULAR_TOLERANCE);
+
+/// The convex polygon `F + G` of a merged face with outward normal `normal`, where `F` is `B`'s polygon
+/// (`scratch.pj`/`pe`) and `G` is `-RA`'s (`scratch.qi`/`qe`), both counter-clockwise about `normal` (a face, or an
+/// edge as a 2-gon), as the vertex-pair cycle of its corners into `out`, counter-clockwise about `normal`.
+///
+/// The classic O(|F| + |G|) merge of the two edge sequences by angle (the sum's edges are the summands' edges in
+/// angular order): starting at `F`'s edge 0 and the corner of `G` whose outgoing edge comes first at or after it, the
+/// walk advances in the polygon whose next edge turns first. An edge of `F` and an edge of `G` that point the same way
+/// within the tolerance ([`parallel_edges`] on the unit edge directions: the same test for the same pair of edges in
+/// every face, so neighbouring faces agree) are one edge of the sum: both advance and their middle corner is not a
+/// corner. All other order decisions are signs of `(v x w) . normal` for non-parallel `v`, `w`, which the rounding of
+/// the inputs cannot flip. No coordinates are sorted or compared, so no length tolerance enters.
+fn planar_merge(
     ra: &[DVec3],
     bv: &[DVec3],
+    a_arcs: &[Arc],
+    b_arcs: &[Arc],
+    merged_with_b: &[Option<usize>],
     normal: DVec3,
     scratch: &mut PlanarScratch,
     out: &mut Vec<[usize; 2]>,
 ) {
-    let (e1, _) = normal.any_orthonormal_pair();
-    let e2 = normal.cross(e1);
-    let pts = &mut scratch.points;
-    pts.clear();
-    let mut any_nan = false;
-    for &i in is {
-        for &j in js {
-            let p = bv[j] - ra[i];
-            let (x, y) = (p.dot(e1), p.dot(e2));
-            any_nan |= x.is_nan() || y.is_nan();
-            pts.push((x, y, [i, j]));
-        }
-    }
-    // numeric order (not total_cmp: -0.0 and 0.0 must tie, or the chain loses its lexicographic order)
-    // (stable: equal points keep their generation order, so the label kept for a duplicate is deterministic)
-    if any_nan {
-        pts.sort_by(|a, b| {
-            a.0.partial_cmp(&b.0).unwrap_or(Ordering::Equal).then(a.1.partial_cmp(&b.1).unwrap_or(Ordering::Equal))
-        });
-    } else {
-        sort_xy(pts);
-    }
-    // Length tolerance of the policy on the polygon's extent: points closer than it are the same point (sums of
-    // parallel features coincide up to rounding), and a point within it of a hull edge lies on that edge.
-    let (mut lo, mut hi) = ((f64::INFINITY, f64::INFINITY), (f64::NEG_INFINITY, f64::NEG_INFINITY));
-    for p in pts.iter() {
-        lo = (lo.0.min(p.0), lo.1.min(p.1));
-        hi = (hi.0.max(p.0), hi.1.max(p.1));
-    }
-    let lin = RELATIVE * ((hi.0 - lo.0) * (hi.0 - lo.0) + (hi.1 - lo.1) * (hi.1 - lo.1)).sqrt();
-    let lin_sq = lin * lin;
-    let unique = &mut scratch.unique;
-    unique.clear();
-    for p in pts.iter() {
-        // `unique` is sorted by x like `pts`: only its tail within `lin` in x can hold a duplicate of `p`
-        let duplicate = unique
-            .iter()
-            .rev()
-            .take_while(|q| q.0 >= p.0 - lin)
-            .any(|q| (p.0 - q.0) * (p.0 - q.0) + (p.1 - q.1) * (p.1 - q.1) <= lin_sq);
-        if !duplicate {
-            unique.push(*p);
-        }
-    }
-    let pts = &*unique;
-
-    // strictly left of the directed line o -> b by more than `lin`
-    let turns_left = |o: &Labelled, a: &Labelled, b: &Labelled| {
-        let (ax, ay, bx, by) = (a.0 - o.0, a.1 - o.1, b.0 - o.0, b.1 - o.1);
-        // o -> a -> b turns left and a is farther than `lin` from the line o -> b
-        ax * by - ay * bx > lin * (bx * bx + by * by).sqrt()
+    let PlanarScratch { pj, pe, pd, pn, qi, qe, qd, qn } = scratch;
+    let (m, n) = (pj.len(), qi.len());
+    pd.clear();
+    pd.extend((0..m).map(|k| bv[pj[if k + 1 == m { 0 } else { k + 1 }]] - bv[pj[k]]));
+    qd.clear();
+    // -RA's vertices are -ra: the edge from corner l to l + 1 is ra[l] - ra[l + 1]
+    qd.extend((0..n).map(|l| ra[qi[l]] - ra[qi[if l + 1 == n { 0 } else { l + 1 }]]));
+    // one edge of the sum: the faces across both edges are merged (then so are the edges, whatever their rounded
+    // directions say: the neighbouring merged face decides the same way), or the directions are parallel
+    let same = |k: usize, l: usize| {
+        let (across_b, across_a) = (pn[k], qn[l]);
+        (across_a != usize::MAX && across_b != usize::MAX && merged_with_b[across_a] == Some(across_b))
+            || (parallel_edges(a_arcs[qe[l]].circle, b_arcs[pe[k]].circle) && pd[k].dot(qd[l]) > 0.0)
     };
-    // the chain itself uses the exact orientation predicate (a tolerance inside the chain loses corners when nearly
-    // collinear points come in non-monotone order); near-collinear corners are removed afterwards
-    // (the floating-point filter of Shewchuk's orient2d inline, as `robust` does it: where it decides, the sign of
-    // `det` is the exact sign; elsewhere the exact predicate)
-    let exact_left = |o: &Labelled, a: &Labelled, b: &Labelled| {
-        let detleft = (o.0 - b.0) * (a.1 - b.1);
-        let detright = (o.1 - b.1) * (a.0 - b.0);
-        let det = detleft - detright;
-        let errbound = ORIENT2D_FILTER * (detleft + detright).abs();
-        if det >= errbound || -det >= errbound {
-            det > 0.0
-        } else {
-            orient2d(DVec2::new(o.0, o.1), DVec2::new(a.0, a.1), DVec2::new(b.0, b.1)) == Ordering::Greater
-        }
+    // angular order relative to r = F's edge 0: the half (0 for angles in [0, pi), 1 for [pi, 2 pi)), then the turn
+    let r = pd[0];
+    let half = |v: DVec3| {
+        let s = r.cross(v).dot(normal);
+        u8::from(!(s > 0.0 || (s == 0.0 && r.dot(v) > 0.0)))
     };
-    let hull = &mut scratch.hull;
-    hull.clear();
-    for p in pts.iter() {
-        while hull.len() >= 2 && !exact_left(&hull[hull.len() - 2], &hull[hull.len() - 1], p) {
-            hull.pop();
+    let before = |v: DVec3, w: DVec3| {
+        let (hv, hw) = (half(v), half(w));
+        hv < hw || (hv == hw && v.cross(w).dot(normal) > 0.0)
+    };
+    // G's first edge: parallel to r, else the first in angular order
+    let mut l0 = 0;
+    if !same(0, 0) {
+        for l in 1..n {
+            if same(0, l) {
+                l0 = l;
+                break;
+            }
+            if before(qd[l], qd[l0]) {
+                l0 = l;
+            }
         }
-        hull.push(*p);
     }
-    let lower = hull.len() + 1;
-    for p in pts.iter().rev().skip(1) {
-        while hull.len() >= lower && !exact_left(&hull[hull.len() - 2], &hull[hull.len() - 1], p) {
-            hull.pop();
-        }
-        hull.push(*p);
-    }
-    hull.pop();
-    // The chain's first point is never tested; drop any corner (the first one included) within `lin` of the line
-    // through its neighbours.
-    let mut k = 0;
-    while hull.len() > 3 && k < hull.len() {
-        let n = hull.len();
-        let (before, after) = (if k == 0 { n - 1 } else { k - 1 }, if k + 1 == n { 0 } else { k + 1 });
-        if turns_left(&hull[before], &hull[k], &hull[after]) {
+    let (mut k, mut l) = (0, 0);
+    while k < m || l < n {
+        let lq = if l0 + l >= n { l0 + l - n } else { l0 + l };
+        out.push([qi[lq], pj[if k == m { 0 } else { k }]]);
+        if k == m {
+            l += 1;
+        } else if l == n {
+            k += 1;
+        } else if same(k, lq) {
+            k += 1;
+            l += 1;
+        } else if before(pd[k], qd[lq]) {
             k += 1;
         } else {
-            hull.remove(k);
-            k = k.saturating_sub(1);
+            l += 1;
         }
     }
-    out.extend(hull.iter().map(|h| h.2));
 }
 
 #[cfg(test)]
@@ -896,31 +893,5 @@ mod tests {
         assert!(other.polytope().vertices().len() > first.polytope().vertices().len());
         let again = gauss_map_obstacle(&a, r, &b).expect("obstacle");
         assert_eq!(format!("{first:?}"), format!("{again:?}"));
-    }
-
-    #[test]
-    fn insertion_sort_of_points_is_the_stable_library_sort() {
-        // many ties, both zeros, infinities: the permutation must be the stable sort's
-        let values = [-1.0, -0.0, 0.0, 0.5, 1.0, f64::INFINITY, f64::NEG_INFINITY];
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        for n in 0..40 {
-            let points: Vec<Labelled> = (0..n)
-                .map(|k| {
-                    state ^= state << 13;
-                    state ^= state >> 7;
-                    state ^= state << 17;
-                    let (x, y) = (values[(state % 7) as usize], values[((state >> 8) % 7) as usize]);
-                    (x, y, [k, n])
-                })
-                .collect();
-            let mut expected = points.clone();
-            expected.sort_by(|a, b| {
-                a.0.partial_cmp(&b.0).unwrap_or(Ordering::Equal).then(a.1.partial_cmp(&b.1).unwrap_or(Ordering::Equal))
-            });
-            let mut got = points;
-            sort_xy(&mut got);
-            let bits = |v: &[Labelled]| v.iter().map(|p| (p.0.to_bits(), p.1.to_bits(), p.2)).collect::<Vec<_>>();
-            assert_eq!(bits(&got), bits(&expected), "n = {n}");
-        }
     }
 }
