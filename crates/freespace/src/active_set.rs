@@ -315,6 +315,12 @@ struct Subspace {
 
 impl Subspace {
     fn new(prob: &Problem<'_>, w: &WorkSet) -> Self {
+        Self::build(prob, w, true)
+    }
+
+    /// The split of the null space of `w`; `lp_shortcut`: take the bit-identical shortcut for a linear objective
+    /// (`false` only in the test that checks it).
+    fn build(prob: &Problem<'_>, w: &WorkSet, lp_shortcut: bool) -> Self {
         let n = prob.n;
         let mut rows = Basis::new();
         for &j in w.as_slice() {
@@ -334,6 +340,17 @@ impl Subspace {
         if (0..n).all(|i| prob.h[i] > 0.0) {
             // strictly convex: no flat directions, the whole null space is curved
             return Self::with_bases(prob, Basis::new(), null);
+        }
+        if lp_shortcut && (0..n).all(|i| prob.h[i] == 0.0) {
+            // a linear objective (every LP of the crate): no curved coordinate, the whole null space is flat. The
+            // general construction below would take the complement of an empty basis in t-space (the identity) and
+            // lift it, `0 + 1 * v_k` plus zero products: `v_k` itself except that a `-0.0` becomes `+0.0`. This is
+            // that result, bit for bit, without the Gram-Schmidt work.
+            let mut flat = null;
+            for v in &mut flat.v[..flat.len] {
+                *v = v.map(|c| c + 0.0);
+            }
+            return Self { flat, curved: Basis::new(), chol: [[0.0; MAX_N]; MAX_N] };
         }
         // rows of the null-space basis matrix restricted to the curved coordinates, in t-space
         let mut curved_t = Basis::new();
@@ -1089,6 +1106,41 @@ mod tests {
     }
 
     proptest::proptest! {
+        /// The linear-objective shortcut of `Subspace::new` gives the general construction's bases bit for bit, for
+        /// working sets of 0..=n rows (random, duplicate, opposite and nearly parallel rows), in 2, 3 and 4
+        /// variables (the Chebyshev LP has 4).
+        #[test]
+        fn lp_subspace_shortcut_is_bit_identical(
+            seed in proptest::prelude::any::<u64>(), n in 2usize..5, kind in 0u8..4, k in 0usize..5,
+        ) {
+            let (mut rows, b, _, g, _) = random_problem(seed, n, kind, 6);
+            // a row nearly parallel to the first cut, and exact zeros of both signs
+            let mut near = rows[2 * n];
+            near[0] += 1e-9;
+            rows.push(near);
+            let mut signed = rows[0].map(|c| if c == 0.0 { -0.0 } else { c });
+            signed[n - 1] = -0.0;
+            rows.push(signed);
+            let offsets: Vec<f64> = b.iter().copied().chain([0.0, 0.0]).collect();
+            let prob = Problem { n, rows: &rows, offsets: &offsets, mask: None, h: [0.0; MAX_N], g, tie: [2, 1, 0, 3], length_scale: 1.0 };
+            let mut w = WorkSet::default();
+            let mut pick = seed;
+            for _ in 0..k.min(n) {
+                pick = pick.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+                let j = (pick >> 33) as usize % rows.len();
+                if !w.contains(j) {
+                    w.push(j);
+                }
+            }
+            let fast = Subspace::build(&prob, &w, true);
+            let general = Subspace::build(&prob, &w, false);
+            let bits = |b: &Basis| b.vectors().iter().map(|v| v.map(f64::to_bits)).collect::<Vec<_>>();
+            proptest::prop_assert_eq!(bits(&fast.flat), bits(&general.flat));
+            proptest::prop_assert_eq!(bits(&fast.curved), bits(&general.curved));
+            let chol_bits = |s: &Subspace| s.chol.map(|r| r.map(f64::to_bits));
+            proptest::prop_assert_eq!(chol_bits(&fast), chol_bits(&general));
+        }
+
         /// The closed-form path on its own (no fallback): it must finish, and agree with the general method.
         #[test]
         fn strictly_convex_path_agrees_with_the_general_method(

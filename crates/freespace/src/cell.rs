@@ -296,12 +296,25 @@ impl<const D: usize> Cell<D> {
         if self.is_empty() {
             return Ok(true);
         }
+        // the row, offset and mask lists live in a per-thread scratch (no allocation per call once warm)
+        let mut scratch = Scratch::take();
+        let result = self.is_empty_with_in(extra, start, &mut scratch);
+        scratch.put_back();
+        result
+    }
+
+    /// [`Cell::is_empty_with`] with its lists in `scratch`.
+    fn is_empty_with_in(
+        &self,
+        extra: impl IntoIterator<Item = Halfspace<D>>,
+        start: &[f64; D],
+        scratch: &mut Scratch,
+    ) -> Result<bool, CellError> {
         let tol = self.tolerance.linear;
         let first_extra = self.rows.len();
-        let mut rows = Vec::with_capacity(first_extra + 8);
+        let Scratch { rows, offsets: grown, mask } = scratch;
         rows.extend_from_slice(&self.rows);
         // the grown cell's offsets
-        let mut grown: Vec<f64> = Vec::with_capacity(first_extra + 8);
         grown.extend(self.offsets.iter().map(|b| b + tol));
         for (k, h) in extra.into_iter().enumerate() {
             if !h.offset.is_finite() || h.normal.iter().any(|c| !c.is_finite()) {
@@ -315,10 +328,11 @@ impl<const D: usize> Cell<D> {
                 return Ok(true);
             }
         }
+        let (rows, grown) = (&rows[..], &grown[..]);
         let m = rows.len();
         let mut point = to_v4(start);
         let satisfied_at = |j: usize, p: &V4| dot4(&rows[j], p) <= grown[j];
-        let mut mask: Vec<bool> = (0..m).map(|j| satisfied_at(j, &point)).collect();
+        mask.extend((0..m).map(|j| satisfied_at(j, &point)));
         for j in 0..m {
             if mask[j] {
                 continue;
@@ -329,9 +343,9 @@ impl<const D: usize> Cell<D> {
             }
             let prob = Problem {
                 n: D,
-                rows: &rows,
-                offsets: &grown,
-                mask: Some(&mask),
+                rows,
+                offsets: grown,
+                mask: Some(&mask[..]),
                 h: [0.0; MAX_N],
                 g: rows[j],
                 tie: default_tie(D),
@@ -438,10 +452,18 @@ impl<const D: usize> Cell<D> {
     }
 
     fn chebyshev(&self) -> Result<CellShape<D>, CellError> {
+        // the LP's rows live in a per-thread scratch (no allocation per call once warm)
+        let mut scratch = Scratch::take();
+        let result = self.chebyshev_in(&mut scratch);
+        scratch.put_back();
+        result
+    }
+
+    /// [`Cell::chebyshev`] with its rows in `scratch`.
+    fn chebyshev_in(&self, scratch: &mut Scratch) -> Result<CellShape<D>, CellError> {
         let tol = self.tolerance.linear;
         let cap = 1e6 * self.length_scale();
-        let mut rows = Vec::with_capacity(self.rows.len() + 1);
-        let mut offsets = Vec::with_capacity(self.rows.len() + 1);
+        let Scratch { rows, offsets, .. } = scratch;
         let mut r0 = cap;
         for (row, &b) in self.rows.iter().zip(&self.offsets) {
             let mut r = *row;
@@ -458,8 +480,8 @@ impl<const D: usize> Cell<D> {
         g[D] = -1.0;
         let prob = Problem {
             n: D + 1,
-            rows: &rows,
-            offsets: &offsets,
+            rows,
+            offsets,
             mask: None,
             h: [0.0; MAX_N],
             g,
@@ -495,6 +517,33 @@ impl<const D: usize> Cell<D> {
             }
         }
         Ok(())
+    }
+}
+
+/// Per-thread lists for the LPs of a cell (rows, offsets, mask), reused between calls so that the hot paths
+/// ([`Cell::is_empty_with`], the Chebyshev LP of every new cell) allocate nothing once warm. Taken out of the
+/// thread-local slot for the duration of a call and put back cleared, so a nested call simply finds an empty one.
+#[derive(Default)]
+struct Scratch {
+    rows: Vec<V4>,
+    offsets: Vec<f64>,
+    mask: Vec<bool>,
+}
+
+thread_local! {
+    static SCRATCH: std::cell::Cell<Scratch> = std::cell::Cell::new(Scratch::default());
+}
+
+impl Scratch {
+    fn take() -> Self {
+        SCRATCH.with(std::cell::Cell::take)
+    }
+
+    fn put_back(mut self) {
+        self.rows.clear();
+        self.offsets.clear();
+        self.mask.clear();
+        SCRATCH.with(|s| s.set(self));
     }
 }
 
