@@ -634,6 +634,139 @@ impl Problem<'_> {
         Err(ActiveSetError::IterationLimit { limit })
     }
 
+    /// [`Problem::seek`] for a linear objective in 2 or 3 variables with the linear algebra in closed form: the
+    /// same iteration (same start, working-set rules, ratio test, level test, multiplier test and anti-cycling) but
+    /// the move is minus the projection of `g` on the null space of the working rows, `-g` (no row),
+    /// `-(g - (g . a) a / |a|^2)` (one row in 3-D), `-(g . z) z / |z|^2` on a line `z = a_1 x a_2` (two rows in 3-D;
+    /// `a_1` turned by 90 degrees in 2-D), none at a vertex; the multipliers come from
+    /// [`Problem::multipliers`] (a Gram system of order <= 2 or Cramer's rule). No Gram-Schmidt split, no Cholesky
+    /// factors: O(m) per iteration (the ratio test) plus O(1).
+    ///
+    /// Rounding differs from [`Problem::seek`] in the last bits, so the point returned may too; its *decision*
+    /// (level reached or not) is the same except when the minimum is within rounding of the target. `None` (the
+    /// caller then runs [`Problem::seek`]) when the path does not apply (`h != 0`, `n` not 2 or 3), a system is
+    /// numerically singular, or the iteration limit is reached.
+    pub(crate) fn seek_small(&self, start: V4, target: f64) -> Option<Seek> {
+        let n = self.n;
+        if !(2..=3).contains(&n) || self.h.iter().any(|&x| x != 0.0) {
+            return None;
+        }
+        let m = self.rows.len();
+        let bland_after = 4 * m + 20;
+        let limit = 40 * (m + 5);
+        let flat_tol = 1e-10 * self.gradient_scale();
+        let mult_tol = MULT_TOL * self.gradient_scale();
+        let g = self.g;
+        let mut p = start;
+        let mut w = WorkSet::default();
+        let mut banned: Vec<usize> = Vec::new();
+        let mut last_dropped: Option<usize> = None;
+        for iter in 0..limit {
+            let level = dot4(&g, &p);
+            if level <= target {
+                return Some(Seek::Reached(p));
+            }
+            let dir = self.lp_projected_descent(&w)?;
+            let len = norm4(&dir);
+            if !len.is_finite() {
+                return None;
+            }
+            if len <= flat_tol {
+                // stationary: drop the most negative multiplier (Bland's rule late), or stop at the minimum
+                let lambda = self.multipliers(&w, &g)?;
+                let bland = iter >= bland_after;
+                let mut choice: Option<usize> = None;
+                for a in 0..w.len {
+                    if lambda[a] < -mult_tol && !banned.contains(&w.idx[a]) {
+                        choice = match choice {
+                            None => Some(a),
+                            Some(c) => {
+                                let better = if bland { w.idx[a] < w.idx[c] } else { lambda[a] < lambda[c] };
+                                Some(if better { a } else { c })
+                            }
+                        };
+                    }
+                }
+                match choice {
+                    Some(a) => {
+                        last_dropped = Some(w.idx[a]);
+                        w.remove_at(a);
+                        continue;
+                    }
+                    None => return Some(Seek::Minimum { point: p, value: level }),
+                }
+            }
+            let threshold = BLOCK_TOL * len;
+            let mut alpha = f64::INFINITY;
+            let mut blocking = None;
+            for (j, a) in self.rows.iter().enumerate() {
+                let ad = dot4(a, &dir);
+                if ad > threshold && self.enabled(j) && !w.contains(j) {
+                    let slack = (self.offsets[j] - dot4(a, &p)).max(0.0);
+                    let t = slack / ad;
+                    if t < alpha {
+                        alpha = t;
+                        blocking = Some(j);
+                    }
+                }
+            }
+            let descent = dot4(&g, &dir);
+            if descent < 0.0 {
+                let to_level = (target - level) / descent;
+                if to_level <= alpha {
+                    axpy(&mut p, to_level, &dir);
+                    return Some(Seek::Reached(p));
+                }
+            }
+            let j = blocking?;
+            axpy(&mut p, alpha, &dir);
+            record_move(alpha * len, self.length_scale, blocking, &mut last_dropped, &mut banned);
+            if w.len >= n {
+                return None;
+            }
+            w.push(j);
+        }
+        None
+    }
+
+    /// `-P g`: minus the projection of the (linear) objective `g` on the null space of the working rows, in closed
+    /// form for `n` = 2 or 3 (see [`Problem::seek_small`]). `None` when the rows are numerically dependent.
+    fn lp_projected_descent(&self, w: &WorkSet) -> Option<V4> {
+        let n = self.n;
+        let g = &self.g;
+        let row = |a: usize| &self.rows[w.idx[a]];
+        let along = |z: &V4| {
+            let zz = dot4(z, z);
+            if !(zz > 0.0 && zz.is_finite()) {
+                return None;
+            }
+            let t = -dot4(z, g) / zz;
+            Some(z.map(|c| c * t))
+        };
+        match (n, w.len) {
+            (_, 0) => Some(g.map(|c| -c)),
+            (2, 1) => {
+                let a = row(0);
+                along(&[-a[1], a[0], 0.0, 0.0])
+            }
+            (3, 1) => {
+                let a = row(0);
+                let aa = dot4(a, a);
+                if !(aa > 0.0 && aa.is_finite()) {
+                    return None;
+                }
+                let t = dot4(a, g) / aa;
+                let mut d = [0.0; MAX_N];
+                for i in 0..3 {
+                    d[i] = -(g[i] - t * a[i]);
+                }
+                Some(d)
+            }
+            (3, 2) => along(&cross3(row(0), row(1))),
+            _ => Some([0.0; MAX_N]),
+        }
+    }
+
     /// Runs the active-set method from `start` (feasible, or infeasible only by rounding).
     pub(crate) fn solve(&self, start: V4) -> Result<Outcome, ActiveSetError> {
         let m = self.rows.len();
@@ -1139,6 +1272,56 @@ mod tests {
             proptest::prop_assert_eq!(bits(&fast.curved), bits(&general.curved));
             let chol_bits = |s: &Subspace| s.chol.map(|r| r.map(f64::to_bits));
             proptest::prop_assert_eq!(chol_bits(&fast), chol_bits(&general));
+        }
+
+        /// The closed-form phase 1 (`seek_small`) against the general `seek` (the oracle): the same decision (level
+        /// reached or the minimum above it) unless the minimum is within 1e-9 of the target, the same minimum value,
+        /// and a returned point that satisfies every enabled row and reaches the level. Random cells with duplicate
+        /// rows, flat pairs and apexes of 4-5 planes; random masks; targets below, near and above the minimum.
+        #[test]
+        fn closed_form_phase_one_agrees_with_the_general_one(
+            seed in proptest::prelude::any::<u64>(), n in 2usize..4, kind in 0u8..4, cuts in 0usize..10,
+            masked in proptest::prelude::any::<u32>(), frac in -0.5f64..1.5,
+        ) {
+            let (rows, b, _, g, c) = random_problem(seed, n, kind, cuts);
+            // disabled rows: only cuts (the box stays, so the LP stays bounded)
+            let mask: Vec<bool> = (0..rows.len()).map(|j| j < 2 * n || (masked >> (j % 32)) & 1 == 0).collect();
+            let prob = Problem {
+                n, rows: &rows, offsets: &b, mask: Some(&mask), h: [0.0; MAX_N], g, tie: [2, 1, 0, 3], length_scale: 10.0,
+            };
+            let Ok(Seek::Minimum { value: min, .. }) = prob.seek(c, f64::NEG_INFINITY) else {
+                return Err(proptest::test_runner::TestCaseError::fail("general seek to -inf must end at the minimum"));
+            };
+            let fast_min = prob.seek_small(c, f64::NEG_INFINITY);
+            let Some(Seek::Minimum { value: fmin, point: fp }) = fast_min else {
+                return Err(proptest::test_runner::TestCaseError::fail(format!("fast seek to -inf: {fast_min:?}")));
+            };
+            let scale = 1e-9 * (1.0 + min.abs());
+            proptest::prop_assert!((fmin - min).abs() <= scale, "minimum {fmin} vs {min}");
+            proptest::prop_assert!((dot4(&g, &fp) - fmin).abs() <= scale);
+            let start_level = dot4(&g, &c);
+            let target = min + frac * (start_level - min);
+            let general = prob.seek(c, target).expect("general");
+            let fast = prob.seek_small(c, target).expect("closed form");
+            let point = match (fast, general) {
+                (Seek::Reached(p), Seek::Reached(_)) => p,
+                (Seek::Minimum { point, value }, Seek::Minimum { value: v, .. }) => {
+                    proptest::prop_assert!((value - v).abs() <= scale);
+                    point
+                }
+                (f, _) => {
+                    proptest::prop_assert!((target - min).abs() <= scale, "decisions differ away from the minimum: {f:?}");
+                    return Ok(());
+                }
+            };
+            for (j, a) in rows.iter().enumerate() {
+                if mask[j] {
+                    proptest::prop_assert!(dot4(a, &point) - b[j] <= 1e-9, "row {j} violated");
+                }
+            }
+            if let Seek::Reached(_) = fast {
+                proptest::prop_assert!(dot4(&g, &point) <= target + scale);
+            }
         }
 
         /// The closed-form path on its own (no fallback): it must finish, and agree with the general method.

@@ -351,7 +351,14 @@ impl<const D: usize> Cell<D> {
                 tie: default_tie(D),
                 length_scale: self.length_scale(),
             };
-            match prob.seek(point, grown[j]).map_err(|source| CellError::Solver { purpose: "phase 1", source })? {
+            // the closed-form iteration in 2-3 variables, the general one if it breaks down
+            let seek = match prob.seek_small(point, grown[j]) {
+                Some(s) => s,
+                None => {
+                    prob.seek(point, grown[j]).map_err(|source| CellError::Solver { purpose: "phase 1", source })?
+                }
+            };
+            match seek {
                 Seek::Reached(p) => point = p,
                 Seek::Minimum { point: p, value } => {
                     if value > grown[j] {
