@@ -102,6 +102,12 @@ pub enum CellShape<const D: usize> {
         /// A point of the cell.
         point: [f64; D],
     },
+    /// Non-empty, built from a known point of it without the Chebyshev LP ([`Cell::with_halfspaces_from`]): flat or
+    /// solid, not classified. `point` is in the cell (within rounding), on its boundary in general.
+    Known {
+        /// A point of the cell.
+        point: [f64; D],
+    },
     /// Full-dimensional: the centre and radius of the largest inscribed ball.
     Solid {
         /// Chebyshev centre.
@@ -174,6 +180,19 @@ impl<const D: usize> Cell<D> {
         tolerance: Tolerance,
         check_bounded: bool,
     ) -> Result<Self, CellError> {
+        let mut cell = Self::normalised(halfspaces, tolerance)?;
+        if cell.shape != CellShape::Empty {
+            cell.shape = cell.chebyshev()?;
+            if check_bounded && cell.shape != CellShape::Empty {
+                cell.check_bounded()?;
+            }
+        }
+        Ok(cell)
+    }
+
+    /// The cell of `halfspaces` with unit normals, before its shape is known: [`CellShape::Empty`] when an inequality
+    /// with a zero normal fails, otherwise (provisionally) [`CellShape::Known`] at the origin.
+    fn normalised(halfspaces: Vec<Halfspace<D>>, tolerance: Tolerance) -> Result<Self, CellError> {
         let () = Self::DIM_OK;
         let mut kept = Vec::with_capacity(halfspaces.len());
         let mut trivially_empty = false;
@@ -191,14 +210,8 @@ impl<const D: usize> Cell<D> {
         }
         let rows: Vec<V4> = kept.iter().map(|h| to_v4(&h.normal)).collect();
         let offsets: Vec<f64> = kept.iter().map(|h| h.offset).collect();
-        let mut cell = Self { halfspaces: kept, rows, offsets, tolerance, shape: CellShape::Empty };
-        if !trivially_empty {
-            cell.shape = cell.chebyshev()?;
-            if check_bounded && cell.shape != CellShape::Empty {
-                cell.check_bounded()?;
-            }
-        }
-        Ok(cell)
+        let shape = if trivially_empty { CellShape::Empty } else { CellShape::Known { point: [0.0; D] } };
+        Ok(Self { halfspaces: kept, rows, offsets, tolerance, shape })
     }
 
     /// The inequalities (unit normals), in order; active-constraint indices refer to this list.
@@ -248,7 +261,7 @@ impl<const D: usize> Cell<D> {
     pub fn interior_point(&self) -> Option<[f64; D]> {
         match self.shape {
             CellShape::Empty => None,
-            CellShape::Flat { point } => Some(point),
+            CellShape::Flat { point } | CellShape::Known { point } => Some(point),
             CellShape::Solid { centre, .. } => Some(centre),
         }
     }
@@ -298,19 +311,65 @@ impl<const D: usize> Cell<D> {
         }
         // the row, offset and mask lists live in a per-thread scratch (no allocation per call once warm)
         let mut scratch = Scratch::take();
-        let result = self.is_empty_with_in(extra, start, &mut scratch);
+        let result = self.phase_one_in(extra, start, self.tolerance.linear, &mut scratch);
         scratch.put_back();
-        result
+        Ok(result?.is_none())
     }
 
-    /// [`Cell::is_empty_with`] with its lists in `scratch`.
-    fn is_empty_with_in(
+    /// This cell with `extra` inequalities added, built from `start`, a point of this cell (within the tolerance),
+    /// without the Chebyshev LP; `None` when it is empty.
+    ///
+    /// Emptiness is decided exactly as by [`Cell::is_empty_with`] (the phase 1 on the tolerance-grown cell). For a
+    /// non-empty cell a second phase 1 from `start` on the cell as it is (offsets not grown) gives a point of it (on
+    /// the boundary of the inequalities `start` violated), which becomes the cell's interior point (the start of its
+    /// QP and LPs) with the shape [`CellShape::Known`]. When only the grown cell is non-empty (the cell is thinner
+    /// than the tolerance, or empty by less than it), the cell is built as by [`Cell::with_halfspaces`] (Chebyshev LP).
+    /// Cost: about one short LP per inequality violated at `start` per phase (a child of the planner's search violates
+    /// one), against the Chebyshev LP's four variables from a cold start.
+    ///
+    /// The QP over the cell then starts from another point than over `with_halfspaces(extra)`: its optimum is the
+    /// same up to rounding in the last bits (the minimiser is unique for strictly convex costs), not bit for bit.
+    pub fn with_halfspaces_from(&self, extra: &[Halfspace<D>], start: &[f64; D]) -> Result<Option<Self>, CellError> {
+        if self.is_empty() {
+            return Ok(None);
+        }
+        let mut scratch = Scratch::take();
+        let grown = self.phase_one_in(extra.iter().copied(), start, self.tolerance.linear, &mut scratch);
+        scratch.clear();
+        let exact = match grown {
+            Ok(Some(_)) => self.phase_one_in(extra.iter().copied(), start, 0.0, &mut scratch),
+            _ => Ok(None),
+        };
+        scratch.put_back();
+        match (grown?, exact?) {
+            (None, _) => Ok(None),
+            (Some(_), Some(point)) => {
+                let mut hs = Vec::with_capacity(self.halfspaces.len() + extra.len());
+                hs.extend_from_slice(&self.halfspaces);
+                hs.extend_from_slice(extra);
+                let mut cell = Self::normalised(hs, self.tolerance)?;
+                if cell.shape != CellShape::Empty {
+                    cell.shape = CellShape::Known { point: from_v4(&point) };
+                }
+                Ok(Some(cell))
+            }
+            (Some(_), None) => {
+                let cell = self.with_halfspaces(extra.iter().copied())?;
+                Ok((!cell.is_empty()).then_some(cell))
+            }
+        }
+    }
+
+    /// The sequential phase 1 of [`Cell::is_empty_with`] on this cell with `extra` added, every offset grown by
+    /// `grow`: the point reached (`None`: empty), lists in `scratch`.
+    fn phase_one_in(
         &self,
         extra: impl IntoIterator<Item = Halfspace<D>>,
         start: &[f64; D],
+        grow: f64,
         scratch: &mut Scratch,
-    ) -> Result<bool, CellError> {
-        let tol = self.tolerance.linear;
+    ) -> Result<Option<V4>, CellError> {
+        let tol = grow;
         let first_extra = self.rows.len();
         let Scratch { rows, offsets: grown, mask } = scratch;
         rows.extend_from_slice(&self.rows);
@@ -324,8 +383,8 @@ impl<const D: usize> Cell<D> {
             if len > 0.0 {
                 rows.push(to_v4(&h.normal.map(|c| c / len)));
                 grown.push(h.offset / len + tol);
-            } else if h.offset < -tol {
-                return Ok(true);
+            } else if h.offset < -self.tolerance.linear {
+                return Ok(None);
             }
         }
         let (rows, grown) = (&rows[..], &grown[..]);
@@ -362,14 +421,14 @@ impl<const D: usize> Cell<D> {
                 Seek::Reached(p) => point = p,
                 Seek::Minimum { point: p, value } => {
                     if value > grown[j] {
-                        return Ok(true);
+                        return Ok(None);
                     }
                     point = p;
                 }
             }
             mask[j] = true;
         }
-        Ok(false)
+        Ok(Some(point))
     }
 
     /// The intersection of two cells (inequalities of `self`, then of `other`); tolerance of `self`.
@@ -546,10 +605,14 @@ impl Scratch {
         SCRATCH.with(std::cell::Cell::take)
     }
 
-    fn put_back(mut self) {
+    fn clear(&mut self) {
         self.rows.clear();
         self.offsets.clear();
         self.mask.clear();
+    }
+
+    fn put_back(mut self) {
+        self.clear();
         SCRATCH.with(|s| s.set(self));
     }
 }

@@ -161,7 +161,8 @@ pub fn subtract<const D: usize>(
         let keep = match piece.shape() {
             CellShape::Empty => false,
             CellShape::Flat { .. } => !parent_solid,
-            CellShape::Solid { .. } => true,
+            // (pieces come from the Chebyshev LP, never `Known`)
+            CellShape::Solid { .. } | CellShape::Known { .. } => true,
         };
         if keep {
             pieces.push(if options.remove_redundant { piece.without_redundant()? } else { piece });
