@@ -388,13 +388,8 @@ fn arcs(p: &ConvexPolytope, vertices: &[DVec3], normals: &[DVec3], out: &mut Vec
 
 #[inline]
 fn tol_sign(v: f64) -> i8 {
-    if v > ANGULAR_TOLERANCE {
-        1
-    } else if v < -ANGULAR_TOLERANCE {
-        -1
-    } else {
-        0
-    }
+    // branch-free: 1 above the tolerance, -1 below minus it, 0 within it (and for NaN)
+    i8::from(v > ANGULAR_TOLERANCE) - i8::from(v < -ANGULAR_TOLERANCE)
 }
 
 /// `out[e * normals.len() + f]`: the side of `normals[f]` w.r.t. the circle of `arcs[e]` ([`tol_sign`]).
@@ -578,7 +573,7 @@ fn overlay(
             faces.push(FaceSpec { normal: x.normalize(), fixed: Feature::Edge(eb), moving: Feature::Edge(ea) });
         }
     }
-    let buffers = AssemblyBuffers { index_of, cycle, planar, merged_with_b };
+    let buffers = AssemblyBuffers { index_of, cycle, planar, merged_with_b, neg_ra };
     assemble(moving, fixed, rotation, ra, a_arcs, b_arcs, faces, buffers)
 }
 
@@ -601,65 +596,88 @@ fn argmax(points: &[DVec3], u: DVec3) -> usize {
     best
 }
 
-/// The polygon of a feature of a merged face into `(vertices, edges)` (cleared first): a face's vertex cycle,
-/// counter-clockwise about its outward normal (reversed when `reflect`, for `-RA`, whose faces are the point
-/// reflections of `A`'s), with the edge from corner `k` to corner `k + 1`; an edge as the 2-gon `[v0, v1]` whose two
-/// sides are both that edge. Not called for vertices.
-fn feature_polygon(
-    p: &ConvexPolytope,
-    feature: Feature,
-    arcs: &[Arc],
-    reflect: bool,
-    scratch: (&mut Vec<usize>, &mut Vec<usize>, &mut Vec<usize>),
-) {
-    let (vertices, edges, across) = scratch;
-    vertices.clear();
-    edges.clear();
-    across.clear();
-    match feature {
-        Feature::Vertex(v) => vertices.push(v),
-        Feature::Edge(e) => {
-            vertices.extend_from_slice(&arcs[e].vertices);
-            edges.extend_from_slice(&[e, e]);
-            across.extend_from_slice(&[usize::MAX, usize::MAX]);
-        }
-        Feature::Face(f) => {
-            let cycle = &p.faces()[f].vertices;
-            let face_edges = p.face_edges(f);
-            if reflect {
-                // reversed cycle: corner k is cycle[n - 1 - k]; the edge to corner k + 1 joins cycle[n - 1 - k] and
-                // cycle[n - 2 - k], i.e. face_edges[n - 2 - k]; the closing edge joins cycle[0] and cycle[n - 1]
-                let n = cycle.len();
-                vertices.extend(cycle.iter().rev());
-                edges.extend(face_edges[..n - 1].iter().rev());
-                edges.push(face_edges[n - 1]);
-            } else {
-                vertices.extend_from_slice(cycle);
-                edges.extend_from_slice(face_edges);
+/// One polygon of a merged face: its corners (vertex indices of its polytope), and per edge `k` (corner `k` to `k + 1`)
+/// the direction, its squared length and its half-plane relative to the reference direction (see [`planar_merge`]),
+/// and the face of the polytope across that edge (`usize::MAX` for an edge feature).
+#[derive(Default)]
+struct Polygon {
+    corners: Vec<usize>,
+    edges: Vec<(DVec3, f64, u8)>,
+    across: Vec<usize>,
+}
+
+impl Polygon {
+    /// The polygon of `feature` of `p` (whose vertices, as summed, are `points`): a face's vertex cycle,
+    /// counter-clockwise about its outward normal (reversed when `reflect`, for `-RA`, whose faces are the point
+    /// reflections of `A`'s); an edge as the 2-gon `[v0, v1]`. The half-planes are taken relative to `reference`, or
+    /// to this polygon's edge 0 when `None`; returns the reference. The faces across the edges only `with_across`.
+    /// Not called for vertices.
+    #[allow(clippy::too_many_arguments)]
+    fn build(
+        &mut self,
+        p: &ConvexPolytope,
+        feature: Feature,
+        arcs: &[Arc],
+        reflect: bool,
+        points: &[DVec3],
+        normal: DVec3,
+        reference: Option<DVec3>,
+        with_across: bool,
+    ) -> DVec3 {
+        let Self { corners, edges, across } = self;
+        corners.clear();
+        edges.clear();
+        across.clear();
+        match feature {
+            Feature::Vertex(v) => corners.push(v),
+            Feature::Edge(e) => corners.extend_from_slice(&arcs[e].vertices),
+            Feature::Face(f) => {
+                let cycle = &p.faces()[f].vertices;
+                if reflect {
+                    corners.extend(cycle.iter().rev());
+                } else {
+                    corners.extend_from_slice(cycle);
+                }
+                if with_across {
+                    let face_edges = p.face_edges(f);
+                    let other = |e: usize| {
+                        let [f0, f1] = p.edges()[e].faces;
+                        if f0 == f { f1 } else { f0 }
+                    };
+                    if reflect {
+                        // reversed cycle: corner k is cycle[n - 1 - k]; the edge to corner k + 1 joins cycle[n - 1 - k]
+                        // and cycle[n - 2 - k], i.e. face_edges[n - 2 - k]; the closing edge is face_edges[n - 1]
+                        let n = cycle.len();
+                        across.extend(face_edges[..n - 1].iter().rev().map(|&e| other(e)));
+                        across.push(other(face_edges[n - 1]));
+                    } else {
+                        across.extend(face_edges.iter().map(|&e| other(e)));
+                    }
+                }
             }
-            across.extend(edges.iter().map(|&e| {
-                let [f0, f1] = p.edges()[e].faces;
-                if f0 == f { f1 } else { f0 }
-            }));
         }
+        let n = corners.len();
+        let first = points[corners[0]];
+        let r = reference.unwrap_or_else(|| points[corners[1]] - first);
+        let mut current = first;
+        edges.reserve(n);
+        for k in 1..=n {
+            let next = if k == n { first } else { points[corners[k]] };
+            let d = next - current;
+            current = next;
+            // 0 for angles in [0, pi) from r about the normal, 1 for [pi, 2 pi)
+            let s = r.cross(d).dot(normal);
+            edges.push((d, d.length_squared(), u8::from(!(s > 0.0 || (s == 0.0 && r.dot(d) > 0.0)))));
+        }
+        r
     }
 }
 
-/// Buffers reused by every merged face (no allocation per face): the two polygons of a planar sum as vertex cycles
-/// with the edge index of every polygon edge and its direction.
+/// Buffers reused by every merged face (no allocation per face): `B`'s polygon and `-RA`'s.
 #[derive(Default)]
 struct PlanarScratch {
-    /// `B`'s polygon: vertices of `B`, edge `k` from `pj[k]` to `pj[k + 1]` is `B`'s edge `pe[k]`, direction `pd[k]`.
-    pj: Vec<usize>,
-    pe: Vec<usize>,
-    pd: Vec<DVec3>,
-    /// The face of `B` across edge `pe[k]` from `B`'s polygon (`usize::MAX` when the polygon is an edge).
-    pn: Vec<usize>,
-    /// `-RA`'s polygon likewise (vertices of `A`, edges of `A`, directions of `-RA`).
-    qi: Vec<usize>,
-    qe: Vec<usize>,
-    qd: Vec<DVec3>,
-    qn: Vec<usize>,
+    b: Polygon,
+    a: Polygon,
 }
 
 /// The scratch buffers [`assemble`] works in.
@@ -671,6 +689,8 @@ struct AssemblyBuffers<'a> {
     planar: &'a mut PlanarScratch,
     /// `merged_with_b[f] = Some(g)`: face `f` of `-RA` and face `g` of `B` are parallel (one face of the sum).
     merged_with_b: &'a [Option<usize>],
+    /// The vertices of `-RA`.
+    neg_ra: &'a [DVec3],
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -684,7 +704,7 @@ fn assemble(
     specs: &[FaceSpec],
     buffers: AssemblyBuffers<'_>,
 ) -> Result<Obstacle, OverlayFailure> {
-    let AssemblyBuffers { index_of, cycle, planar: scratch, merged_with_b } = buffers;
+    let AssemblyBuffers { index_of, cycle, planar: scratch, merged_with_b, neg_ra } = buffers;
     let bv = fixed.vertices();
     let nb = bv.len();
     index_of.clear();
@@ -715,11 +735,11 @@ fn assemble(
                 }
             }
             (fixed_feature, moving_feature) => {
-                let (pj, pe, pn) = (&mut scratch.pj, &mut scratch.pe, &mut scratch.pn);
-                feature_polygon(fixed, fixed_feature, b_arcs, false, (pj, pe, pn));
-                let (qi, qe, qn) = (&mut scratch.qi, &mut scratch.qe, &mut scratch.qn);
-                feature_polygon(moving, moving_feature, a_arcs, true, (qi, qe, qn));
-                planar_merge(ra, bv, a_arcs, b_arcs, merged_with_b, spec.normal, scratch, cycle);
+                let n = spec.normal;
+                let both_faces = matches!((fixed_feature, moving_feature), (Feature::Face(_), Feature::Face(_)));
+                let r = scratch.b.build(fixed, fixed_feature, b_arcs, false, bv, n, None, both_faces);
+                scratch.a.build(moving, moving_feature, a_arcs, true, neg_ra, n, Some(r), both_faces);
+                planar_merge(merged_with_b, n, both_faces, scratch, cycle);
             }
         }
         if cycle.len() < 3 {
@@ -749,13 +769,6 @@ fn assemble(
     Ok(Obstacle { polytope, vertex_pairs, face_kinds: kinds, rotation, route: Route::GaussMap })
 }
 
-/// Whether the edge directions `ca` (a unit edge direction of `-RA`) and `cb` (of `B`) are parallel: the sine of
-/// their angle is at most half the angular tolerance, the threshold at which two face normals are one direction.
-#[inline]
-fn parallel_edges(ca: DVec3, cb: DVec3) -> bool {
-    ca.cross(cb).length_squared() <= PARALLEL_SQ
-}
-
 /// `(ANGULAR_TOLERANCE / 2)^2`: the squared sine below which two edge directions are parallel, and the squared
 /// distance below which two unit face normals are the same direction.
 const PARALLEL_SQ: f64 = (0.5 * ANGULAR_TOLERANCE) * (0.5 * ANGULAR_TOLERANCE);
@@ -766,54 +779,42 @@ const PARALLEL_SQ: f64 = (0.5 * ANGULAR_TOLERANCE) * (0.5 * ANGULAR_TOLERANCE);
 ///
 /// The classic O(|F| + |G|) merge of the two edge sequences by angle (the sum's edges are the summands' edges in
 /// angular order): starting at `F`'s edge 0 and the corner of `G` whose outgoing edge comes first at or after it, the
-/// walk advances in the polygon whose next edge turns first. An edge of `F` and an edge of `G` that point the same way
-/// within the tolerance ([`parallel_edges`] on the unit edge directions: the same test for the same pair of edges in
-/// every face, so neighbouring faces agree) are one edge of the sum: both advance and their middle corner is not a
-/// corner. All other order decisions are signs of `(v x w) . normal` for non-parallel `v`, `w`, which the rounding of
-/// the inputs cannot flip. No coordinates are sorted or compared, so no length tolerance enters.
+/// walk advances in the polygon whose next edge turns first. An edge `p` of `F` and an edge `q` of `G` that point the
+/// same way (`p . q > 0`) are one edge of the sum (both advance; their middle corner is not a corner) when the sine of
+/// their angle is at most half the tolerance (`|p x q|^2 <= (tol / 2)^2 |p|^2 |q|^2`), or when the faces of `B` and
+/// `A` across them are merged. Both tests see the same vectors (up to an exact sign) for the same pair of edges in
+/// every face, so neighbouring faces agree. All other order decisions are signs of `(v x w) . normal` for
+/// non-parallel `v`, `w`, which the rounding of the inputs cannot flip. No coordinates are sorted or compared, so no
+/// length tolerance enters. O(|F| + |G|), no allocation (the scratch buffers are reused).
 fn planar_merge(
-    ra: &[DVec3],
-    bv: &[DVec3],
-    a_arcs: &[Arc],
-    b_arcs: &[Arc],
     merged_with_b: &[Option<usize>],
     normal: DVec3,
-    scratch: &mut PlanarScratch,
+    faces: bool,
+    scratch: &PlanarScratch,
     out: &mut Vec<[usize; 2]>,
 ) {
-    let PlanarScratch { pj, pe, pd, pn, qi, qe, qd, qn } = scratch;
+    let (pj, pd, pn) = (&scratch.b.corners, &scratch.b.edges, &scratch.b.across);
+    let (qi, qd, qn) = (&scratch.a.corners, &scratch.a.edges, &scratch.a.across);
     let (m, n) = (pj.len(), qi.len());
-    pd.clear();
-    pd.extend((0..m).map(|k| bv[pj[if k + 1 == m { 0 } else { k + 1 }]] - bv[pj[k]]));
-    qd.clear();
-    // -RA's vertices are -ra: the edge from corner l to l + 1 is ra[l] - ra[l + 1]
-    qd.extend((0..n).map(|l| ra[qi[l]] - ra[qi[if l + 1 == n { 0 } else { l + 1 }]]));
-    // one edge of the sum: the faces across both edges are merged (then so are the edges, whatever their rounded
-    // directions say: the neighbouring merged face decides the same way), or the directions are parallel
-    let same = |k: usize, l: usize| {
-        let (across_b, across_a) = (pn[k], qn[l]);
-        (across_a != usize::MAX && across_b != usize::MAX && merged_with_b[across_a] == Some(across_b))
-            || (parallel_edges(a_arcs[qe[l]].circle, b_arcs[pe[k]].circle) && pd[k].dot(qd[l]) > 0.0)
+    let r = pd[0].0;
+    // one edge of the sum: pointing the same way, and the faces across both edges are merged (then so are the edges,
+    // whatever their rounded directions say: the neighbouring merged face decides the same way) or the sine of their
+    // angle is at most half the tolerance (`c = p x q`; the same vectors up to sign in every face, so the same answer)
+    let same = |k: usize, l: usize, c: DVec3| {
+        let ((p, p2, _), (q, q2, _)) = (pd[k], qd[l]);
+        p.dot(q) > 0.0
+            && (c.length_squared() <= PARALLEL_SQ * p2 * q2 || (faces && merged_with_b[qn[l]] == Some(pn[k])))
     };
-    // angular order relative to r = F's edge 0: the half (0 for angles in [0, pi), 1 for [pi, 2 pi)), then the turn
-    let r = pd[0];
-    let half = |v: DVec3| {
-        let s = r.cross(v).dot(normal);
-        u8::from(!(s > 0.0 || (s == 0.0 && r.dot(v) > 0.0)))
-    };
-    let before = |v: DVec3, w: DVec3| {
-        let (hv, hw) = (half(v), half(w));
-        hv < hw || (hv == hw && v.cross(w).dot(normal) > 0.0)
-    };
-    // G's first edge: parallel to r, else the first in angular order
+    // G's first edge: the one parallel to r, else the first in angular order
     let mut l0 = 0;
-    if !same(0, 0) {
+    if !same(0, 0, r.cross(qd[0].0)) {
         for l in 1..n {
-            if same(0, l) {
+            if same(0, l, r.cross(qd[l].0)) {
                 l0 = l;
                 break;
             }
-            if before(qd[l], qd[l0]) {
+            let ((v, _, hv), (w, _, hw)) = (qd[l], qd[l0]);
+            if hv < hw || (hv == hw && v.cross(w).dot(normal) > 0.0) {
                 l0 = l;
             }
         }
@@ -826,13 +827,17 @@ fn planar_merge(
             l += 1;
         } else if l == n {
             k += 1;
-        } else if same(k, lq) {
-            k += 1;
-            l += 1;
-        } else if before(pd[k], qd[lq]) {
-            k += 1;
         } else {
-            l += 1;
+            let ((p, _, hp), (q, _, hq)) = (pd[k], qd[lq]);
+            let c = p.cross(q);
+            if same(k, lq, c) {
+                k += 1;
+                l += 1;
+            } else if hp < hq || (hp == hq && c.dot(normal) > 0.0) {
+                k += 1;
+            } else {
+                l += 1;
+            }
         }
     }
 }

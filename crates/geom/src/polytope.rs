@@ -641,8 +641,22 @@ fn edge_table<F>(
 /// Whether [`plane_of`] finds a plane for the face because its Newell normal is non-zero (the usual case; when it is
 /// zero, `plane_of` tries a fallback, so `false` means "ask `plane_of`", not "degenerate").
 fn has_area(vertices: &[DVec3], face: &[usize]) -> bool {
-    let len = newell_normal(face.iter().map(|&i| vertices[i])).length();
-    !len.is_nan() && len > 0.0 && len.is_finite()
+    // Newell's normal as `newell_normal` computes it (the same terms summed in the same order, so bit for bit the
+    // same vector), by index; its squared length decides exactly what its length would (`sqrt` keeps 0, NaN and
+    // infinity)
+    let Some(&start) = face.first() else { return false };
+    let first = vertices[start];
+    let mut n = DVec3::ZERO;
+    let mut p = first;
+    for k in 1..=face.len() {
+        let q = if k == face.len() { first } else { vertices[face[k]] };
+        n.x += (p.y - q.y) * (p.z + q.z);
+        n.y += (p.z - q.z) * (p.x + q.x);
+        n.z += (p.x - q.x) * (p.y + q.y);
+        p = q;
+    }
+    let len_sq = n.length_squared();
+    len_sq > 0.0 && len_sq.is_finite()
 }
 
 fn plane_of(vertices: &[DVec3], face: &[usize]) -> Option<Plane> {
@@ -676,6 +690,36 @@ mod tests {
 
     pub(crate) fn unit_cube() -> ConvexPolytope {
         ConvexPolytope::cuboid(DVec3::ZERO, DVec3::ONE).expect("cube")
+    }
+
+    #[test]
+    fn has_area_decides_as_the_newell_length() {
+        // the index loop must give exactly the decision of `newell_normal(..).length()`, slivers and zeros included
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for case in 0..400 {
+            let n = 3 + case % 5;
+            let scale = [1.0, 1e-160, 1e155, 1e-300][case % 4];
+            let vertices: Vec<DVec3> = (0..n)
+                .map(|k| {
+                    if case % 7 == 0 {
+                        DVec3::new(k as f64, 2.0 * k as f64, 0.5) * scale // collinear: zero area
+                    } else {
+                        DVec3::new(next(), next(), next()) * scale
+                    }
+                })
+                .collect();
+            let face: Vec<usize> = (0..n).collect();
+            let len = newell_normal(face.iter().map(|&i| vertices[i])).length();
+            let expected = !len.is_nan() && len > 0.0 && len.is_finite();
+            assert_eq!(has_area(&vertices, &face), expected, "case {case}");
+        }
+        assert!(!has_area(&[], &[]));
     }
 
     #[test]
