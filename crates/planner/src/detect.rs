@@ -1,6 +1,6 @@
 //! Interference pairs of the new part at a configuration ([A] eq. 8, section 5.1.3): a broad phase on axis-aligned
-//! boxes and the exact separating-axis narrow phase of `stackplan-cspace` (`classify_pair`, GJK distance for pairs
-//! closer than the clearance).
+//! boxes and the exact separating-axis narrow phase of `stackplan-cspace` on the complete axis set
+//! (`classify_pair_all_axes`, GJK distance for pairs closer than the clearance).
 //!
 //! * Without clearance a pair is reported only when it *penetrates* by more than the tolerance; touching is free.
 //! * With clearance `delta > 0`, a pair closer than `delta` is reported (touching included).
@@ -114,14 +114,9 @@ impl SweepAxes {
     }
 }
 
-/// `placed` moved by `p`.
+/// `placed` moved by `p` ([`PlacedConvex::translated`]).
 pub fn translated(placed: &PlacedConvex, p: DVec3) -> PlacedConvex {
-    PlacedConvex {
-        vertices: placed.vertices.iter().map(|v| *v + p).collect(),
-        normal_axes: placed.normal_axes.clone(),
-        edge_directions: placed.edge_directions.clone(),
-        aabb: (placed.aabb.0 + p, placed.aabb.1 + p),
-    }
+    placed.translated(p)
 }
 
 /// `placed` moved by `p` and swept up to `top` (see the module documentation).
@@ -132,12 +127,8 @@ fn swept(placed: &PlacedConvex, axes: &(Vec<DVec3>, Vec<DVec3>), p: DVec3, top: 
     for k in 0..n {
         vertices.push(vertices[k] + DVec3::new(0.0, 0.0, lift));
     }
-    PlacedConvex {
-        vertices,
-        normal_axes: axes.0.clone(),
-        edge_directions: axes.1.clone(),
-        aabb: (placed.aabb.0 + p, placed.aabb.1 + p + DVec3::new(0.0, 0.0, lift)),
-    }
+    let aabb = (placed.aabb.0 + p, placed.aabb.1 + p + DVec3::new(0.0, 0.0, lift));
+    PlacedConvex::from_parts(vertices, axes.0.clone(), axes.1.clone(), aabb)
 }
 
 fn boxes_overlap(a: &(DVec3, DVec3), b: &(DVec3, DVec3), margin: f64) -> bool {
@@ -630,7 +621,7 @@ pub fn horizontal_slack_below(a: &PlacedConvex, b: &PlacedConvex, clearance: f64
 mod tests {
     use super::*;
     use crate::request::Cost;
-    use stackplan_cspace::interference::classify_pair;
+    use stackplan_cspace::interference::{classify_pair, classify_pair_all_axes};
     use stackplan_geom::PartOrigin;
 
     fn cuboid(lo: DVec3, hi: DVec3) -> ConvexPolytope {
@@ -646,8 +637,9 @@ mod tests {
         Part::from_components("l", c, 1.0, PartOrigin::ConvexPieces).expect("part")
     }
 
-    /// The reference: every pair moved and classified by `classify_pair` / `horizontal_slack` of the full axis set,
-    /// sorted by (violation desc, moving, fixed).
+    /// The reference: every pair moved and classified by `classify_pair_all_axes` / `horizontal_slack` (the complete
+    /// axis set), sorted by (violation desc, moving, fixed). Also checks that `classify_pair` (which skips duplicate
+    /// axes) agrees with the complete axis set up to rounding.
     fn reference(
         scene: &StackScene,
         o: &Orientation,
@@ -674,7 +666,14 @@ mod tests {
                     }
                     continue;
                 }
-                let violation = match classify_pair(&moved, &fixed.placed, tol, clearance) {
+                let all_axes = classify_pair_all_axes(&moved, &fixed.placed, tol, clearance);
+                let pruned = classify_pair(&moved, &fixed.placed, tol, clearance);
+                let gap = |c: PairContact| match c {
+                    PairContact::Penetrating { depth } => -depth,
+                    PairContact::Touching { gap } | PairContact::Separated { gap } => gap,
+                };
+                assert!((gap(all_axes) - gap(pruned)).abs() <= 1e-9, "{all_axes:?} vs {pruned:?}");
+                let violation = match all_axes {
                     PairContact::Penetrating { depth } => depth + clearance,
                     PairContact::Touching { gap } if clearance > tol => clearance - gap,
                     PairContact::Separated { gap } if clearance > tol && gap < clearance - tol => clearance - gap,
