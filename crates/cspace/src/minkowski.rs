@@ -29,9 +29,10 @@
 //! merged too, or when their unit directions point the same way within half the tolerance (`|c_a x c_b| <= tol / 2`,
 //! the threshold of merged face normals, so that a rotation about a face normal by less than it merges the faces and
 //! their edges alike). Every other decision of the merge is the sign of `(v x w) . u` for two edge directions that
-//! are not parallel, which rounding cannot flip. (Until session 13 this was a labelled 2-D hull of the `|F| |G|`
-//! rounded sum points with duplicates and corners within a *length* tolerance removed; on every input away from the
-//! tolerance band both give the same faces, see `BENCHMARKS.md`.)
+//! are not parallel, which rounding cannot flip; a face plus an edge (most merged faces of sheet metal rotated about
+//! `z`) takes a one-pass form of the same rule (`face_plus_segment`). (Until session 13 this was a labelled 2-D hull
+//! of the `|F| |G|` rounded sum points with duplicates and corners within a *length* tolerance removed; on every
+//! input away from the tolerance band both give the same faces, see `crates/cspace/BENCHMARKS.md`.)
 //!
 //! Why a tolerance and not exact predicates: the input to this step is a *rotated* polytope whose coordinates are
 //! already rounded (`cos(pi / 2)` is not 0 in `f64`), so exact parallelism of a rotated face with a fixed one cannot be
@@ -678,6 +679,8 @@ impl Polygon {
 struct PlanarScratch {
     b: Polygon,
     a: Polygon,
+    /// The edge classes of [`face_plus_segment`].
+    classes: Vec<u8>,
 }
 
 /// The scratch buffers [`assemble`] works in.
@@ -733,6 +736,18 @@ fn assemble(
                 } else {
                     cycle.extend([[i0, j0], [i1, j0], [i1, j1], [i0, j1]]);
                 }
+            }
+            (Feature::Face(g), Feature::Edge(ea)) => {
+                let corners = &fixed.faces()[g].vertices;
+                let [i0, i1] = a_arcs[ea].vertices;
+                face_plus_segment(corners, bv, [i0, i1], neg_ra, true, spec.normal, &mut scratch.classes, cycle);
+            }
+            (Feature::Edge(eb), Feature::Face(f)) => {
+                let corners = &mut scratch.a.corners;
+                corners.clear();
+                corners.extend(moving.faces()[f].vertices.iter().rev());
+                let [j0, j1] = b_arcs[eb].vertices;
+                face_plus_segment(corners, neg_ra, [j0, j1], bv, false, spec.normal, &mut scratch.classes, cycle);
             }
             (fixed_feature, moving_feature) => {
                 let n = spec.normal;
@@ -842,6 +857,67 @@ fn planar_merge(
     }
 }
 
+/// [`planar_merge`] for a face plus a parallel edge (a 2-gon), in one pass: the face polygon `corners` (points
+/// `points`, counter-clockwise about `normal`) plus the segment `segment` (points `segment_points`); `face_is_b` says
+/// whether the face is `B`'s (the corner labels are then `[segment vertex, corner]`, else `[corner, segment vertex]`).
+///
+/// With `d` the segment's direction, every face edge `e` is *parallel* (`e . d > 0`), *antiparallel* (`e . d < 0`)
+/// when the sine of their angle is at most half the tolerance (the test of [`planar_merge`], evaluated with the same
+/// operands in the same order: `B`'s edge first), else *after* `d` (`(d x e) . normal > 0`) or *before* it. The sum
+/// translates the face edges before `d` by the segment's start `s0`, those after it by its end `s1`; a parallel edge
+/// runs from `s0` to `s1`, an antiparallel one from `s1` to `s0`. Each corner of the face is one corner of the sum
+/// when the edges on both sides translate it alike, else two (the segment's edge `d` or `-d` joins them). Exactly the
+/// cycle [`planar_merge`] gives for the 2-gon (up to where it starts), in O(|F|) with one cross product per edge.
+#[allow(clippy::too_many_arguments)]
+fn face_plus_segment(
+    corners: &[usize],
+    points: &[DVec3],
+    segment: [usize; 2],
+    segment_points: &[DVec3],
+    face_is_b: bool,
+    normal: DVec3,
+    classes: &mut Vec<u8>,
+    out: &mut Vec<[usize; 2]>,
+) {
+    const BEFORE: u8 = 0;
+    const AFTER: u8 = 1;
+    const PARALLEL: u8 = 2;
+    const ANTIPARALLEL: u8 = 3;
+    let d = segment_points[segment[1]] - segment_points[segment[0]];
+    let m = corners.len();
+    classes.clear();
+    let first = points[corners[0]];
+    let mut current = first;
+    for k in 1..=m {
+        let next = if k == m { first } else { points[corners[k]] };
+        let e = next - current;
+        current = next;
+        // the parallel test with B's edge first, as in `planar_merge`
+        let (p, q) = if face_is_b { (e, d) } else { (d, e) };
+        let c = p.cross(q);
+        let tolerance = PARALLEL_SQ * p.length_squared() * q.length_squared();
+        classes.push(if c.length_squared() <= tolerance {
+            if e.dot(d) > 0.0 { PARALLEL } else { ANTIPARALLEL }
+        } else if d.cross(e).dot(normal) > 0.0 {
+            AFTER
+        } else {
+            BEFORE
+        });
+    }
+    let label = |corner: usize, end: usize| if face_is_b { [segment[end], corner] } else { [corner, segment[end]] };
+    for k in 0..m {
+        let (incoming, outgoing) = (classes[if k == 0 { m - 1 } else { k - 1 }], classes[k]);
+        // the end of the segment by which corner k is translated as the end of the incoming edge, and as the start
+        // of the outgoing one
+        let end = usize::from(incoming == AFTER || incoming == PARALLEL);
+        let start = usize::from(!(outgoing == BEFORE || outgoing == PARALLEL));
+        out.push(label(corners[k], end));
+        if start != end {
+            out.push(label(corners[k], start));
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -878,6 +954,87 @@ mod tests {
         assert_eq!(o.polytope().vertices().len(), 16);
         let h = obstacle_by_hull(&a, DMat3::from_rotation_z(0.3), &b).expect("hull");
         assert!((h.polytope().volume() - o.polytope().volume()).abs() < 1e-9);
+    }
+
+    /// A polygon for [`planar_merge`] from raw points (what `Polygon::build` computes for a feature).
+    fn raw_polygon(points: &[DVec3], corners: &[usize], normal: DVec3, reference: Option<DVec3>) -> (Polygon, DVec3) {
+        let n = corners.len();
+        let r = reference.unwrap_or(points[corners[1]] - points[corners[0]]);
+        let edges = (0..n)
+            .map(|k| {
+                let d = points[corners[(k + 1) % n]] - points[corners[k]];
+                let s = r.cross(d).dot(normal);
+                (d, d.length_squared(), u8::from(!(s > 0.0 || (s == 0.0 && r.dot(d) > 0.0))))
+            })
+            .collect();
+        (Polygon { corners: corners.to_vec(), edges, across: vec![usize::MAX; n] }, r)
+    }
+
+    fn same_cycle(a: &[[usize; 2]], b: &[[usize; 2]]) -> bool {
+        a.len() == b.len() && (0..a.len()).any(|s| (0..a.len()).all(|k| a[(s + k) % a.len()] == b[k]))
+    }
+
+    #[test]
+    fn face_plus_segment_is_the_general_merge_of_a_2_gon() {
+        // convex polygons (regular, rotated, scaled) plus segments in every direction: exactly along an edge, within
+        // 0.3 and 0.7 of the tolerance of it, and generic; the face as B's and as A's
+        let normal = DVec3::Z;
+        let mut cases = 0;
+        for sides in 3..9 {
+            for turn in [0.0, 0.1, 1.0] {
+                let points: Vec<DVec3> = (0..sides)
+                    .map(|k| {
+                        let t = turn + k as f64 * std::f64::consts::TAU / sides as f64;
+                        DVec3::new(3.0 * t.cos() + 1.0, 2.0 * t.sin() - 0.5, 0.25)
+                    })
+                    .collect();
+                let corners: Vec<usize> = (0..sides).collect();
+                let mut directions = Vec::new();
+                for k in 0..sides {
+                    let e = points[(k + 1) % sides] - points[k];
+                    let angle = e.y.atan2(e.x);
+                    for offset in [0.0, 0.3, -0.3, 0.7, -0.7, 3.0] {
+                        let a = angle + offset * ANGULAR_TOLERANCE;
+                        directions.push(DVec3::new(a.cos(), a.sin(), 0.0) * 1.5);
+                    }
+                    directions.push(DVec3::new((angle + 0.4).cos(), (angle + 0.4).sin(), 0.0));
+                }
+                for d in directions {
+                    for face_is_b in [true, false] {
+                        // the segment's points: [p, p + d]
+                        let seg_points = vec![DVec3::new(0.5, 0.25, 0.0), DVec3::new(0.5, 0.25, 0.0) + d];
+                        let mut got = Vec::new();
+                        let mut classes = Vec::new();
+                        face_plus_segment(
+                            &corners,
+                            &points,
+                            [0, 1],
+                            &seg_points,
+                            face_is_b,
+                            normal,
+                            &mut classes,
+                            &mut got,
+                        );
+                        let (b_points, b_corners, a_points, a_corners) = if face_is_b {
+                            (&points, corners.clone(), &seg_points, vec![0, 1])
+                        } else {
+                            (&seg_points, vec![0, 1], &points, corners.clone())
+                        };
+                        let (b, r) = raw_polygon(b_points, &b_corners, normal, None);
+                        let (a, _) = raw_polygon(a_points, &a_corners, normal, Some(r));
+                        let scratch = PlanarScratch { b, a, classes: Vec::new() };
+                        let mut expected = Vec::new();
+                        planar_merge(&[], normal, false, &scratch, &mut expected);
+                        assert!(
+                            same_cycle(&got, &expected),
+                            "{sides} sides, d {d}, face_is_b {face_is_b}: {got:?} vs {expected:?}"
+                        );
+                        cases += 1;
+                    }
+                }
+            }
+        }
+        assert!(cases > 500);
     }
 
     #[test]
