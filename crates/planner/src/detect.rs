@@ -21,8 +21,6 @@ use stackplan_cspace::PlacedConvex;
 use stackplan_cspace::interference::{PairContact, gjk_distance, project};
 use stackplan_geom::polytope::ConvexPolytope;
 use stackplan_geom::{Part, Pose};
-use std::collections::HashMap;
-use std::collections::hash_map::Entry;
 
 /// A component of a stack part, placed in the world.
 #[derive(Debug, Clone)]
@@ -261,39 +259,34 @@ fn scan_direct(
     false
 }
 
-/// What [`AxesCache`] knows of a pair: tested once (its axes are computed on the fly), or its [`PairAxes`] (built
-/// on the second test, so pairs tested once cost no allocation).
-#[derive(Debug, Clone)]
-pub enum PairEntry {
-    /// Tested once.
-    Seen,
-    /// Tested more than once.
-    Axes(PairAxes),
+/// The separating-axis data of the pairs tested so far, by (orientation index, moving component, stack component):
+/// for each pair "never tested", "tested once" (its axes are computed on the fly) or its [`PairAxes`] (built on the
+/// second test, so pairs tested once cost no allocation). A dense index per (orientation, moving component) over the
+/// stack components (4 bytes a pair, allocated when the pair's row is first touched) into one arena of axes: the
+/// narrow phase looks up every pair that passes the boxes, so this replaces a hash map whose probes dominated it.
+#[derive(Debug, Clone, Default)]
+pub struct AxesCache {
+    /// `[orientation][moving][fixed]`: 0 never tested, 1 tested once, `k + 2` = `axes[k]`.
+    index: Vec<Vec<Vec<u32>>>,
+    axes: Vec<PairAxes>,
 }
 
-/// A multiplicative hasher for the small integer keys of [`AxesCache`] (the standard SipHash dominated the lookups).
-#[derive(Debug, Clone, Copy, Default)]
-pub struct KeyHasher(u64);
+const UNSEEN: u32 = 0;
+const SEEN: u32 = 1;
 
-impl std::hash::Hasher for KeyHasher {
-    fn finish(&self) -> u64 {
-        self.0
+impl AxesCache {
+    /// Forgets every pair.
+    pub fn clear(&mut self) {
+        self.index.clear();
+        self.axes.clear();
     }
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u64(u64::from(b));
-        }
-    }
-    fn write_u64(&mut self, x: u64) {
-        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-    }
-    fn write_usize(&mut self, x: usize) {
-        self.write_u64(x as u64);
+
+    /// The cached axes of a pair, if it has them.
+    fn axes_mut(&mut self, orientation: usize, moving: usize, fixed: usize) -> Option<&mut PairAxes> {
+        let slot = *self.index.get(orientation)?.get(moving)?.get(fixed)?;
+        if slot >= 2 { self.axes.get_mut((slot - 2) as usize) } else { None }
     }
 }
-
-/// The separating-axis data of the pairs tested so far, by (orientation index, moving component, stack component).
-pub type AxesCache = HashMap<(usize, usize, usize), PairEntry, std::hash::BuildHasherDefault<KeyHasher>>;
 
 /// A pair whose normal axes did not decide it: the running maximum so far (an upper bound of its violation follows
 /// from it) and whether its scan runs on the fly or on cached axes.
@@ -393,6 +386,21 @@ impl CandidateQueue {
                 Some(s) => (&s.axes[mi].0, &s.axes[mi].1),
                 None => (&placed.normal_axes, &placed.edge_directions),
             };
+            let AxesCache { index, axes: arena } = &mut *cache;
+            let row = {
+                if index.len() <= orientation.index {
+                    index.resize_with(orientation.index + 1, Vec::new);
+                }
+                let rows = &mut index[orientation.index];
+                if rows.len() <= mi {
+                    rows.resize_with(mi + 1, Vec::new);
+                }
+                let row = &mut rows[mi];
+                if row.len() < scene.components.len() {
+                    row.resize(scene.components.len(), UNSEEN);
+                }
+                row
+            };
             for &fi in &near {
                 let fixed = &scene.components[fi];
                 if !boxes_overlap(&moved_box, &fixed.placed.aabb, margin) {
@@ -412,26 +420,18 @@ impl CandidateQueue {
                 }
                 let mut best = f64::NEG_INFINITY;
                 // first test of the pair: on the fly; second: build and keep its axes; later: reuse them
-                let (decided, direct, scanned) = match cache.entry((orientation.index, mi, fi)) {
-                    Entry::Vacant(v) => {
-                        v.insert(PairEntry::Seen);
-                        (scan_direct(normals, edges, &fixed.placed, moving, &rule, true, &mut best), true, 0)
+                let slot = &mut row[fi];
+                let (decided, direct, scanned) = if *slot == UNSEEN {
+                    *slot = SEEN;
+                    (scan_direct(normals, edges, &fixed.placed, moving, &rule, true, &mut best), true, 0)
+                } else {
+                    if *slot == SEEN {
+                        *slot = arena.len() as u32 + 2;
+                        arena.push(PairAxes::new(normals, edges, &fixed.placed));
                     }
-                    Entry::Occupied(o) => {
-                        let e = o.into_mut();
-                        if let PairEntry::Seen = e {
-                            *e = PairEntry::Axes(PairAxes::new(normals, edges, &fixed.placed));
-                        }
-                        match e {
-                            PairEntry::Axes(axes) => {
-                                let k = (normals.len() + fixed.placed.normal_axes.len()).min(axes.axes.len());
-                                (axes.scan(moving, &rule, 0..k, &mut best), false, k)
-                            }
-                            PairEntry::Seen => {
-                                (scan_direct(normals, edges, &fixed.placed, moving, &rule, true, &mut best), true, 0)
-                            }
-                        }
-                    }
+                    let axes = &mut arena[(*slot - 2) as usize];
+                    let k = (normals.len() + fixed.placed.normal_axes.len()).min(axes.axes.len());
+                    (axes.scan(moving, &rule, 0..k, &mut best), false, k)
                 };
                 if !decided {
                     queue.open.push(OpenPair { moving: mi, fixed: fi, best, direct, scanned });
@@ -511,13 +511,13 @@ impl CandidateQueue {
             };
             scan_direct(normals, edges, &fixed.placed, moving, &self.rule, false, &mut open.best)
         } else {
-            match cache.get_mut(&(orientation.index, mi, fi)) {
-                Some(PairEntry::Axes(axes)) => {
+            match cache.axes_mut(orientation.index, mi, fi) {
+                Some(axes) => {
                     let n = axes.axes.len();
                     axes.scan(moving, &self.rule, open.scanned..n, &mut open.best)
                 }
                 // the entry was built when the pair was opened: cannot happen
-                _ => false,
+                None => false,
             }
         };
         let tol = self.tol;

@@ -214,21 +214,76 @@ struct Node<const D: usize> {
     applied: Arc<Vec<u32>>,
 }
 
-impl<const D: usize> PartialEq for Node<D> {
+/// The key of a node in the heap: its cost, orientation and id (the total order of the search), and its slot in
+/// [`NodeHeap`]'s slab.
+#[derive(Debug, Clone, Copy)]
+struct HeapKey {
+    cost: f64,
+    orientation: u32,
+    slot: u32,
+    id: u64,
+}
+
+impl PartialEq for HeapKey {
     fn eq(&self, other: &Self) -> bool {
         self.cmp(other) == Ordering::Equal
     }
 }
-impl<const D: usize> Eq for Node<D> {}
-impl<const D: usize> PartialOrd for Node<D> {
+impl Eq for HeapKey {}
+impl PartialOrd for HeapKey {
     fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
         Some(self.cmp(other))
     }
 }
-impl<const D: usize> Ord for Node<D> {
+impl Ord for HeapKey {
     /// Reversed so that `BinaryHeap` pops the cheapest (then lowest orientation, then lowest id).
     fn cmp(&self, other: &Self) -> Ordering {
         other.cost.total_cmp(&self.cost).then(other.orientation.cmp(&self.orientation)).then(other.id.cmp(&self.id))
+    }
+}
+
+/// The open nodes: a binary heap of small keys (cost, orientation, id) over a slab of the nodes themselves (whose
+/// cells, optima and paths would otherwise be moved at every sift). Pops in the order (cost, orientation, id).
+struct NodeHeap<const D: usize> {
+    keys: BinaryHeap<HeapKey>,
+    slab: Vec<Option<Node<D>>>,
+    free: Vec<u32>,
+}
+
+impl<const D: usize> Default for NodeHeap<D> {
+    fn default() -> Self {
+        Self { keys: BinaryHeap::new(), slab: Vec::new(), free: Vec::new() }
+    }
+}
+
+impl<const D: usize> NodeHeap<D> {
+    fn push(&mut self, node: Node<D>) {
+        let key = HeapKey { cost: node.cost, orientation: node.orientation as u32, slot: 0, id: node.id };
+        let slot = match self.free.pop() {
+            Some(slot) => {
+                self.slab[slot as usize] = Some(node);
+                slot
+            }
+            None => {
+                self.slab.push(Some(node));
+                (self.slab.len() - 1) as u32
+            }
+        };
+        self.keys.push(HeapKey { slot, ..key });
+    }
+
+    fn pop(&mut self) -> Option<Node<D>> {
+        let key = self.keys.pop()?;
+        self.free.push(key.slot);
+        self.slab[key.slot as usize].take()
+    }
+
+    fn len(&self) -> usize {
+        self.keys.len()
+    }
+
+    fn is_empty(&self) -> bool {
+        self.keys.is_empty()
     }
 }
 
@@ -261,6 +316,42 @@ fn restrict_quadratic<const D: usize>(q: &SeparableQuadratic, fixed_z: f64) -> Q
 /// A child of a split: the face's outside half-space `normal . p >= offset` and the face's index.
 type Outside<const D: usize> = (([f64; D], f64), u32);
 
+/// The obstacles known at one orientation, their planes stored contiguously (the known-obstacle test of every popped
+/// node scans them all; one flat array instead of a pointer chase per obstacle).
+#[derive(Debug, Default)]
+struct KnownObstacles {
+    /// Obstacle ids, in the order they became known.
+    ids: Vec<u32>,
+    /// `planes[starts[k]..starts[k + 1]]` are obstacle `ids[k]`'s planes `(normal, offset)`.
+    starts: Vec<u32>,
+    planes: Vec<(DVec3, f64)>,
+}
+
+impl KnownObstacles {
+    fn push(&mut self, id: u32, obstacle: &DerivedObstacle) {
+        if self.starts.is_empty() {
+            self.starts.push(0);
+        }
+        self.ids.push(id);
+        self.planes.extend(obstacle.planes.iter().map(|pl| (pl.normal, pl.offset)));
+        self.starts.push(self.planes.len() as u32);
+    }
+
+    /// [`DerivedObstacle::interior_depth`] of obstacle `ids[k]` (the same arithmetic).
+    #[inline]
+    fn interior_depth(&self, k: usize, p: DVec3, tol: f64) -> Option<f64> {
+        let mut depth = f64::INFINITY;
+        for &(normal, offset) in &self.planes[self.starts[k] as usize..self.starts[k + 1] as usize] {
+            let slack = offset - tol - normal.dot(p);
+            if slack <= 0.0 {
+                return None;
+            }
+            depth = depth.min(slack);
+        }
+        Some(depth + tol)
+    }
+}
+
 /// The search state shared by the loop.
 struct Search<'r, 'a> {
     request: &'r PlacementRequest<'a>,
@@ -273,7 +364,7 @@ struct Search<'r, 'a> {
     derived: HashMap<(usize, usize, usize), Arc<DerivedObstacle>>,
     obstacle_ids: HashMap<(usize, usize, usize), u32>,
     /// The obstacles built (or taken from the shared caches) for each orientation, in order.
-    by_orientation: Vec<Vec<u32>>,
+    by_orientation: Vec<KnownObstacles>,
     /// Per orientation, the (moving, stack component) pairs whose derived obstacle an earlier search of the plan
     /// built (indexed once per search; taken when the orientation is first expanded).
     shared_pairs: Vec<Vec<(usize, usize)>>,
@@ -431,7 +522,7 @@ pub fn place_with_caches(
         cache,
         obstacles: Vec::new(),
         obstacle_ids: HashMap::new(),
-        by_orientation: vec![Vec::new(); n_orientations],
+        by_orientation: (0..n_orientations).map(|_| KnownObstacles::default()).collect(),
         shared_pairs,
         axes: std::mem::take(&mut caches.axes),
         derived: std::mem::take(&mut caches.derived),
@@ -507,7 +598,7 @@ impl Search<'_, '_> {
                 Ok(opt.map(|opt| (cell, opt)))
             })
             .collect();
-        let mut heap: BinaryHeap<Node<D>> = BinaryHeap::new();
+        let mut heap: NodeHeap<D> = NodeHeap::default();
         let mut next_id: u64 = 0;
         for (i, r) in roots.into_iter().enumerate() {
             match r? {
@@ -591,9 +682,10 @@ impl Search<'_, '_> {
             // below runs only when none does
             let mut cutting: Option<u32> = {
                 let mut best: Option<(f64, u32)> = None;
-                for &id in &self.by_orientation[node.orientation] {
+                let known = &self.by_orientation[node.orientation];
+                for (k, &id) in known.ids.iter().enumerate() {
                     // the interior test exits at the first plane p* is outside of: cheaper than the path lookup
-                    if let Some(depth) = self.obstacles[id as usize].interior_depth(p, tol)
+                    if let Some(depth) = known.interior_depth(k, p, tol)
                         && best.is_none_or(|(d, _)| depth > d)
                         && !node.applied.contains(&id)
                     {
@@ -695,7 +787,7 @@ impl Search<'_, '_> {
             let id = self.obstacles.len() as u32;
             self.obstacles.push(Arc::clone(shared));
             self.obstacle_ids.insert((orientation, moving, fixed), id);
-            self.by_orientation[orientation].push(id);
+            self.by_orientation[orientation].push(id, shared);
             self.stats.pairs_evaluated += 1;
             self.stats.time_obstacles_ms += ms(t);
             return Ok(id);
@@ -734,9 +826,10 @@ impl Search<'_, '_> {
         ));
         self.derived.insert((orientation, moving, fixed), Arc::clone(&built));
         let id = self.obstacles.len() as u32;
+        self.by_orientation[orientation].push(id, &built);
         self.obstacles.push(built);
         self.obstacle_ids.insert((orientation, moving, fixed), id);
-        self.by_orientation[orientation].push(id);
+
         self.stats.pairs_evaluated += 1;
         self.stats.time_obstacles_ms += ms(t);
         Ok(id)
