@@ -740,14 +740,14 @@ fn assemble(
             (Feature::Face(g), Feature::Edge(ea)) => {
                 let corners = &fixed.faces()[g].vertices;
                 let [i0, i1] = a_arcs[ea].vertices;
-                face_plus_segment(corners, bv, [i0, i1], neg_ra, true, spec.normal, &mut scratch.classes, cycle);
+                face_plus_segment::<true>(corners, bv, [i0, i1], neg_ra, spec.normal, &mut scratch.classes, cycle);
             }
             (Feature::Edge(eb), Feature::Face(f)) => {
                 let corners = &mut scratch.a.corners;
                 corners.clear();
                 corners.extend(moving.faces()[f].vertices.iter().rev());
                 let [j0, j1] = b_arcs[eb].vertices;
-                face_plus_segment(corners, neg_ra, [j0, j1], bv, false, spec.normal, &mut scratch.classes, cycle);
+                face_plus_segment::<false>(corners, neg_ra, [j0, j1], bv, spec.normal, &mut scratch.classes, cycle);
             }
             (fixed_feature, moving_feature) => {
                 let n = spec.normal;
@@ -777,7 +777,9 @@ fn assemble(
         kinds.push(FaceKind::from_features(spec.fixed, spec.moving).unwrap_or(FaceKind::Unclassified));
     }
     let (v, f) = (vertices.len(), faces.len());
-    let polytope = ConvexPolytope::from_faces(vertices, faces).map_err(OverlayFailure::Assembly)?;
+    // every face has a positive area by construction (a translated face of `A` or `B`, a sum containing one, or a
+    // parallelogram of two edges that cross properly, i.e. are not parallel): only the edge table is checked
+    let polytope = ConvexPolytope::from_faces_with_area(vertices, faces).map_err(OverlayFailure::Assembly)?;
     if v + f != polytope.edges().len() + 2 {
         return Err(OverlayFailure::Euler);
     }
@@ -858,7 +860,7 @@ fn planar_merge(
 }
 
 /// [`planar_merge`] for a face plus a parallel edge (a 2-gon), in one pass: the face polygon `corners` (points
-/// `points`, counter-clockwise about `normal`) plus the segment `segment` (points `segment_points`); `face_is_b` says
+/// `points`, counter-clockwise about `normal`) plus the segment `segment` (points `segment_points`); `FACE_IS_B` says
 /// whether the face is `B`'s (the corner labels are then `[segment vertex, corner]`, else `[corner, segment vertex]`).
 ///
 /// With `d` the segment's direction, every face edge `e` is *parallel* (`e . d > 0`), *antiparallel* (`e . d < 0`)
@@ -869,12 +871,11 @@ fn planar_merge(
 /// when the edges on both sides translate it alike, else two (the segment's edge `d` or `-d` joins them). Exactly the
 /// cycle [`planar_merge`] gives for the 2-gon (up to where it starts), in O(|F|) with one cross product per edge.
 #[allow(clippy::too_many_arguments)]
-fn face_plus_segment(
+fn face_plus_segment<const FACE_IS_B: bool>(
     corners: &[usize],
     points: &[DVec3],
     segment: [usize; 2],
     segment_points: &[DVec3],
-    face_is_b: bool,
     normal: DVec3,
     classes: &mut Vec<u8>,
     out: &mut Vec<[usize; 2]>,
@@ -892,19 +893,24 @@ fn face_plus_segment(
         let next = if k == m { first } else { points[corners[k]] };
         let e = next - current;
         current = next;
-        // the parallel test with B's edge first, as in `planar_merge`
-        let (p, q) = if face_is_b { (e, d) } else { (d, e) };
+        // the parallel test with B's edge first, as in `planar_merge` (bit for bit: the same products in the same
+        // order); `|c . normal| <= |c|`, so a turn clearly above the tolerance skips the length (the margin 2 covers
+        // the rounding of the unit normal)
+        let (p, q) = if FACE_IS_B { (e, d) } else { (d, e) };
         let c = p.cross(q);
+        let turn = c.dot(normal);
         let tolerance = PARALLEL_SQ * p.length_squared() * q.length_squared();
-        classes.push(if c.length_squared() <= tolerance {
+        let parallel = turn * turn <= 2.0 * tolerance && c.length_squared() <= tolerance;
+        // (d x e) . normal is `turn` for an A face and `-turn` for a B face
+        classes.push(if parallel {
             if e.dot(d) > 0.0 { PARALLEL } else { ANTIPARALLEL }
-        } else if d.cross(e).dot(normal) > 0.0 {
+        } else if (if FACE_IS_B { -turn } else { turn }) > 0.0 {
             AFTER
         } else {
             BEFORE
         });
     }
-    let label = |corner: usize, end: usize| if face_is_b { [segment[end], corner] } else { [corner, segment[end]] };
+    let label = |corner: usize, end: usize| if FACE_IS_B { [segment[end], corner] } else { [corner, segment[end]] };
     for k in 0..m {
         let (incoming, outgoing) = (classes[if k == 0 { m - 1 } else { k - 1 }], classes[k]);
         // the end of the segment by which corner k is translated as the end of the incoming edge, and as the start
@@ -1005,16 +1011,12 @@ mod tests {
                         let seg_points = vec![DVec3::new(0.5, 0.25, 0.0), DVec3::new(0.5, 0.25, 0.0) + d];
                         let mut got = Vec::new();
                         let mut classes = Vec::new();
-                        face_plus_segment(
-                            &corners,
-                            &points,
-                            [0, 1],
-                            &seg_points,
-                            face_is_b,
-                            normal,
-                            &mut classes,
-                            &mut got,
-                        );
+                        let (c, p, sp) = (&corners, &points, &seg_points);
+                        if face_is_b {
+                            face_plus_segment::<true>(c, p, [0, 1], sp, normal, &mut classes, &mut got);
+                        } else {
+                            face_plus_segment::<false>(c, p, [0, 1], sp, normal, &mut classes, &mut got);
+                        }
                         let (b_points, b_corners, a_points, a_corners) = if face_is_b {
                             (&points, corners.clone(), &seg_points, vec![0, 1])
                         } else {

@@ -268,6 +268,16 @@ impl ConvexPolytope {
         Ok(Self { vertices, faces, edges, face_edges })
     }
 
+    /// [`Self::from_faces`] without its zero-area check of every face (the edge table, the manifold and index checks
+    /// and the finiteness check are the same): for constructions that give every face a positive area by design, such
+    /// as the Gauss-map Minkowski sums of `stackplan-cspace`, whose faces each contain a translated face of a summand
+    /// or are parallelograms of two non-parallel edges. The faces' planes must have unit normals.
+    pub fn from_faces_with_area(vertices: Vec<DVec3>, faces: Vec<Face>) -> Result<Self, PolytopeError> {
+        check_vertices(&vertices)?;
+        let (edges, face_edges) = edge_table(vertices.len(), &faces, |f| f.vertices.as_slice())?;
+        Ok(Self { vertices, faces, edges, face_edges })
+    }
+
     /// The same topology (faces, edges) with new vertex coordinates and face planes, in O(V + F) without any
     /// search: for computed polytopes whose structure is known to be unchanged (e.g. c-space obstacles extrapolated
     /// within a constant-topology interval). `None` when the lengths do not match this polytope's.
@@ -690,6 +700,19 @@ mod tests {
 
     pub(crate) fn unit_cube() -> ConvexPolytope {
         ConvexPolytope::cuboid(DVec3::ZERO, DVec3::ONE).expect("cube")
+    }
+
+    #[test]
+    fn from_faces_with_area_equals_from_faces_on_proper_faces() {
+        let c = unit_cube();
+        let faces = c.faces().to_vec();
+        let a = ConvexPolytope::from_faces(c.vertices().to_vec(), faces.clone()).expect("checked");
+        let b = ConvexPolytope::from_faces_with_area(c.vertices().to_vec(), faces.clone()).expect("unchecked area");
+        assert_eq!(format!("{a:?}"), format!("{b:?}"));
+        // the manifold check stays
+        let mut open = faces;
+        open.pop();
+        assert!(ConvexPolytope::from_faces_with_area(c.vertices().to_vec(), open).is_err());
     }
 
     #[test]
