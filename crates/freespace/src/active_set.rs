@@ -28,6 +28,11 @@
 //!    `lambda_0 + e1 mu_1 + ...`, compared lexicographically with 0). If one is lexicographically negative, drop that
 //!    constraint; otherwise `p` is optimal.
 //!
+//! Linear objectives (`h = 0`, every LP of the crate) skip the flat/curved split (the whole null space is flat; the
+//! shortcut gives the general split's bits), and the orthonormal basis of the working rows is extended by one
+//! Gram-Schmidt step as a row joins instead of being recomputed. The phase 1 in 2-3 variables
+//! (`Problem::seek_small`) runs with its linear algebra in closed form (cross products, Cramer's rule).
+//!
 //! Anti-cycling: after `4 m + 20` iterations both choices switch to Bland's rule (lowest index); a hard iteration
 //! limit returns an error instead of looping. Cost per iteration O(m) (the ratio test) plus O(1) linear algebra on
 //! at most 4x4 matrices; in three variables the number of iterations is usually at most 4-8.
@@ -315,17 +320,23 @@ struct Subspace {
 
 impl Subspace {
     fn new(prob: &Problem<'_>, w: &WorkSet) -> Self {
-        Self::build(prob, w, true)
+        Self::build(prob, &Self::row_basis(prob, w), true)
     }
 
-    /// The split of the null space of `w`; `lp_shortcut`: take the bit-identical shortcut for a linear objective
-    /// (`false` only in the test that checks it).
-    fn build(prob: &Problem<'_>, w: &WorkSet, lp_shortcut: bool) -> Self {
-        let n = prob.n;
+    /// The orthonormal basis of the working rows: Gram-Schmidt in working-set order (a row dependent on the earlier
+    /// ones is skipped). Adding a row to the working set extends it by one `try_add` of that row, bit for bit.
+    fn row_basis(prob: &Problem<'_>, w: &WorkSet) -> Basis {
         let mut rows = Basis::new();
         for &j in w.as_slice() {
             rows.try_add(&prob.rows[j], RANK_TOL);
         }
+        rows
+    }
+
+    /// The split of the null space of the working rows (`rows`: their [`Subspace::row_basis`]); `lp_shortcut`: take
+    /// the bit-identical shortcut for a linear objective (`false` only in the test that checks it).
+    fn build(prob: &Problem<'_>, rows: &Basis, lp_shortcut: bool) -> Self {
+        let n = prob.n;
         let null = if rows.len == 0 {
             let mut id = Basis::new();
             for i in 0..n {
@@ -551,6 +562,29 @@ impl Problem<'_> {
         (None, lambda0)
     }
 
+    /// The ratio test of a move `p + t dir` (`len = |dir|`, `t <= alpha0`): the first enabled constraint outside the
+    /// working set that blocks it (normal component along the unit direction above `BLOCK_TOL`; slack clamped at
+    /// zero, so a constraint violated by rounding blocks at once) and the step length. O(m); the cheap component test
+    /// comes first, the mask and working-set tests only for the rows that pass it.
+    #[inline]
+    fn ratio_test(&self, w: &WorkSet, p: &V4, dir: &V4, len: f64, alpha0: f64) -> (f64, Option<usize>) {
+        let threshold = BLOCK_TOL * len;
+        let mut alpha = alpha0;
+        let mut blocking = None;
+        for (j, a) in self.rows.iter().enumerate() {
+            let ad = dot4(a, dir);
+            if ad > threshold && self.enabled(j) && !w.contains(j) {
+                let slack = (self.offsets[j] - dot4(a, p)).max(0.0);
+                let t = slack / ad;
+                if t < alpha {
+                    alpha = t;
+                    blocking = Some(j);
+                }
+            }
+        }
+        (alpha, blocking)
+    }
+
     /// Phase 1 towards one more constraint: the LP `min g . p` (with `h = 0`, no tie-break) run from `start`
     /// (feasible for the enabled constraints, or infeasible only by rounding) and stopped as soon as
     /// `g . p <= target`: on the move that crosses the level the point stops exactly there. Returns
@@ -581,23 +615,8 @@ impl Problem<'_> {
             match step {
                 Step::Move { dir, bounded, stage: 0 } => {
                     let len = norm4(&dir);
-                    let mut alpha = if bounded { 1.0 } else { f64::INFINITY };
-                    let mut blocking = None;
-                    for j in 0..m {
-                        if !self.enabled(j) || w.contains(j) {
-                            continue;
-                        }
-                        let a = &self.rows[j];
-                        let ad = dot4(a, &dir);
-                        if ad > BLOCK_TOL * len {
-                            let slack = (self.offsets[j] - dot4(a, &p)).max(0.0);
-                            let t = slack / ad;
-                            if t < alpha {
-                                alpha = t;
-                                blocking = Some(j);
-                            }
-                        }
-                    }
+                    let (alpha, blocking) =
+                        self.ratio_test(&w, &p, &dir, len, if bounded { 1.0 } else { f64::INFINITY });
                     let descent = dot4(&self.g, &dir);
                     if descent < 0.0 {
                         let to_level = (target - level) / descent;
@@ -778,36 +797,34 @@ impl Problem<'_> {
         // same constraint. They stay in the working set until the point moves.
         let mut banned: Vec<usize> = Vec::new();
         let mut last_dropped: Option<usize> = None;
+        // the working rows' orthonormal basis, extended as rows join and rebuilt when one leaves
+        let mut row_basis = Basis::new();
         for iter in 0..limit {
-            let sub = Subspace::new(self, &w);
+            debug_assert!(
+                row_basis
+                    .vectors()
+                    .iter()
+                    .map(|v| v.map(f64::to_bits))
+                    .eq(Subspace::row_basis(self, &w).vectors().iter().map(|v| v.map(f64::to_bits))),
+                "the maintained row basis is the recomputed one, bit for bit"
+            );
+            let sub = Subspace::build(self, &row_basis, true);
             match self.step(&sub, &p) {
                 Step::Move { dir, bounded, stage } => {
                     let len = norm4(&dir);
-                    let mut alpha = if bounded { 1.0 } else { f64::INFINITY };
-                    let mut blocking = None;
-                    for j in 0..m {
-                        if !self.enabled(j) || w.contains(j) {
-                            continue;
-                        }
-                        let a = &self.rows[j];
-                        let ad = dot4(a, &dir);
-                        if ad > BLOCK_TOL * len {
-                            let slack = (self.offsets[j] - dot4(a, &p)).max(0.0);
-                            let t = slack / ad;
-                            if t < alpha {
-                                alpha = t;
-                                blocking = Some(j);
-                            }
-                        }
-                    }
+                    let (alpha, blocking) =
+                        self.ratio_test(&w, &p, &dir, len, if bounded { 1.0 } else { f64::INFINITY });
                     match blocking {
                         None if !bounded => return Ok(Outcome::Unbounded { point: p, stage }),
                         _ => {}
                     }
                     axpy(&mut p, alpha, &dir);
                     record_move(alpha * len, self.length_scale, blocking, &mut last_dropped, &mut banned);
-                    if let Some(j) = blocking {
+                    if let Some(j) = blocking
+                        && w.len < MAX_N
+                    {
                         w.push(j);
+                        row_basis.try_add(&self.rows[j], RANK_TOL);
                     }
                 }
                 Step::Stationary => {
@@ -816,6 +833,7 @@ impl Problem<'_> {
                         Some(k) => {
                             last_dropped = Some(w.idx[k]);
                             w.remove_at(k);
+                            row_basis = Subspace::row_basis(self, &w);
                         }
                         None => {
                             return Ok(Outcome::Optimal { point: p, working: w, multipliers, iterations: iter + 1 });
@@ -1265,8 +1283,9 @@ mod tests {
                     w.push(j);
                 }
             }
-            let fast = Subspace::build(&prob, &w, true);
-            let general = Subspace::build(&prob, &w, false);
+            let rows_basis = Subspace::row_basis(&prob, &w);
+            let fast = Subspace::build(&prob, &rows_basis, true);
+            let general = Subspace::build(&prob, &rows_basis, false);
             let bits = |b: &Basis| b.vectors().iter().map(|v| v.map(f64::to_bits)).collect::<Vec<_>>();
             proptest::prop_assert_eq!(bits(&fast.flat), bits(&general.flat));
             proptest::prop_assert_eq!(bits(&fast.curved), bits(&general.curved));

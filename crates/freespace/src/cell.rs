@@ -19,6 +19,10 @@
 //! [`CellError::Unbounded`] otherwise. Cells derived from a bounded cell (Omega, subtraction pieces, intersections)
 //! are subsets of it and skip the check. So the QP on a cell always has a minimiser and every tie-break terminates.
 //!
+//! **Known points.** [`Cell::is_empty_with`] decides the emptiness of a child cell by a phase 1 from a point of its
+//! parent (closed-form LPs in 2-3 variables, no Chebyshev LP); [`Cell::with_halfspaces_from`] also builds the
+//! non-empty child from a point found that way ([`CellShape::Known`]), skipping its Chebyshev LP.
+//!
 //! Redundancy removal costs one LP per inequality (O(m) iterations of O(m) each); membership is O(m).
 
 use crate::active_set::{ActiveSetError, MAX_N, Outcome, Problem, Seek, V4, dot4};
