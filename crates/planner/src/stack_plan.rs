@@ -8,9 +8,10 @@
 //! 2. the best-first placement search ([`crate::search::place`]) returns up to [`PlanOptions::candidates`]
 //!    interference-free positions sorted by the part's term of cost (1), one per free-space cell; with
 //!    `insertion` every candidate can be lowered straight down into place (insertion obstacles);
-//! 3. the candidates are tested in cost order with [`stackplan_stability::check::check_stack`] on the stack plus the
-//!    candidate: the new part statically stable on its supports (friction cones), the whole stack stable, a suction
-//!    face for the cup, insertable from above; the first that passes is taken;
+//! 3. the candidates are tested in cost order with [`stackplan_stability::check_added_part`] on the stack plus the
+//!    candidate (the new part's report of [`stackplan_stability::check::check_stack`], without re-checking the parts
+//!    that passed before): the new part statically stable on its supports (friction cones), the whole stack stable,
+//!    a suction face for the cup, insertable from above; the first that passes is taken;
 //! 4. the seed's two stages: stage 1 searches within the stack's current floor footprint (its bounding rectangle
 //!    grown by `nest_allowance`, clipped to the floor), so the stack's bounding box is not enlarged, or only
 //!    slightly to nest; stage 2 searches the whole floor. Stage 1's part is taken unless stage 2's is strictly
@@ -31,6 +32,7 @@ use serde::{Deserialize, Serialize};
 use stackplan_cspace::cache::ObstacleCache;
 use stackplan_geom::{Part, Pose, Tolerance};
 use stackplan_stability::check::{CheckOptions, check_stack};
+use stackplan_stability::check_added_part;
 use stackplan_stability::grasp::{GraspOptions, grasp_faces, is_graspable};
 use stackplan_stability::world::PlacedPart;
 
@@ -484,13 +486,11 @@ fn accept(
     let mut world: Vec<PlacedPart<'_>> =
         placed.iter().map(|p| PlacedPart { part, rotation: p.rotation, position: p.position }).collect();
     world.push(PlacedPart { part, rotation: pose.rotation, position: pose.position });
-    let report = check_stack(&world, options).map_err(|e| PlanError::Check(e.to_string()))?;
-    let Some(new) = report.parts.last() else {
-        return Ok(Err("the stack check returned no part".into()));
-    };
+    // the stack before the candidate passed these checks when its parts were added: only the new part is checked
+    let new = check_added_part(&world, options).map_err(|e| PlanError::Check(e.to_string()))?;
     let reason = if !new.stable.is_stable() {
         "not stable on its supports"
-    } else if !report.stack.verdict.is_stable() {
+    } else if !new.stack_stable.is_stable() {
         "the stack would not be stable"
     } else if !new.graspable {
         "no suction face for the cup"

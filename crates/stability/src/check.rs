@@ -138,11 +138,22 @@ pub fn check_stack_reference(stack: &[PlacedPart<'_>], options: &CheckOptions) -
     check_stack_with(stack, options, true)
 }
 
-fn check_stack_with(
-    stack: &[PlacedPart<'_>],
-    options: &CheckOptions,
-    reference: bool,
-) -> Result<StackCheck, StabilityError> {
+/// A stack in world coordinates with its contacts: what every per-part report reads.
+pub(crate) struct Analysed {
+    /// The parts in world coordinates.
+    pub parts: Vec<WorldPart>,
+    /// The parts at their release positions (with [`CheckOptions::release_drops`]).
+    pub released: Option<Vec<WorldPart>>,
+    /// The length tolerance (mm).
+    pub tol: f64,
+    /// Every contact patch.
+    pub patches: Vec<ContactPatch>,
+    /// Every interference.
+    pub interferences: Vec<crate::contacts::Interference>,
+}
+
+/// Validates the options, places the parts and analyses their contacts.
+pub(crate) fn analyse(stack: &[PlacedPart<'_>], options: &CheckOptions) -> Result<Analysed, StabilityError> {
     if !(options.clearance >= 0.0 && options.clearance.is_finite()) {
         return Err(StabilityError::BadOption(format!("clearance must be >= 0, got {}", options.clearance)));
     }
@@ -177,8 +188,107 @@ fn check_stack_with(
         Some(t) => return Err(StabilityError::BadOption(format!("contact tolerance must be >= 0, got {t}"))),
         None => stack_tolerance(&parts).linear,
     };
-    let n = parts.len();
     let ContactAnalysis { patches, interferences } = analyse_contacts(&parts, tol, |_| true);
+    Ok(Analysed { parts, released, tol, patches, interferences })
+}
+
+/// What a part's report takes from the stack-level analyses.
+pub(crate) struct StackFacts {
+    /// The part's grasp: largest inscribed radius and whether the cup fits.
+    pub grasp: (f64, bool),
+    /// Equilibrium of the stack `0..=i`.
+    pub stack_stable: Verdict,
+    /// Whether the stack `0..i` left behind when the part is lifted away is stable.
+    pub remaining_stable: bool,
+}
+
+/// The report of part `i` (interference, clearance, equilibrium on fixed supports, insertion; the stack-level facts
+/// given).
+pub(crate) fn part_report(
+    a: &Analysed,
+    i: usize,
+    options: &CheckOptions,
+    equilibrium: &EquilibriumOptions,
+    cache: &SolveCache,
+    facts: StackFacts,
+) -> Result<PartCheck, StabilityError> {
+    let (parts, tol) = (&a.parts, a.tol);
+    let n = parts.len();
+    let mut interference = 0.0f64;
+    let mut interferes_with = Vec::new();
+    for x in &a.interferences {
+        let other = if x.b == i {
+            Some(x.a)
+        } else if x.a == Body::Part(i) {
+            Some(Body::Part(x.b))
+        } else {
+            None
+        };
+        if let Some(o) = other {
+            interference = interference.max(x.depth);
+            if !interferes_with.contains(&o) {
+                interferes_with.push(o);
+            }
+        }
+    }
+    let (min_clear, clearance_met) = match &a.released {
+        None => clearance_of(
+            &parts[i],
+            parts.iter().enumerate().filter(|(j, _)| *j != i).map(|(_, p)| p),
+            options.clearance,
+            tol,
+        ),
+        Some(lifted) => clearance_of(&lifted[i], parts[..i].iter(), options.clearance, tol),
+    };
+    let sub: Vec<ContactPatch> = a.patches.iter().filter(|p| patch_within(p, i)).cloned().collect();
+    let movable: Vec<bool> = (0..n).map(|k| k == i).collect();
+    let alone = solve_equilibrium_with(parts, &movable, &sub, equilibrium, cache)?;
+    let (grasp_radius, graspable) = facts.grasp;
+    let obstruction = insertion_obstruction(parts, i, tol).err();
+    let insertable = obstruction.is_none();
+    let removable = insertable && facts.remaining_stable;
+    let stack_stable = facts.stack_stable;
+    let ok = interferes_with.is_empty()
+        && clearance_met
+        && alone.verdict.is_stable()
+        && stack_stable.is_stable()
+        && graspable
+        && insertable
+        && removable;
+    Ok(PartCheck {
+        index: i,
+        name: parts[i].name.clone(),
+        interference,
+        interferes_with,
+        min_horizontal_clearance: min_clear,
+        clearance_met,
+        stable: alone.verdict,
+        margin: alone.margin,
+        forces: alone.forces,
+        stack_stable,
+        grasp_radius,
+        graspable,
+        insertable,
+        insertion_obstruction: obstruction,
+        removable,
+        ok,
+    })
+}
+
+/// The grasp of part `i` alone: largest inscribed radius of an upward face and whether the cup (or pattern) fits.
+pub(crate) fn grasp_of(part: &WorldPart, tol: f64, options: &GraspOptions) -> (f64, bool) {
+    let faces = grasp_faces_of_components(&part.components, tol, options);
+    (faces.iter().map(|f| f.inscribed_radius).fold(0.0, f64::max), is_graspable(&faces, options))
+}
+
+fn check_stack_with(
+    stack: &[PlacedPart<'_>],
+    options: &CheckOptions,
+    reference: bool,
+) -> Result<StackCheck, StabilityError> {
+    let analysed = analyse(stack, options)?;
+    let (parts, patches, tol) = (&analysed.parts, &analysed.patches, analysed.tol);
+    let n = parts.len();
     // one memo for every equilibrium problem of the check (the reference solves everything afresh)
     let cache = SolveCache::new();
     let eq_with_margin = EquilibriumOptions {
@@ -198,12 +308,12 @@ fn check_stack_with(
             decided_by_precheck: false,
         }
     } else {
-        solve_equilibrium_with(&parts, &movable_all, &patches, &eq_with_margin, &cache)?
+        solve_equilibrium_with(parts, &movable_all, patches, &eq_with_margin, &cache)?
     };
     let prefix_verdicts = if options.prefix_stability {
         prefix_verdicts(
-            &parts,
-            &patches,
+            parts,
+            patches,
             &whole.verdict,
             &EquilibriumOptions { directions: 0, verdict_only: true, ..eq_with_margin },
             &cache,
@@ -233,79 +343,22 @@ fn check_stack_with(
             }
         };
     }
-    let grasps: Vec<(f64, bool)> = representatives
-        .par_iter()
-        .map(|&r| {
-            let faces = grasp_faces_of_components(&parts[r].components, tol, &options.grasp);
-            (faces.iter().map(|f| f.inscribed_radius).fold(0.0, f64::max), is_graspable(&faces, &options.grasp))
-        })
-        .collect();
-    let part_report = |i: usize| -> Result<PartCheck, StabilityError> {
-        let mut interference = 0.0f64;
-        let mut interferes_with = Vec::new();
-        for x in &interferences {
-            let other = if x.b == i {
-                Some(x.a)
-            } else if x.a == Body::Part(i) {
-                Some(Body::Part(x.b))
-            } else {
-                None
+    let grasps: Vec<(f64, bool)> =
+        representatives.par_iter().map(|&r| grasp_of(&parts[r], tol, &options.grasp)).collect();
+    let reports: Vec<PartCheck> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let facts = StackFacts {
+                grasp: grasps[grasp_class[i]],
+                stack_stable: prefix_verdicts[i].clone(),
+                remaining_stable: i == 0 || prefix_verdicts[i - 1].is_stable(),
             };
-            if let Some(o) = other {
-                interference = interference.max(x.depth);
-                if !interferes_with.contains(&o) {
-                    interferes_with.push(o);
-                }
-            }
-        }
-        let (min_clear, clearance_met) = match &released {
-            None => clearance_of(
-                &parts[i],
-                parts.iter().enumerate().filter(|(j, _)| *j != i).map(|(_, p)| p),
-                options.clearance,
-                tol,
-            ),
-            Some(lifted) => clearance_of(&lifted[i], parts[..i].iter(), options.clearance, tol),
-        };
-        let sub: Vec<ContactPatch> = patches.iter().filter(|p| patch_within(p, i)).cloned().collect();
-        let movable: Vec<bool> = (0..n).map(|k| k == i).collect();
-        let alone = solve_equilibrium_with(&parts, &movable, &sub, &eq_with_margin, &cache)?;
-        let (grasp_radius, graspable) = grasps[grasp_class[i]];
-        let obstruction = insertion_obstruction(&parts, i, tol).err();
-        let insertable = obstruction.is_none();
-        let remaining_stable = i == 0 || prefix_verdicts[i - 1].is_stable();
-        let removable = insertable && remaining_stable;
-        let stack_stable = prefix_verdicts[i].clone();
-        let ok = interferes_with.is_empty()
-            && clearance_met
-            && alone.verdict.is_stable()
-            && stack_stable.is_stable()
-            && graspable
-            && insertable
-            && removable;
-        Ok(PartCheck {
-            index: i,
-            name: parts[i].name.clone(),
-            interference,
-            interferes_with,
-            min_horizontal_clearance: min_clear,
-            clearance_met,
-            stable: alone.verdict,
-            margin: alone.margin,
-            forces: alone.forces,
-            stack_stable,
-            grasp_radius,
-            graspable,
-            insertable,
-            insertion_obstruction: obstruction,
-            removable,
-            ok,
+            part_report(&analysed, i, options, &eq_with_margin, &cache, facts)
         })
-    };
-    let reports: Vec<PartCheck> = (0..n).into_par_iter().map(part_report).collect::<Result<_, _>>()?;
+        .collect::<Result<_, _>>()?;
     let ok = reports.iter().all(|r| r.ok);
     tracing::info!(parts = n, ok, "stack checked");
-    Ok(StackCheck { parts: reports, stack: whole, contacts: patches, tolerance: tol, ok })
+    Ok(StackCheck { parts: reports, stack: whole, contacts: analysed.patches, tolerance: tol, ok })
 }
 
 /// The verdicts of the prefix stacks `0..=i` (every part movable, the floor fixed); the last one is `whole`.
@@ -383,7 +436,7 @@ fn prefix_verdicts(
 }
 
 /// Whether both bodies of the patch are among the floor and parts `0..=i`.
-fn patch_within(p: &ContactPatch, i: usize) -> bool {
+pub(crate) fn patch_within(p: &ContactPatch, i: usize) -> bool {
     p.b <= i
         && match p.a {
             Body::Floor => true,

@@ -9,11 +9,13 @@
 //! * [`equilibrium`]: static equilibrium with Coulomb friction cones (SOCP, clarabel) and a robustness margin;
 //! * [`insertion`]: lowering straight down / lifting straight up;
 //! * [`clearance`]: horizontal clearance for robot positioning error;
-//! * [`check`]: everything for every part of a stack.
+//! * [`check`]: everything for every part of a stack;
+//! * [`addition`]: the same for a part added to a stack that passed (the planner's per-candidate test).
 //!
 //! Helpers: [`sat`] (separating-axis test with sweeps), [`polygon2d`] (planar hulls and clipping), [`world`]
 //! (placed parts in world coordinates). Lengths in millimetres, angles in radians, forces in mass units times g.
 
+pub mod addition;
 pub mod check;
 pub mod clearance;
 pub mod contacts;
@@ -25,6 +27,7 @@ pub mod resting_poses;
 pub mod sat;
 pub mod world;
 
+pub use addition::check_added_part;
 pub use check::{CheckOptions, PartCheck, StackCheck, check_stack, check_stack_reference};
 pub use contacts::{Body, ContactAnalysis, ContactPatch, analyse_contacts};
 pub use equilibrium::{
