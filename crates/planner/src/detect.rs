@@ -145,6 +145,30 @@ pub struct DetectCounts {
     pub narrow_phase: u64,
 }
 
+/// A moving component at the queue's position: its vertices (moved, or swept) and, computed on first use, its
+/// projection onto each of its own normal axes, which every pair of the component needs on the same axes (the same
+/// values as projecting again: computed once per detection instead of once per pair).
+#[derive(Debug, Clone, Default)]
+struct MovedComponent {
+    vertices: Vec<DVec3>,
+    /// Per normal axis of the component (or of its sweep): the projection `[lo, hi]`, NaN until computed.
+    own: Vec<(f64, f64)>,
+}
+
+impl MovedComponent {
+    /// The projection onto the component's own normal axis `k` (`u`).
+    #[inline]
+    fn own(&mut self, k: usize, u: DVec3) -> (f64, f64) {
+        let e = self.own[k];
+        if e.0.is_nan() {
+            let e = project(&self.vertices, u);
+            self.own[k] = e;
+            return e;
+        }
+        e
+    }
+}
+
 /// The separating axes of one (orientation, moving component, stack component) pair with the stack component's
 /// projection on each: everything of the separating-axis test that does not depend on the position, kept for the
 /// pair's next test ([`AxesCache`]). The axes are those of `stackplan_cspace::interference::sat_gap` and of
@@ -186,12 +210,20 @@ impl PairAxes {
     /// Scans the axes `witness + k` (cyclically) for `k` in `range`, raising `scan.best` to `gap_u - weight |u_xy|`;
     /// stops at the first axis that makes it pass the rule's threshold (remembered as the next witness) and returns
     /// whether it did. O(axes x moving vertices).
-    fn scan(&mut self, moving: &[DVec3], rule: &Rule, range: std::ops::Range<usize>, best: &mut f64) -> bool {
+    fn scan(
+        &mut self,
+        moving: &mut MovedComponent,
+        rule: &Rule,
+        range: std::ops::Range<usize>,
+        best: &mut f64,
+    ) -> bool {
         let n = self.axes.len();
+        // the first axes are the moving component's own normals, in order
+        let own = moving.own.len();
         for k in range {
-            let i = (self.witness + k) % n;
+            let i = if self.witness + k >= n { self.witness + k - n } else { self.witness + k };
             let (u, b_lo, b_hi, horizontal) = self.axes[i];
-            let (a_lo, a_hi) = project(moving, u);
+            let (a_lo, a_hi) = if i < own { moving.own(i, u) } else { project(&moving.vertices, u) };
             let gap = (b_lo - a_hi).max(a_lo - b_hi);
             let value = if rule.weight == 0.0 { gap } else { gap - rule.weight * horizontal };
             *best = best.max(value);
@@ -226,22 +258,27 @@ fn scan_direct(
     moving_normals: &[DVec3],
     moving_edges: &[DVec3],
     fixed: &PlacedConvex,
-    moving: &[DVec3],
+    moving: &mut MovedComponent,
     rule: &Rule,
     normals: bool,
     best: &mut f64,
 ) -> bool {
-    let mut test = |u: DVec3| {
-        let (b_lo, b_hi) = project(&fixed.vertices, u);
-        let (a_lo, a_hi) = project(moving, u);
+    // the stack component's projection onto its own normals is its `normal_extents`, the moving component's onto
+    // its own normals is computed once per detection (the same values)
+    let mut test = |u: DVec3, (a_lo, a_hi): (f64, f64), (b_lo, b_hi): (f64, f64)| {
         let gap = (b_lo - a_hi).max(a_lo - b_hi);
         let value = if rule.weight == 0.0 { gap } else { gap - rule.weight * (1.0 - u.z * u.z).max(0.0).sqrt() };
         *best = best.max(value);
         rule.decided(*best)
     };
     if normals {
-        for &u in moving_normals.iter().chain(&fixed.normal_axes) {
-            if test(u) {
+        for (k, &u) in moving_normals.iter().enumerate() {
+            if test(u, moving.own(k, u), project(&fixed.vertices, u)) {
+                return true;
+            }
+        }
+        for (&u, &extent) in fixed.normal_axes.iter().zip(&fixed.normal_extents) {
+            if test(u, project(&moving.vertices, u), extent) {
                 return true;
             }
         }
@@ -251,8 +288,11 @@ fn scan_direct(
         for &db in &fixed.edge_directions {
             let c = da.cross(db);
             let len2 = c.length_squared();
-            if len2 > 1e-18 && test(c / len2.sqrt()) {
-                return true;
+            if len2 > 1e-18 {
+                let u = c / len2.sqrt();
+                if test(u, project(&moving.vertices, u), project(&fixed.vertices, u)) {
+                    return true;
+                }
             }
         }
     }
@@ -316,7 +356,7 @@ pub struct CandidateQueue {
     horizontal: bool,
     tol: f64,
     rule: Rule,
-    moved: Vec<Vec<DVec3>>,
+    moved: Vec<MovedComponent>,
     open: Vec<OpenPair>,
     exact: Vec<Candidate>,
 }
@@ -353,7 +393,7 @@ impl CandidateQueue {
             horizontal,
             tol,
             rule,
-            moved: vec![Vec::new(); orientation.components.len()],
+            moved: vec![MovedComponent::default(); orientation.components.len()],
             open: Vec::new(),
             exact: Vec::new(),
         };
@@ -408,15 +448,17 @@ impl CandidateQueue {
                 }
                 counts.narrow_phase += 1;
                 let moving = &mut queue.moved[mi];
-                if moving.is_empty() {
+                if moving.vertices.is_empty() {
                     // the same sums as `translated` / `swept`
-                    moving.extend(placed.vertices.iter().map(|v| *v + p));
+                    let vertices = &mut moving.vertices;
+                    vertices.extend(placed.vertices.iter().map(|v| *v + p));
                     if sweep.is_some() {
-                        let n = moving.len();
+                        let n = vertices.len();
                         for k in 0..n {
-                            moving.push(moving[k] + DVec3::new(0.0, 0.0, lift));
+                            vertices.push(vertices[k] + DVec3::new(0.0, 0.0, lift));
                         }
                     }
+                    moving.own = vec![(f64::NAN, f64::NAN); normals.len()];
                 }
                 let mut best = f64::NEG_INFINITY;
                 // first test of the pair: on the fly; second: build and keep its axes; later: reuse them
@@ -493,7 +535,7 @@ impl CandidateQueue {
 
     /// Scans an open pair's remaining axes and classifies it as `classify_pair` / [`horizontal_slack`] would.
     fn finish(
-        &self,
+        &mut self,
         mut open: OpenPair,
         scene: &StackScene,
         orientation: &Orientation,
@@ -503,7 +545,7 @@ impl CandidateQueue {
         let (mi, fi) = (open.moving, open.fixed);
         let placed = &orientation.components[mi];
         let fixed = &scene.components[fi];
-        let moving = &self.moved[mi];
+        let moving = &mut self.moved[mi];
         let decided = if open.direct {
             let (normals, edges) = match sweep {
                 Some(s) => (&s.axes[mi].0, &s.axes[mi].1),
