@@ -217,6 +217,15 @@ fn emptiness(c: &mut Criterion, name: &str) {
             black_box(cell.with_halfspaces(extra.iter().copied()).expect("cell").is_empty())
         })
     });
+    // the child built from the known point (`with_halfspaces_from`: both phases 1, no Chebyshev LP)
+    let mut i = 0;
+    group.bench_function("from_known_point", |b| {
+        b.iter(|| {
+            i = (i + 1) % cases.len();
+            let (cell, at, extra) = &cases[i];
+            black_box(cell.with_halfspaces_from(extra, black_box(at)).expect("cell").is_none())
+        })
+    });
     group.finish();
 }
 
