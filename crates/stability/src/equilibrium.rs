@@ -69,6 +69,7 @@ use serde::{Deserialize, Serialize};
 mod cache;
 mod margin;
 mod tree;
+mod vertical_qp;
 
 pub use cache::SolveCache;
 
@@ -113,8 +114,9 @@ pub struct EquilibriumOptions {
     #[serde(default)]
     pub equilibrium_by_socp_only: bool,
     /// Only the verdict is wanted: a group without a support tree may be certified stable by any admissible force
-    /// distribution (vertical forces at its horizontal contacts, see `tree::vertical_certificate`) instead of the
-    /// minimum-norm solve; the result's forces are then empty.
+    /// distribution (vertical forces at its horizontal contacts: the least-squares one, `tree::vertical_certificate`,
+    /// else the minimum-norm nonnegative one, `vertical_qp`) instead of the minimum-norm solve; the result's forces
+    /// are then empty.
     #[serde(default)]
     pub verdict_only: bool,
 }
@@ -360,6 +362,12 @@ fn group_equilibrium(
         if !plain
             && options.verdict_only
             && let Some(forces) = tree::vertical_certificate(bodies, &group.movers, &own)
+        {
+            return Ok((Verdict::Stable, forces));
+        }
+        if !plain
+            && options.verdict_only
+            && let Some(forces) = vertical_qp::vertical_qp_certificate(bodies, &group.movers, &own)?
         {
             return Ok((Verdict::Stable, forces));
         }
