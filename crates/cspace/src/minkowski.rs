@@ -32,7 +32,7 @@
 //! are not parallel, which rounding cannot flip; a face plus an edge (most merged faces of sheet metal rotated about
 //! `z`) takes a one-pass form of the same rule (`face_plus_segment`). (Until session 13 this was a labelled 2-D hull
 //! of the `|F| |G|` rounded sum points with duplicates and corners within a *length* tolerance removed; on every
-//! input away from the tolerance band both give the same faces, see `crates/cspace/BENCHMARKS.md`.)
+//! input away from the tolerance band both give the same faces, see `docs/benchmarks.md`, cspace section.)
 //!
 //! Why a tolerance and not exact predicates: the input to this step is a *rotated* polytope whose coordinates are
 //! already rounded (`cos(pi / 2)` is not 0 in `f64`), so exact parallelism of a rotated face with a fixed one cannot be

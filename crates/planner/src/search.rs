@@ -16,8 +16,8 @@
 //!    bound of their cost: the larger of the parent's cost and the minimum of the cost over the half-space
 //!    `n_k . p >= d_k` alone (closed form, [`Quadratic::halfspace_lower_bound`]). When a pending child is popped its
 //!    emptiness is decided by a phase 1 from the parent's optimum (`Cell::is_empty_with`: the optimum violates
-//!    only `n_k . p >= d_k`, so this is usually one LP move); a non-empty child's cell is built (Chebyshev centre)
-//!    and its QP solved ([`crate::qp`]), and it is pushed back with its own cost — so children that never become
+//!    only `n_k . p >= d_k`, so this is usually one LP move); a non-empty child's cell is built from a second phase 1
+//!    on the exact cell (`Cell::with_halfspaces_from`, no Chebyshev LP) and its QP solved ([`crate::qp`]), and it is pushed back with its own cost — so children that never become
 //!    the cheapest are never solved. The keys only decide *when* a pending child is solved, never the order of the
 //!    solved nodes (a total order by (cost, orientation, id) that a valid lower bound cannot overtake), so the
 //!    search pops the same solved nodes in the same order as with the parent's cost as key;
@@ -901,15 +901,15 @@ impl Search<'_, '_> {
         fixed_z: f64,
     ) -> Result<Option<(Cell<D>, QpOptimum<D>)>, PlacementError> {
         let fs_err = |reason: String| PlacementError::FreeSpace { orientation: node.orientation, reason };
-        // emptiness first by the phase 1 from the parent's optimum (it satisfies the parent and the obstacle's
-        // inside cuts; only the child's outside face is violated): most children are empty and never need the
-        // Chebyshev LP. A non-empty child is then built as before (Chebyshev centre as the QP's start), so the QP's
-        // optimum is bit-for-bit the one of a cold build and ties between equal-cost cells break as before.
-        if node.cell.is_empty_with(extra.iter().copied(), start).map_err(|e| fs_err(e.to_string()))? {
+        // the child from the parent's optimum (it satisfies the parent and the obstacle's inside cuts; only the
+        // child's outside face is violated): emptiness by a phase 1 from it (most children are empty), and a
+        // non-empty child's interior point by a second phase 1 on the exact cell instead of the Chebyshev LP
+        // (`Cell::with_halfspaces_from`; a cell thinner than the tolerance still gets the Chebyshev build). The QP's
+        // optimum equals a cold build's up to rounding in the last bits.
+        let Some(cell) = node.cell.with_halfspaces_from(extra, start).map_err(|e| fs_err(e.to_string()))? else {
             self.stats.cells_empty += 1;
             return Ok(None);
-        }
-        let cell = node.cell.with_halfspaces(extra.iter().copied()).map_err(|e| fs_err(e.to_string()))?;
+        };
         if cell.is_empty() {
             self.stats.cells_empty += 1;
             return Ok(None);
