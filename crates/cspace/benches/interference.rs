@@ -1,4 +1,4 @@
-//! The convex-pair interference test (`interference::classify_pair`): box x box (the bench of `obstacle.rs`: two
+//! The convex-pair interference test (`interference::classify_pair`): box x box (two
 //! 100 x 50 x 2 plates, the second turned 0.3 rad about z), sheet-metal hexagonal prisms turned about z, and hulls of
 //! 20 random points under a general rotation. Besides criterion's wall-clock medians it prints each case's on-CPU
 //! median per call (thread CPU time from `/proc/thread-self/schedstat`, 9 batches of at least 50 ms), since on the
@@ -9,41 +9,10 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{DMat3, DVec3};
 use stackplan_cspace::interference::{PlacedConvex, classify_pair};
-use stackplan_geom::{ConvexPolytope, convex_hull};
 use std::hint::black_box;
 
-fn cuboid(hi: DVec3) -> ConvexPolytope {
-    ConvexPolytope::cuboid(DVec3::ZERO, hi).expect("box")
-}
-
-/// A sheet-metal piece: a convex hexagon extruded by 2 mm.
-fn hexagon_prism() -> ConvexPolytope {
-    let outline = [(0.0, 0.0), (60.0, 0.0), (90.0, 30.0), (80.0, 70.0), (20.0, 80.0), (-10.0, 40.0)];
-    let mut pts = Vec::new();
-    for (x, y) in outline {
-        pts.push(DVec3::new(x, y, 0.0));
-        pts.push(DVec3::new(x, y, 2.0));
-    }
-    convex_hull(&pts).expect("prism").polytope
-}
-
-/// The hull of `n` pseudo-random points on a sphere of radius 50.
-fn random_polytope(n: usize, seed: u64) -> ConvexPolytope {
-    let mut s = seed;
-    let mut next = || {
-        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (s >> 11) as f64 / (1u64 << 53) as f64
-    };
-    let pts: Vec<DVec3> = (0..n)
-        .map(|_| {
-            let z = 2.0 * next() - 1.0;
-            let phi = 2.0 * std::f64::consts::PI * next();
-            let r = (1.0 - z * z).sqrt();
-            DVec3::new(50.0 * r * phi.cos(), 50.0 * r * phi.sin(), 50.0 * z)
-        })
-        .collect();
-    convex_hull(&pts).expect("hull").polytope
-}
+mod common;
+use common::{cuboid, hexagon_prism, random_polytope};
 
 /// CPU time of the calling thread (ns), where Linux reports it.
 fn thread_cpu_ns() -> Option<u64> {
@@ -81,7 +50,7 @@ fn bench(c: &mut Criterion) {
     let rz = DMat3::from_rotation_z(0.3);
     let tol = 1e-7;
     let plate = cuboid(DVec3::new(100.0, 50.0, 2.0));
-    let prism = hexagon_prism();
+    let prism = hexagon_prism(1.0);
     let ra = random_polytope(20, 7);
     let rb = random_polytope(20, 11);
     let general = DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7);

@@ -232,6 +232,25 @@ impl Obstacle {
         &self.face_kinds
     }
 
+    /// The structure of the obstacle: per face its kind (with the generating features, as `Debug` text) and its cycle
+    /// of vertex provenances `[i, j]` rotated to start at the smallest, as a set. Two obstacles with equal structures
+    /// have the same faces from the same features (what orientation intervals and extrapolation rely on; the
+    /// coordinates may differ). O(size log size).
+    pub fn structure(&self) -> std::collections::BTreeSet<(String, Vec<[usize; 2]>)> {
+        self.polytope
+            .faces()
+            .iter()
+            .zip(&self.face_kinds)
+            .map(|(f, k)| {
+                let cycle: Vec<[usize; 2]> = f.vertices.iter().map(|&v| self.vertex_pairs[v]).collect();
+                let start = (0..cycle.len()).min_by_key(|&s| cycle[s]).unwrap_or(0);
+                let mut canonical = cycle[start..].to_vec();
+                canonical.extend_from_slice(&cycle[..start]);
+                (format!("{k:?}"), canonical)
+            })
+            .collect()
+    }
+
     /// The rotation `R` of the moving component.
     pub fn rotation(&self) -> DMat3 {
         self.rotation

@@ -4,37 +4,19 @@
 
 use glam::{DMat3, DVec3};
 use stackplan_cspace::minkowski::{ANGULAR_TOLERANCE, FaceKind, Obstacle, Route, gauss_map_obstacle, obstacle_by_hull};
-use stackplan_geom::{ConvexPolytope, convex_hull};
-use std::collections::BTreeSet;
+use stackplan_geom::ConvexPolytope;
+
+mod common;
 
 fn cuboid(hi: DVec3) -> ConvexPolytope {
-    ConvexPolytope::cuboid(DVec3::ZERO, hi).expect("box")
+    common::cuboid(DVec3::ZERO, hi)
 }
 
+/// The benchmarks' sheet-metal piece: a convex hexagon (scaled) extruded by 2 mm.
 fn hexagon_prism(scale: f64) -> ConvexPolytope {
     let outline = [(0.0, 0.0), (60.0, 0.0), (90.0, 30.0), (80.0, 70.0), (20.0, 80.0), (-10.0, 40.0)];
-    let mut pts = Vec::new();
-    for (x, y) in outline {
-        pts.push(DVec3::new(x * scale, y * scale, 0.0));
-        pts.push(DVec3::new(x * scale, y * scale, 2.0));
-    }
-    convex_hull(&pts).expect("prism").polytope
-}
-
-/// Faces as (kind, vertex-pair cycle from its smallest pair).
-fn structure(o: &Obstacle) -> BTreeSet<(String, Vec<[usize; 2]>)> {
-    o.polytope()
-        .faces()
-        .iter()
-        .zip(o.face_kinds())
-        .map(|(f, k)| {
-            let cycle: Vec<[usize; 2]> = f.vertices.iter().map(|&v| o.vertex_pairs()[v]).collect();
-            let start = (0..cycle.len()).min_by_key(|&s| cycle[s]).unwrap_or(0);
-            let mut canonical = cycle[start..].to_vec();
-            canonical.extend_from_slice(&cycle[..start]);
-            (format!("{k:?}"), canonical)
-        })
-        .collect()
+    let scaled: Vec<(f64, f64)> = outline.iter().map(|&(x, y)| (x * scale, y * scale)).collect();
+    common::prism(&scaled, 0.0, 2.0, 2).expect("prism")
 }
 
 fn check_provenance(a: &ConvexPolytope, r: DMat3, b: &ConvexPolytope, o: &Obstacle) {
@@ -66,7 +48,7 @@ fn below_half_the_tolerance_faces_and_edges_merge() {
                 let o = gauss_map_obstacle(a, r, b).unwrap_or_else(|e| panic!("theta {theta}: {e}"));
                 assert_eq!(o.route(), Route::GaussMap);
                 // the faces of the aligned pair: the same merged faces with the same corners
-                assert_eq!(structure(&o), structure(&aligned), "theta {theta}");
+                assert_eq!(o.structure(), aligned.structure(), "theta {theta}");
                 check_provenance(a, r, b, &o);
             }
         }
@@ -91,7 +73,7 @@ fn above_half_the_tolerance_the_structure_is_the_generic_one() {
                 let o = gauss_map_obstacle(a, r, b).unwrap_or_else(|e| panic!("theta {theta}: {e}"));
                 // the vertical faces are not merged and neither are the edges of the horizontal faces: the sum keeps
                 // its short edges (length ~ theta * size) and the corners between them
-                assert_eq!(structure(&o), structure(&generic), "theta {theta}");
+                assert_eq!(o.structure(), generic.structure(), "theta {theta}");
                 check_provenance(a, r, b, &o);
             }
         }

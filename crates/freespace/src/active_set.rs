@@ -693,19 +693,7 @@ impl Problem<'_> {
             if len <= flat_tol {
                 // stationary: drop the most negative multiplier (Bland's rule late), or stop at the minimum
                 let lambda = self.multipliers(&w, &g)?;
-                let bland = iter >= bland_after;
-                let mut choice: Option<usize> = None;
-                for a in 0..w.len {
-                    if lambda[a] < -mult_tol && !banned.contains(&w.idx[a]) {
-                        choice = match choice {
-                            None => Some(a),
-                            Some(c) => {
-                                let better = if bland { w.idx[a] < w.idx[c] } else { lambda[a] < lambda[c] };
-                                Some(if better { a } else { c })
-                            }
-                        };
-                    }
-                }
+                let choice = most_negative_multiplier(&lambda, &w, &banned, iter >= bland_after, mult_tol);
                 match choice {
                     Some(a) => {
                         last_dropped = Some(w.idx[a]);
@@ -715,20 +703,7 @@ impl Problem<'_> {
                     None => return Some(Seek::Minimum { point: p, value: level }),
                 }
             }
-            let threshold = BLOCK_TOL * len;
-            let mut alpha = f64::INFINITY;
-            let mut blocking = None;
-            for (j, a) in self.rows.iter().enumerate() {
-                let ad = dot4(a, &dir);
-                if ad > threshold && self.enabled(j) && !w.contains(j) {
-                    let slack = (self.offsets[j] - dot4(a, &p)).max(0.0);
-                    let t = slack / ad;
-                    if t < alpha {
-                        alpha = t;
-                        blocking = Some(j);
-                    }
-                }
-            }
+            let (alpha, blocking) = self.ratio_test(&w, &p, &dir, len, f64::INFINITY);
             let descent = dot4(&g, &dir);
             if descent < 0.0 {
                 let to_level = (target - level) / descent;
@@ -1025,19 +1000,7 @@ impl Problem<'_> {
                     r[i] += self.h[i] * dir[i];
                 }
                 let lambda = self.multipliers(&w, &r)?;
-                let bland = iter >= bland_after;
-                let mut choice: Option<usize> = None;
-                for a in 0..w.len {
-                    if lambda[a] < -mult_tol && !banned.contains(&w.idx[a]) {
-                        choice = match choice {
-                            None => Some(a),
-                            Some(c) => {
-                                let better = if bland { w.idx[a] < w.idx[c] } else { lambda[a] < lambda[c] };
-                                Some(if better { a } else { c })
-                            }
-                        };
-                    }
-                }
+                let choice = most_negative_multiplier(&lambda, &w, &banned, iter >= bland_after, mult_tol);
                 match choice {
                     Some(a) => {
                         last_dropped = Some(w.idx[a]);
@@ -1054,20 +1017,7 @@ impl Problem<'_> {
                 }
                 continue;
             }
-            let threshold = BLOCK_TOL * len;
-            let mut alpha = 1.0;
-            let mut blocking = None;
-            for (j, a) in self.rows.iter().enumerate() {
-                let ad = dot4(a, &dir);
-                if ad > threshold && self.enabled(j) && !w.contains(j) {
-                    let slack = (self.offsets[j] - dot4(a, &p)).max(0.0);
-                    let t = slack / ad;
-                    if t < alpha {
-                        alpha = t;
-                        blocking = Some(j);
-                    }
-                }
-            }
+            let (alpha, blocking) = self.ratio_test(&w, &p, &dir, len, 1.0);
             axpy(&mut p, alpha, &dir);
             record_move(alpha * len, self.length_scale, blocking, &mut last_dropped, &mut banned);
             if let Some(j) = blocking {
@@ -1082,6 +1032,25 @@ impl Problem<'_> {
 }
 
 #[inline]
+/// The working-set slot whose constraint to drop in the closed-form paths ([`Problem::seek_small`],
+/// [`Problem::solve_strictly_convex`]): the most negative multiplier below `-mult_tol` (or, under Bland's rule, the
+/// lowest constraint index among them), skipping `banned` constraints; `None` at a minimum. O(|W| |banned|).
+fn most_negative_multiplier(lambda: &V4, w: &WorkSet, banned: &[usize], bland: bool, mult_tol: f64) -> Option<usize> {
+    let mut choice: Option<usize> = None;
+    for a in 0..w.len {
+        if lambda[a] < -mult_tol && !banned.contains(&w.idx[a]) {
+            choice = match choice {
+                None => Some(a),
+                Some(c) => {
+                    let better = if bland { w.idx[a] < w.idx[c] } else { lambda[a] < lambda[c] };
+                    Some(if better { a } else { c })
+                }
+            };
+        }
+    }
+    choice
+}
+
 fn normalized(x: &V4) -> Option<V4> {
     let l = norm4(x);
     if l > 0.0 && l.is_finite() { Some(x.map(|c| c / l)) } else { None }

@@ -119,31 +119,52 @@ proptest! {
     }
 }
 
+/// A child-cell case like the planner's: a random parent (solid, face-thin or edge-thin), a point of it to start from
+/// (the QP optimum of a random cost with diagonal `h`, on its boundary as in the planner, or its interior point) and
+/// `cuts` random cuts through its box (some keep the start, some do not: then the phase 1 has to move). `None` when
+/// the parent came out empty.
+struct ChildCase {
+    cell: stackplan_freespace::Cell<3>,
+    cost: stackplan_freespace::SeparableCost<3>,
+    start: [f64; 3],
+    cuts: Vec<stackplan_freespace::Halfspace<3>>,
+}
+
+fn child_case(rng: &mut Rng, extra: usize, flat: usize, cuts: usize, h: [f64; 3]) -> Option<ChildCase> {
+    use stackplan_freespace::{Halfspace, SeparableCost, Tag, minimize};
+    let shape = [Shape::Solid, Shape::Face, Shape::Edge][flat];
+    let cell = random_cell(rng, extra, shape);
+    if cell.is_empty() {
+        return None;
+    }
+    let (lo, hi) = bbox(&cell);
+    let target = [rng.range(lo[0] - 3.0, hi[0] + 3.0), rng.range(lo[1] - 3.0, hi[1] + 3.0), rng.range(lo[2], hi[2])];
+    let cost = SeparableCost::new(h, target.map(|t| -2.0 * t), 0.0).expect("cost");
+    let start = if rng.below(2) == 0 {
+        minimize(&cell, &cost).expect("qp").point
+    } else {
+        cell.interior_point().expect("point")
+    };
+    let mut hs = Vec::new();
+    for k in 0..cuts {
+        let n = rng.unit3();
+        let through = [rng.range(lo[0], hi[0]), rng.range(lo[1], hi[1]), rng.range(lo[2], hi[2])];
+        hs.push(Halfspace::new(n, common::dot(&n, &through), Tag::User(100 + k as u64)));
+    }
+    Some(ChildCase { cell, cost, start, cuts: hs })
+}
+
 proptest! {
     /// The phase 1 of `is_empty_with` (from a point of the parent: its QP optimum or its interior point) decides
     /// emptiness as the Chebyshev LP of `with_halfspaces` does.
     #[test]
     fn phase_one_agrees_with_the_chebyshev_lp(seed in any::<u64>(), extra in 0usize..5, cuts in 1usize..5,
                                              flat in 0usize..3) {
-        use stackplan_freespace::{Halfspace, SeparableCost, Tag, minimize};
+        use stackplan_freespace::{Halfspace, minimize};
         let mut rng = Rng(seed);
-        let shape = [Shape::Solid, Shape::Face, Shape::Edge][flat];
-        let cell = random_cell(&mut rng, extra, shape);
-        prop_assume!(!cell.is_empty());
-        let (lo, hi) = bbox(&cell);
-        // start: the QP optimum of a random cost (a boundary point, as in the planner) or the interior point
-        let target = [rng.range(lo[0] - 3.0, hi[0] + 3.0), rng.range(lo[1] - 3.0, hi[1] + 3.0), rng.range(lo[2], hi[2])];
-        let cost = SeparableCost::new([2.0; 3], target.map(|t| -2.0 * t), 0.0).expect("cost");
-        let start = if rng.below(2) == 0 { minimize(&cell, &cost).expect("qp").point } else {
-            cell.interior_point().expect("point")
+        let Some(ChildCase { cell, cost, start, cuts: hs }) = child_case(&mut rng, extra, flat, cuts, [2.0; 3]) else {
+            return Ok(());
         };
-        // cuts through the cell's box: some keep the start, some do not (then the phase 1 has to move)
-        let mut hs = Vec::new();
-        for k in 0..cuts {
-            let n = rng.unit3();
-            let through = [rng.range(lo[0], hi[0]), rng.range(lo[1], hi[1]), rng.range(lo[2], hi[2])];
-            hs.push(Halfspace::new(n, common::dot(&n, &through), Tag::User(100 + k as u64)));
-        }
         let empty = cell.is_empty_with(hs.iter().copied(), &start).expect("phase 1");
         let reference = cell.with_halfspaces(hs.iter().copied()).expect("chebyshev");
         let tol = cell.tolerance().linear;
@@ -181,23 +202,12 @@ proptest! {
     #[test]
     fn child_from_a_known_point_agrees_with_the_chebyshev_build(seed in any::<u64>(), extra in 0usize..5,
                                                               cuts in 1usize..5, flat in 0usize..3, special in 0usize..4) {
-        use stackplan_freespace::{CellShape, Halfspace, SeparableCost, Tag, minimize};
+        use stackplan_freespace::{CellShape, Halfspace, Tag, minimize};
         let mut rng = Rng(seed);
-        let shape = [Shape::Solid, Shape::Face, Shape::Edge][flat];
-        let cell = random_cell(&mut rng, extra, shape);
-        prop_assume!(!cell.is_empty());
-        let (lo, hi) = bbox(&cell);
-        let target = [rng.range(lo[0] - 3.0, hi[0] + 3.0), rng.range(lo[1] - 3.0, hi[1] + 3.0), rng.range(lo[2], hi[2])];
-        let cost = SeparableCost::new([2.0, 1.5, 0.4], target.map(|t| -2.0 * t), 0.0).expect("cost");
-        let start = if rng.below(2) == 0 { minimize(&cell, &cost).expect("qp").point } else {
-            cell.interior_point().expect("point")
+        let Some(ChildCase { cell, cost, start, cuts: mut hs }) = child_case(&mut rng, extra, flat, cuts, [2.0, 1.5, 0.4])
+        else {
+            return Ok(());
         };
-        let mut hs = Vec::new();
-        for k in 0..cuts {
-            let n = rng.unit3();
-            let through = [rng.range(lo[0], hi[0]), rng.range(lo[1], hi[1]), rng.range(lo[2], hi[2])];
-            hs.push(Halfspace::new(n, common::dot(&n, &through), Tag::User(100 + k as u64)));
-        }
         let face = cell.halfspaces()[rng.below(cell.len())];
         match special {
             // the outside of a face of the parent: the child is that face (flat), or empty by rounding

@@ -2,30 +2,15 @@
 //! vertex provenances `[i, j]` (rotated to a canonical start), compared as sets. Used by the tests, the sweep's
 //! self-check and the benchmarks' interval-length measurement. O(size log size).
 
-use stackplan_cspace::minkowski::{FaceKind, Obstacle};
+use stackplan_cspace::minkowski::Obstacle;
 use std::collections::BTreeSet;
 
 /// A face as kind (with features) and canonical provenance cycle.
 pub type FaceKey = (String, Vec<[usize; 2]>);
 
-/// The structure of an obstacle as a set of faces.
+/// The structure of an obstacle as a set of faces ([`Obstacle::structure`]).
 pub fn structure_key(o: &Obstacle) -> BTreeSet<FaceKey> {
-    o.polytope()
-        .faces()
-        .iter()
-        .zip(o.face_kinds())
-        .map(|(f, k)| {
-            let cycle: Vec<[usize; 2]> = f.vertices.iter().map(|&v| o.vertex_pairs()[v]).collect();
-            let start = (0..cycle.len()).min_by_key(|&s| cycle[s]).unwrap_or(0);
-            let mut canonical = cycle[start..].to_vec();
-            canonical.extend_from_slice(&cycle[..start]);
-            (kind_key(k), canonical)
-        })
-        .collect()
-}
-
-fn kind_key(k: &FaceKind) -> String {
-    format!("{k:?}")
+    o.structure()
 }
 
 /// Whether two obstacles have the same structure and provenance.

@@ -55,25 +55,15 @@ pub fn check_added_part(stack: &[PlacedPart<'_>], options: &CheckOptions) -> Res
 
 /// The parts connected to `last` through part-part contact patches (union-find over the patches; O(P + K alpha)).
 fn step_group(n: usize, patches: &[crate::contacts::ContactPatch], last: usize) -> Vec<bool> {
-    let mut parent: Vec<usize> = (0..n).collect();
-    fn find(parent: &mut [usize], mut x: usize) -> usize {
-        while parent[x] != x {
-            parent[x] = parent[parent[x]];
-            x = parent[x];
-        }
-        x
-    }
+    let mut sets = crate::union_find::UnionFind::new(n);
     for p in patches {
         if let Body::Part(a) = p.a
             && a < n
             && p.b < n
         {
-            let (ra, rb) = (find(&mut parent, a), find(&mut parent, p.b));
-            if ra != rb {
-                parent[ra.max(rb)] = ra.min(rb);
-            }
+            sets.union(a, p.b);
         }
     }
-    let root = find(&mut parent, last);
-    (0..n).map(|k| find(&mut parent, k) == root).collect()
+    let root = sets.find(last);
+    (0..n).map(|k| sets.find(k) == root).collect()
 }

@@ -542,29 +542,19 @@ fn movable_groups(
     points: &[Point],
     is_movable: impl Fn(usize) -> bool,
 ) -> Vec<Group> {
-    let mut parent: Vec<usize> = (0..n_parts).collect();
-    fn find(parent: &mut [usize], mut x: usize) -> usize {
-        while parent[x] != x {
-            parent[x] = parent[parent[x]];
-            x = parent[x];
-        }
-        x
-    }
+    let mut sets = crate::union_find::UnionFind::new(n_parts);
     for pt in points {
         if let Some(a) = pt.a
             && is_movable(a)
             && is_movable(pt.b)
         {
-            let (ra, rb) = (find(&mut parent, a), find(&mut parent, pt.b));
-            if ra != rb {
-                parent[ra.max(rb)] = ra.min(rb);
-            }
+            sets.union(a, pt.b);
         }
     }
     let mut slot = vec![usize::MAX; n_parts];
     let mut groups: Vec<Group> = Vec::new();
     for &i in movers {
-        let r = find(&mut parent, i);
+        let r = sets.find(i);
         if slot[r] == usize::MAX {
             slot[r] = groups.len();
             groups.push(Group { movers: Vec::new(), point_indices: Vec::new() });
@@ -573,7 +563,7 @@ fn movable_groups(
     }
     for (k, pt) in points.iter().enumerate() {
         let body = if is_movable(pt.b) { pt.b } else { pt.a.expect("a point between fixed bodies was skipped") };
-        let r = find(&mut parent, body);
+        let r = sets.find(body);
         groups[slot[r]].point_indices.push(k);
     }
     groups

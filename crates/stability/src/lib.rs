@@ -25,6 +25,7 @@ pub mod insertion;
 pub mod polygon2d;
 pub mod resting_poses;
 pub mod sat;
+mod union_find;
 pub mod world;
 
 pub use addition::check_added_part;

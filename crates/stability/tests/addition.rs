@@ -9,28 +9,19 @@
 
 mod common;
 
-use common::{at, box_part};
+use common::{at, box_layers, box_part, build, fixture_columns, placements, planned_channels, same_margin};
 use glam::DVec3;
 use proptest::prelude::*;
 use stackplan_geom::io::{ReadOptions, read_part};
 use stackplan_stability::check::{CheckOptions, PartCheck, check_stack};
 use stackplan_stability::check_added_part;
-use stackplan_stability::contacts::analyse_contacts;
 use stackplan_stability::equilibrium::ContactForce;
-use stackplan_stability::resting_poses::resting_poses;
-use stackplan_stability::world::{PlacedPart, stack_tolerance, world_stack};
+use stackplan_stability::world::PlacedPart;
 
 fn options(mu: f64, margin_directions: usize, clearance: f64) -> CheckOptions {
     let mut o = CheckOptions { mu, margin_directions, clearance, prefix_stability: true, ..CheckOptions::default() };
     o.grasp.cup_diameter = 5.0;
     o
-}
-
-fn same_margin(a: Option<f64>, b: Option<f64>) -> bool {
-    match (a, b) {
-        (Some(x), Some(y)) => (x - y).abs() <= 1e-6 * (1.0 + y.abs()),
-        (x, y) => x.is_none() && y.is_none(),
-    }
 }
 
 fn same_forces(a: &[ContactForce], b: &[ContactForce], weight: f64) -> bool {
@@ -90,26 +81,6 @@ fn compare_additions(stack: &[PlacedPart<'_>], options: &CheckOptions, weight: f
     compared
 }
 
-/// The smallest upward shift at which a copy of `placed` moved by `(dx, dy)` does not interfere with it.
-fn nesting_height(placed: PlacedPart<'_>, dx: f64, dy: f64, upper: f64) -> f64 {
-    let interferes = |dz: f64| {
-        let top = PlacedPart { position: placed.position + DVec3::new(dx, dy, dz), ..placed };
-        let parts = world_stack(&[placed, top]).expect("world");
-        let tol = stack_tolerance(&parts).linear;
-        !analyse_contacts(&parts, tol, |_| true).interferences.is_empty()
-    };
-    let (mut lo, mut hi) = (0.0, upper);
-    for _ in 0..50 {
-        let mid = 0.5 * (lo + hi);
-        if interferes(mid) {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    hi
-}
-
 #[test]
 fn added_parts_report_like_the_whole_check_on_fixture_columns() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/parts");
@@ -118,29 +89,11 @@ fn added_parts_report_like_the_whole_check_on_fixture_columns() {
     let mut compared = 0;
     for file in files.iter().filter(|f| f.extension().is_some_and(|e| e == "json")) {
         let part = read_part(file, &ReadOptions::default()).expect("fixture part");
-        let poses = resting_poses(&part).expect("poses");
-        for pose in poses.iter().take(2) {
+        for pose in 0..2 {
             for (dx, dy) in [(0.0, 0.0), (7.0, -3.0), (40.0, 0.0)] {
-                let base = PlacedPart { part: &part, rotation: pose.rotation, position: pose.position };
-                let size = {
-                    let w = world_stack(&[base]).expect("world");
-                    w[0].aabb.1 - w[0].aabb.0
-                };
-                let rise = nesting_height(base, dx, dy, size.z + 1.0);
-                let stack: Vec<PlacedPart<'_>> = (0..3)
-                    .flat_map(|level| {
-                        (0..2).map(move |column| {
-                            let shift = DVec3::new(
-                                (size.x + 20.0) * column as f64 + dx * level as f64,
-                                dy * level as f64,
-                                rise * level as f64,
-                            );
-                            PlacedPart { position: base.position + shift, ..base }
-                        })
-                    })
-                    .collect();
+                let stack = fixture_columns(&part, pose, dx, dy);
                 for (mu, directions, clearance) in [(0.4, 8, 0.0), (0.8, 0, 5.0)] {
-                    let what = format!("{} shift ({dx}, {dy}) mu {mu}", file.display());
+                    let what = format!("{} pose {pose} shift ({dx}, {dy}) mu {mu}", file.display());
                     compared += compare_additions(&stack, &options(mu, directions, clearance), part.mass.mass, &what);
                 }
             }
@@ -151,16 +104,8 @@ fn added_parts_report_like_the_whole_check_on_fixture_columns() {
 
 #[test]
 fn added_parts_report_like_the_whole_check_on_the_planned_channel_stack() {
-    let plan = stackplan_geom::io::stack::read_stack(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/benches/stacks/channel-plan-15.json"
-    ))
-    .expect("plan");
-    let stack: Vec<PlacedPart<'_>> = plan
-        .placements
-        .iter()
-        .map(|p| PlacedPart { part: &plan.part, rotation: p.rotation, position: p.position })
-        .collect();
+    let plan = planned_channels();
+    let stack = placements(&plan);
     let compared = compare_additions(&stack, &options(0.5, 0, 0.0), plan.part.mass.mass, "planned channels");
     assert_eq!(compared, stack.len());
 }
@@ -198,23 +143,13 @@ proptest! {
     #[test]
     fn added_parts_report_like_the_whole_check_on_random_box_stacks(
         columns in 2usize..=3,
-        layers in prop::collection::vec(
-            (10.0f64..30.0, prop::collection::vec((-15.0f64..15.0, -15.0f64..15.0, 30.0f64..70.0, 30.0f64..70.0), 3)),
-            1..=3,
-        ),
+        layers in box_layers(10.0f64..30.0, 15.0, 30.0f64..70.0),
         bridge in prop::option::of((-30.0f64..30.0, 5.0f64..20.0)),
         mu in 0.1f64..1.0,
         clearance in prop::sample::select(vec![0.0, 3.0, 60.0]),
     ) {
-        let mut boxes: Vec<(DVec3, DVec3)> = Vec::new();
-        let mut z = 0.0;
-        for (height, columns_of_layer) in &layers {
-            for (c, &(cx, cy, sx, sy)) in columns_of_layer.iter().take(columns).enumerate() {
-                let centre = DVec3::new(200.0 * c as f64 + cx, cy, z);
-                boxes.push((centre - DVec3::new(sx / 2.0, sy / 2.0, 0.0), DVec3::new(sx, sy, *height)));
-            }
-            z += height;
-        }
+        let mut boxes: Vec<(DVec3, DVec3)> = build(&layers, columns).into_iter().map(|(_, lo, size)| (lo, size)).collect();
+        let z = boxes.iter().map(|(lo, size)| lo.z + size.z).fold(0.0, f64::max);
         if let Some((dx, thickness)) = bridge {
             let length = 200.0 * (columns - 1) as f64 + 40.0;
             boxes.push((DVec3::new(dx - 20.0, -10.0, z), DVec3::new(length, 20.0, thickness)));

@@ -21,34 +21,20 @@
 
 mod common;
 
-use common::{at, box_part};
+use common::{at, box_layers, box_part, build, fixture_columns, placements, planned_channels, same_margin};
 use glam::DVec3;
 use proptest::prelude::*;
-use stackplan_geom::Part;
 use stackplan_geom::io::{ReadOptions, read_part};
 use stackplan_stability::check::{CheckOptions, StackCheck, check_stack, check_stack_reference};
 use stackplan_stability::contacts::analyse_contacts;
 use stackplan_stability::equilibrium::{ContactForce, Equilibrium};
 use stackplan_stability::equilibrium::{EquilibriumOptions, Verdict, solve_equilibrium};
-use stackplan_stability::resting_poses::resting_poses;
 use stackplan_stability::world::{PlacedPart, stack_tolerance, world_stack};
 
 fn options() -> CheckOptions {
     let mut o = CheckOptions { mu: 0.6, margin_directions: 8, ..CheckOptions::default() };
     o.grasp.cup_diameter = 5.0;
     o
-}
-
-/// Stacks the boxes given per layer and column; returns (part index -> column, lower corner) in placement order.
-/// A layer: its height and per column (centre offset x, y, size x, y).
-type Layer = (f64, Vec<(f64, f64, f64, f64)>);
-
-/// Margins agree within 1e-6 relative (both absent, or both present).
-fn same_margin(fast: Option<f64>, plain: Option<f64>) -> bool {
-    match (fast, plain) {
-        (Some(f), Some(p)) => (f - p).abs() <= 1e-6 * (1.0 + p.abs()),
-        (f, p) => f.is_none() && p.is_none(),
-    }
 }
 
 /// Same verdict, margins within 1e-6 relative, the same minimum-norm forces: the same points, the sum of squares
@@ -87,47 +73,6 @@ fn assert_checks_equivalent(fast: &StackCheck, plain: &StackCheck, weight: f64, 
     }
 }
 
-/// The smallest upward shift at which a copy of `placed` moved by `(dx, dy)` and lifted does not interfere with it
-/// (bisection on the interference test): the copy then rests on (or nests in) the one below.
-fn nesting_height(placed: PlacedPart<'_>, dx: f64, dy: f64, upper: f64) -> f64 {
-    let interferes = |dz: f64| {
-        let top = PlacedPart { position: placed.position + DVec3::new(dx, dy, dz), ..placed };
-        let parts = world_stack(&[placed, top]).expect("world");
-        let tol = stack_tolerance(&parts).linear;
-        !analyse_contacts(&parts, tol, |_| true).interferences.is_empty()
-    };
-    let (mut lo, mut hi) = (0.0, upper);
-    for _ in 0..50 {
-        let mid = 0.5 * (lo + hi);
-        if interferes(mid) {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    hi
-}
-
-/// Two columns of three copies of `part` in resting pose `pose`, each copy shifted by `(dx, dy)` from the one below
-/// and lowered onto it.
-fn fixture_columns(part: &Part, pose: usize, dx: f64, dy: f64) -> Vec<PlacedPart<'_>> {
-    let poses = resting_poses(part).expect("poses");
-    let pose = &poses[pose.min(poses.len() - 1)];
-    let base = PlacedPart { part, rotation: pose.rotation, position: pose.position };
-    let parts = world_stack(&[base]).expect("world");
-    let size = parts[0].aabb.1 - parts[0].aabb.0;
-    let rise = nesting_height(base, dx, dy, size.z + 1.0);
-    let mut out = Vec::new();
-    for level in 0..3 {
-        for column in 0..2 {
-            let shift =
-                DVec3::new((size.x + 20.0) * column as f64 + dx * level as f64, dy * level as f64, rise * level as f64);
-            out.push(PlacedPart { position: base.position + shift, ..base });
-        }
-    }
-    out
-}
-
 #[test]
 fn shortcuts_match_the_plain_socps_on_fixture_columns() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/parts");
@@ -154,16 +99,8 @@ fn shortcuts_match_the_plain_socps_on_fixture_columns() {
 /// heights, where the minimum-norm forces need friction).
 #[test]
 fn shortcuts_match_the_plain_socps_on_the_planned_channel_stack() {
-    let plan = stackplan_geom::io::stack::read_stack(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/benches/stacks/channel-plan-15.json"
-    ))
-    .expect("plan");
-    let stack: Vec<PlacedPart<'_>> = plan
-        .placements
-        .iter()
-        .map(|p| PlacedPart { part: &plan.part, rotation: p.rotation, position: p.position })
-        .collect();
+    let plan = planned_channels();
+    let stack = placements(&plan);
     for mu in [0.2, 0.5, 1.0] {
         let options = CheckOptions { mu, ..options() };
         let fast = check_stack(&stack, &options).expect("check");
@@ -172,29 +109,13 @@ fn shortcuts_match_the_plain_socps_on_the_planned_channel_stack() {
     }
 }
 
-fn build(layers: &[Layer], columns: usize) -> Vec<(usize, DVec3, DVec3)> {
-    let mut out = Vec::new();
-    let mut z = 0.0;
-    for (height, boxes) in layers {
-        for (c, &(cx, cy, sx, sy)) in boxes.iter().take(columns).enumerate() {
-            let centre = DVec3::new(200.0 * c as f64 + cx, cy, z);
-            out.push((c, centre - DVec3::new(sx / 2.0, sy / 2.0, 0.0), DVec3::new(sx, sy, *height)));
-        }
-        z += height;
-    }
-    out
-}
-
 proptest! {
     #![proptest_config(ProptestConfig { cases: std::env::var("PROPTEST_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(16), ..ProptestConfig::default() })]
 
     #[test]
     fn groups_decide_like_direct_solves(
         columns in 2usize..=3,
-        layers in prop::collection::vec(
-            (10.0f64..30.0, prop::collection::vec((-12.0f64..12.0, -12.0f64..12.0, 30.0f64..70.0, 30.0f64..70.0), 3)),
-            1..=3,
-        ),
+        layers in box_layers(10.0f64..30.0, 12.0, 30.0f64..70.0),
         bridge in prop::option::of((-30.0f64..30.0, 5.0f64..20.0)),
     ) {
         let layout = build(&layers, columns);
@@ -237,10 +158,7 @@ proptest! {
     #[test]
     fn shortcuts_match_the_plain_socps_on_random_box_stacks(
         columns in 1usize..=3,
-        layers in prop::collection::vec(
-            (10.0f64..40.0, prop::collection::vec((-25.0f64..25.0, -25.0f64..25.0, 20.0f64..70.0, 20.0f64..70.0), 3)),
-            1..=3,
-        ),
+        layers in box_layers(10.0f64..40.0, 25.0, 20.0f64..70.0),
         bridge in prop::option::of((-30.0f64..30.0, 5.0f64..20.0)),
         mu in 0.1f64..1.2,
     ) {

@@ -55,14 +55,7 @@ impl SolveCache {
         key: Vec<u64>,
         solve: impl FnOnce() -> Result<(Verdict, Vec<DVec3>), super::EquilibriumError>,
     ) -> Result<(Verdict, Vec<DVec3>), super::EquilibriumError> {
-        if let Some(hit) = self.equilibria.lock().ok().and_then(|m| m.get(&key).cloned()) {
-            return Ok(hit);
-        }
-        let value = solve()?;
-        if let Ok(mut m) = self.equilibria.lock() {
-            m.insert(key, value.clone());
-        }
-        Ok(value)
+        memo(&self.equilibria, key, solve)
     }
 
     pub(super) fn margin(
@@ -70,13 +63,22 @@ impl SolveCache {
         key: Vec<u64>,
         solve: impl FnOnce() -> Result<Vec<Option<f64>>, super::EquilibriumError>,
     ) -> Result<Vec<Option<f64>>, super::EquilibriumError> {
-        if let Some(hit) = self.margins.lock().ok().and_then(|m| m.get(&key).cloned()) {
-            return Ok(hit);
-        }
-        let value = solve()?;
-        if let Ok(mut m) = self.margins.lock() {
-            m.insert(key, value.clone());
-        }
-        Ok(value)
+        memo(&self.margins, key, solve)
     }
+}
+
+/// The value under `key`, or `solve()`'s stored under it (a poisoned lock only disables the memo).
+fn memo<V: Clone, E>(
+    map: &Mutex<HashMap<Vec<u64>, V>>,
+    key: Vec<u64>,
+    solve: impl FnOnce() -> Result<V, E>,
+) -> Result<V, E> {
+    if let Some(hit) = map.lock().ok().and_then(|m| m.get(&key).cloned()) {
+        return Ok(hit);
+    }
+    let value = solve()?;
+    if let Ok(mut m) = map.lock() {
+        m.insert(key, value.clone());
+    }
+    Ok(value)
 }

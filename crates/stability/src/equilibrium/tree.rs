@@ -197,25 +197,10 @@ pub(super) fn parallel_certificate(
     let union = Rigid::union(movers.iter().map(|&i| bodies[i]));
     let scale = (union.aabb.1 - union.aabb.0).length().max(1.0);
     let weight = union.mass.max(f64::MIN_POSITIVE);
-    // the sparse column of A of a point: up to two bodies x three rows (none for a point that is not vertical)
-    let column = |p: &Point| -> Vec<(usize, f64)> {
-        let mut out = Vec::with_capacity(6);
-        if !vertical(p) {
-            return out;
-        }
-        let nz = p.frame[0].z.signum();
-        for (body, sign) in [(Some(p.b), 1.0), (p.a, -1.0)] {
-            let Some(body) = body else { continue };
-            let Ok(m) = movers.binary_search(&body) else { continue };
-            let c = bodies[body].cg;
-            let v = sign * nz;
-            out.push((3 * m, v));
-            out.push((3 * m + 1, v * (p.p - c).dot(e1) / scale));
-            out.push((3 * m + 2, v * (p.p - c).dot(e2) / scale));
-        }
-        out
-    };
-    let columns: Vec<Vec<(usize, f64)>> = points.iter().map(|p| column(p)).collect();
+    let columns: Vec<Vec<(usize, f64)>> = points
+        .iter()
+        .map(|p| if vertical(p) { certificate_column(bodies, movers, p, (e1, e2), scale) } else { Vec::new() })
+        .collect();
     let mut gram = vec![0.0f64; rows * rows];
     for col in &columns {
         for &(r, a) in col {
@@ -242,6 +227,31 @@ pub(super) fn parallel_certificate(
         forces.push(gravity * (p.frame[0].z.signum() * normal * weight));
     }
     residual.iter().zip(&rhs).all(|(r, b)| (r - b).abs() <= 1e-12).then_some(forces)
+}
+
+/// The sparse column of a vertical point in the certificate rows of [`parallel_certificate`] (also those of
+/// [`super::vertical_qp`]): per movable body it acts on (up to two), `s n_z` in the force row `3 m` and `s n_z (p - c)
+/// . e / scale` in the moment rows `3 m + 1`, `3 m + 2` (`s = +1` on `b`, `-1` on `a`; `e1`, `e2` the axes
+/// perpendicular to gravity; `movers` ascending).
+pub(super) fn certificate_column(
+    bodies: &[Rigid],
+    movers: &[usize],
+    p: &Point,
+    (e1, e2): (DVec3, DVec3),
+    scale: f64,
+) -> Vec<(usize, f64)> {
+    let mut out = Vec::with_capacity(6);
+    let nz = p.frame[0].z.signum();
+    for (body, sign) in [(Some(p.b), 1.0), (p.a, -1.0)] {
+        let Some(body) = body else { continue };
+        let Ok(m) = movers.binary_search(&body) else { continue };
+        let c = bodies[body].cg;
+        let v = sign * nz;
+        out.push((3 * m, v));
+        out.push((3 * m + 1, v * (p.p - c).dot(e1) / scale));
+        out.push((3 * m + 2, v * (p.p - c).dot(e2) / scale));
+    }
+    out
 }
 
 /// Solves the dense `n x n` system `a y = b` (row-major) by Gaussian elimination with partial pivoting; `None` when a

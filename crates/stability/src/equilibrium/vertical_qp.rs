@@ -48,20 +48,11 @@ pub(super) fn vertical_qp_certificate(
             unknown_of.push(None);
             continue;
         }
-        let nz = p.frame[0].z.signum();
-        for (body, sign) in [(Some(p.b), 1.0), (p.a, -1.0)] {
-            let Some(body) = body else { continue };
-            let Ok(m) = movers.binary_search(&body) else { continue };
-            let c = bodies[body].cg;
-            let v = sign * nz;
-            for (r, value) in
-                [(3 * m, v), (3 * m + 1, v * (p.p - c).dot(e1) / scale), (3 * m + 2, v * (p.p - c).dot(e2) / scale)]
-            {
-                if value != 0.0 {
-                    ri.push(r);
-                    ci.push(n);
-                    vi.push(value);
-                }
+        for (r, value) in super::tree::certificate_column(bodies, movers, p, (e1, e2), scale) {
+            if value != 0.0 {
+                ri.push(r);
+                ci.push(n);
+                vi.push(value);
             }
         }
         unknown_of.push(Some(n));
