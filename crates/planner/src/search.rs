@@ -4,7 +4,8 @@
 //! A node is an orientation `theta_k`, a convex cell `K` of positions (an H-polytope, [A] VI-A-1) and the optimum
 //! `p*` of the cost over `K` (`f(p*)` is the key). The roots are `(theta_k, Omega(theta_k))`. Loop:
 //!
-//! 1. pop the cheapest node (ties: lower orientation index, then lower cell id — deterministic);
+//! 1. pop the cheapest node (costs compared rounded to about `1e-12` relative, so that exact ties do not depend
+//!    on the optima's last bits; ties: lower orientation index, then lower cell id — deterministic);
 //! 2. if an obstacle of `theta_k` built earlier holds `p*` in its interior by more than the tolerance (not one
 //!    applied on the node's path), take the deepest such (any obstacle holding `p*` gives a valid split; this one
 //!    needs no detection, which halves the detections of the Triangle scenario; in a plan the obstacles earlier
@@ -214,8 +215,29 @@ struct Node<const D: usize> {
     applied: Arc<Vec<u32>>,
 }
 
-/// The key of a node in the heap: its cost, orientation and id (the total order of the search), and its slot in
-/// [`NodeHeap`]'s slab.
+/// Low mantissa bits rounded away by [`quantised_cost`]: 12 of 52, a relative step of `2^-40` (about `1e-12`).
+const KEY_ROUND_BITS: u32 = 12;
+
+/// The cost as the heap compares it: rounded to the nearest multiple of `2^-40` of its binade (about `1e-12`
+/// relative; half-way cases away from zero), so that costs equal but for rounding in their last bits (mirror-image
+/// cells, optima reached from different start points) compare equal and their order falls to (orientation, id),
+/// which no rounding moves. Rounding is monotone (`a <= b` implies `q(a) <= q(b)`), so a lower bound of a cost stays
+/// a lower bound of its key, and comparing rounded values is a total order (a strict weak order, unlike "within
+/// eps"). Non-finite values are kept.
+#[inline]
+fn quantised_cost(cost: f64) -> f64 {
+    if !cost.is_finite() {
+        return cost;
+    }
+    let half = 1u64 << (KEY_ROUND_BITS - 1);
+    let mask = !((1u64 << KEY_ROUND_BITS) - 1);
+    // sign bit untouched; a carry out of the mantissa moves to the next binade (or to infinity at the very top,
+    // which only a cost near f64::MAX could reach)
+    f64::from_bits((cost.to_bits().wrapping_add(half)) & mask)
+}
+
+/// The key of a node in the heap: its cost (rounded, [`quantised_cost`]), orientation and id (the total order of
+/// the search), and its slot in [`NodeHeap`]'s slab.
 #[derive(Debug, Clone, Copy)]
 struct HeapKey {
     cost: f64,
@@ -258,7 +280,8 @@ impl<const D: usize> Default for NodeHeap<D> {
 
 impl<const D: usize> NodeHeap<D> {
     fn push(&mut self, node: Node<D>) {
-        let key = HeapKey { cost: node.cost, orientation: node.orientation as u32, slot: 0, id: node.id };
+        let key =
+            HeapKey { cost: quantised_cost(node.cost), orientation: node.orientation as u32, slot: 0, id: node.id };
         let slot = match self.free.pop() {
             Some(slot) => {
                 self.slab[slot as usize] = Some(node);
@@ -966,6 +989,34 @@ impl Search<'_, '_> {
             resting_pose: o.rest,
             cost: o.quadratic.value(p),
             contacts,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rounded key: last-bit neighbours compare equal, it is monotone, and it stays within `2^-40` relative.
+    #[test]
+    fn quantised_cost_merges_last_bit_ties_monotonically() {
+        let exact = 8560.25_f64;
+        let below = f64::from_bits(exact.to_bits() - 3);
+        let above = f64::from_bits(exact.to_bits() + 5);
+        assert_eq!(quantised_cost(below), quantised_cost(exact));
+        assert_eq!(quantised_cost(above), quantised_cost(exact));
+        assert!(quantised_cost(8560.25 * (1.0 + 1e-10)) > quantised_cost(exact));
+        assert_eq!(quantised_cost(0.0), 0.0);
+        assert_eq!(quantised_cost(f64::INFINITY), f64::INFINITY);
+        let mut values: Vec<f64> = (0..2000).map(|i| 1e-3 * 1.37_f64.powi(i % 97) * (1.0 + i as f64 * 1e-14)).collect();
+        values.extend([-2.5, -2.5000000000000004, 1.0, 0.9999999999999999, 2.0, 1.9999999999999998]);
+        values.sort_by(f64::total_cmp);
+        for w in values.windows(2) {
+            assert!(quantised_cost(w[0]) <= quantised_cost(w[1]), "not monotone at {w:?}");
+        }
+        for v in values {
+            let q = quantised_cost(v);
+            assert!((q - v).abs() <= v.abs() * 2f64.powi(-40), "{v} -> {q}");
         }
     }
 }
