@@ -14,8 +14,11 @@
 //! 3. take the first of them (deepest violation first) whose obstacle ([`crate::obstacles`]) contains `p*` in its
 //!    interior by more than the tolerance, and split `K` into the children
 //!    `K n {n_k . p >= d_k} n {n_j . p <= d_j, j < k}` ([A] VI-A-3). Children are pushed *lazily* keyed by a lower
-//!    bound of their cost: the larger of the parent's cost and the minimum of the cost over the half-space
-//!    `n_k . p >= d_k` alone (closed form, [`Quadratic::halfspace_lower_bound`]). When a pending child is popped its
+//!    bound of their cost: the largest of the parent's cost, the minimum of the cost over the half-space
+//!    `n_k . p >= d_k` alone (closed form, [`Quadratic::halfspace_lower_bound`]) and the bound that the parent's
+//!    optimality conditions give over the part of `K` beyond that plane ([`Quadratic::lower_bound_beyond`]: it grows
+//!    with the plane's distance from `p*`, which lies inside the obstacle; it halves the children solved in the
+//!    Channel and Triangle searches and leaves the solved nodes' order alone). When a pending child is popped its
 //!    emptiness is decided by a phase 1 from the parent's optimum (`Cell::is_empty_with`: the optimum violates
 //!    only `n_k . p >= d_k`, so this is usually one LP move); a non-empty child's cell is built from a second phase 1
 //!    on the exact cell (`Cell::with_halfspaces_from`, no Chebyshev LP) and its QP solved ([`crate::qp`]), and it is pushed back with its own cost — so children that never become
@@ -198,21 +201,38 @@ pub struct PlacementResult {
     pub stats: PlacementStats,
 }
 
-/// A node's cell: solved (with its optimum) or pending (the parent's cell plus the extra inequalities of child
-/// `face` of obstacle `obstacle`, rebuilt from the obstacle's planes when popped, and the parent's optimum; keyed by
-/// a lower bound of its cost: the child is only built and solved when popped).
-enum Body<const D: usize> {
-    Pending { obstacle: u32, face: u32, start: [f64; D] },
-    Solved(QpOptimum<D>),
-}
-
+/// A solved node: an orientation, a cell, its optimum and the obstacles applied on its path.
 struct Node<const D: usize> {
     cost: f64,
     orientation: usize,
     id: u64,
     cell: Arc<Cell<D>>,
-    body: Body<D>,
+    optimum: QpOptimum<D>,
     applied: Arc<Vec<u32>>,
+}
+
+/// The pending children of one split: the parent's cell plus the extra inequalities of child `face` of obstacle
+/// `obstacle` (rebuilt from the obstacle's planes when the child is popped), the parent's optimum as the start of
+/// their phase 1, and per child its key (a lower bound of its cost), id and face. A child is built and solved only
+/// when popped. The heap holds one entry per family, keyed by its cheapest remaining child (`children` is sorted
+/// so that it is the last): the heap pops the children in the same order as with one entry each (a family's key
+/// is the least of its children's, and a total order's least over a union is the least of the least ones), without
+/// holding the many children that are never popped.
+struct Family<const D: usize> {
+    orientation: usize,
+    cell: Arc<Cell<D>>,
+    applied: Arc<Vec<u32>>,
+    obstacle: u32,
+    start: [f64; D],
+    /// `(key, id, face)`, the cheapest (by [`HeapKey`]'s order) last.
+    children: Vec<(f64, u64, u32)>,
+}
+
+/// A popped entry: a solved node, or the next child of a family (its id and face; the family by index into
+/// [`NodeHeap::families`]).
+enum Popped<const D: usize> {
+    Solved(Node<D>),
+    Pending { family: u32, id: u64, face: u32 },
 }
 
 /// Low mantissa bits rounded away by [`quantised_cost`]: 12 of 52, a relative step of `2^-40` (about `1e-12`).
@@ -237,7 +257,7 @@ fn quantised_cost(cost: f64) -> f64 {
 }
 
 /// The key of a node in the heap: its cost (rounded, [`quantised_cost`]), orientation and id (the total order of
-/// the search), and its slot in [`NodeHeap`]'s slab.
+/// the search), and its slot in [`NodeHeap`]'s slab, or (with [`FAMILY`] set) its family's index.
 #[derive(Debug, Clone, Copy)]
 struct HeapKey {
     cost: f64,
@@ -245,6 +265,9 @@ struct HeapKey {
     slot: u32,
     id: u64,
 }
+
+/// The bit of [`HeapKey::slot`] that marks a family's entry.
+const FAMILY: u32 = 1 << 31;
 
 impl PartialEq for HeapKey {
     fn eq(&self, other: &Self) -> bool {
@@ -264,17 +287,19 @@ impl Ord for HeapKey {
     }
 }
 
-/// The open nodes: a binary heap of small keys (cost, orientation, id) over a slab of the nodes themselves (whose
-/// cells, optima and paths would otherwise be moved at every sift). Pops in the order (cost, orientation, id).
+/// The open nodes: a binary heap of small keys (cost, orientation, id) over a slab of the solved nodes (whose
+/// cells, optima and paths would otherwise be moved at every sift) and the families of pending children (one entry
+/// each, see [`Family`]). Pops in the order (cost, orientation, id).
 struct NodeHeap<const D: usize> {
     keys: BinaryHeap<HeapKey>,
     slab: Vec<Option<Node<D>>>,
     free: Vec<u32>,
+    families: Vec<Family<D>>,
 }
 
 impl<const D: usize> Default for NodeHeap<D> {
     fn default() -> Self {
-        Self { keys: BinaryHeap::new(), slab: Vec::new(), free: Vec::new() }
+        Self { keys: BinaryHeap::new(), slab: Vec::new(), free: Vec::new(), families: Vec::new() }
     }
 }
 
@@ -295,10 +320,45 @@ impl<const D: usize> NodeHeap<D> {
         self.keys.push(HeapKey { slot, ..key });
     }
 
-    fn pop(&mut self) -> Option<Node<D>> {
+    /// Pushes a family of pending children (none: nothing to push).
+    fn push_family(&mut self, mut family: Family<D>) {
+        if family.children.is_empty() {
+            return;
+        }
+        // descending in (rounded key, id): the cheapest last
+        family
+            .children
+            .sort_unstable_by(|a, b| quantised_cost(b.0).total_cmp(&quantised_cost(a.0)).then(b.1.cmp(&a.1)));
+        let index = self.families.len() as u32;
+        self.push_family_key(&family, index);
+        self.families.push(family);
+    }
+
+    fn push_family_key(&mut self, family: &Family<D>, index: u32) {
+        if let Some(&(cost, id, _)) = family.children.last() {
+            self.keys.push(HeapKey {
+                cost: quantised_cost(cost),
+                orientation: family.orientation as u32,
+                slot: index | FAMILY,
+                id,
+            });
+        }
+    }
+
+    fn pop(&mut self) -> Option<Popped<D>> {
         let key = self.keys.pop()?;
+        if key.slot & FAMILY != 0 {
+            let index = key.slot & !FAMILY;
+            let family = &mut self.families[index as usize];
+            let (_, id, face) = family.children.pop()?;
+            if let Some(&(cost, next, _)) = family.children.last() {
+                let orientation = family.orientation as u32;
+                self.keys.push(HeapKey { cost: quantised_cost(cost), orientation, slot: key.slot, id: next });
+            }
+            return Some(Popped::Pending { family: index, id, face });
+        }
         self.free.push(key.slot);
-        self.slab[key.slot as usize].take()
+        self.slab[key.slot as usize].take().map(Popped::Solved)
     }
 
     fn len(&self) -> usize {
@@ -632,7 +692,7 @@ impl Search<'_, '_> {
                         orientation: i,
                         id: next_id,
                         cell: Arc::new(cell),
-                        body: Body::Solved(optimum),
+                        optimum,
                         applied: Arc::new(Vec::new()),
                     });
                 }
@@ -655,32 +715,36 @@ impl Search<'_, '_> {
         let clearance = self.request.clearance;
         let tol = self.tol.linear;
         let mut pops: u64 = 0;
-        while let Some(node) = heap.pop() {
+        while let Some(popped) = heap.pop() {
             pops += 1;
             if pops > self.request.node_budget as u64 {
                 return Err(PlacementError::NodeBudget { budget: self.request.node_budget, found: placements.len() });
             }
-            let optimum = match &node.body {
-                Body::Pending { obstacle, face, start } => {
+            let node = match popped {
+                Popped::Pending { family, id, face } => {
                     // build and solve the child now; push it back with its true cost (>= its key)
                     let t_cells = Instant::now();
-                    let extra = self.child_inequalities::<D>(*obstacle, *face, fixed_z);
-                    let solved = self.solve_child::<D>(&node, &extra, start, fixed_z)?;
+                    let f = &heap.families[family as usize];
+                    let (orientation, cell, applied, obstacle, start) =
+                        (f.orientation, Arc::clone(&f.cell), Arc::clone(&f.applied), f.obstacle, f.start);
+                    let extra = self.child_inequalities::<D>(obstacle, face, fixed_z);
+                    let solved = self.solve_child::<D>(orientation, &cell, &extra, &start, fixed_z)?;
                     if let Some((cell, optimum)) = solved {
                         heap.push(Node {
                             cost: optimum.value,
-                            orientation: node.orientation,
-                            id: node.id,
+                            orientation,
+                            id,
                             cell: Arc::new(cell),
-                            body: Body::Solved(optimum),
-                            applied: node.applied,
+                            optimum,
+                            applied,
                         });
                     }
                     self.stats.time_cells_ms += ms(t_cells);
                     continue;
                 }
-                Body::Solved(optimum) => optimum,
+                Popped::Solved(node) => node,
             };
+            let optimum = &node.optimum;
             self.stats.nodes_expanded += 1;
             if !considered[node.orientation] {
                 considered[node.orientation] = true;
@@ -774,25 +838,35 @@ impl Search<'_, '_> {
             };
             let t_cells = Instant::now();
             let children = self.split::<D>(node.orientation, id, fixed_z)?;
-            let mut applied: Vec<u32> = node.applied.as_ref().clone();
+            let mut applied: Vec<u32> = Vec::with_capacity(node.applied.len() + 1);
+            applied.extend_from_slice(&node.applied);
             applied.push(id);
-            let applied = Arc::new(applied);
             let q = restrict_quadratic::<D>(&self.orientations[node.orientation].quadratic, fixed_z);
+            let mut family = Family {
+                orientation: node.orientation,
+                cell: Arc::clone(&node.cell),
+                applied: Arc::new(applied),
+                obstacle: id,
+                start: optimum.point,
+                children: Vec::with_capacity(children.len()),
+            };
             for (outside, face) in children {
                 self.stats.nodes_pushed += 1;
-                // key: a lower bound of the child's cost, the larger of the parent's cost and the cost's minimum
-                // over the child's half-space outside the obstacle face (slack: twice the cell tolerance)
-                let bound = q.halfspace_lower_bound(&outside.0, outside.1, 2.0 * tol);
-                heap.push(Node {
-                    cost: node.cost.max(bound),
-                    orientation: node.orientation,
-                    id: next_id,
-                    cell: Arc::clone(&node.cell),
-                    body: Body::Pending { obstacle: id, face, start: optimum.point },
-                    applied: Arc::clone(&applied),
-                });
+                // key: a lower bound of the child's cost, the largest of the parent's cost, the cost's minimum over
+                // the child's half-space outside the obstacle face (slack: twice the cell tolerance) and the bound
+                // from the parent's optimality conditions, which grows with the face's distance from p*
+                // (`Quadratic::lower_bound_beyond`: the child lies in the parent's cell)
+                let bound = q.halfspace_lower_bound(&outside.0, outside.1, 2.0 * tol).max(q.lower_bound_beyond(
+                    optimum,
+                    &outside.0,
+                    outside.1,
+                    2.0 * tol,
+                    tol,
+                ));
+                family.children.push((node.cost.max(bound), next_id, face));
                 next_id += 1;
             }
+            heap.push_family(family);
             self.stats.time_cells_ms += ms(t_cells);
         }
         self.stats.orientations_considered = considered.iter().filter(|c| **c).count();
@@ -918,18 +992,19 @@ impl Search<'_, '_> {
     /// Builds a pending child's cell and solves its QP (`None` when empty).
     fn solve_child<const D: usize>(
         &mut self,
-        node: &Node<D>,
+        orientation: usize,
+        parent: &Cell<D>,
         extra: &[Halfspace<D>],
         start: &[f64; D],
         fixed_z: f64,
     ) -> Result<Option<(Cell<D>, QpOptimum<D>)>, PlacementError> {
-        let fs_err = |reason: String| PlacementError::FreeSpace { orientation: node.orientation, reason };
+        let fs_err = |reason: String| PlacementError::FreeSpace { orientation, reason };
         // the child from the parent's optimum (it satisfies the parent and the obstacle's inside cuts; only the
         // child's outside face is violated): emptiness by a phase 1 from it (most children are empty), and a
         // non-empty child's interior point by a second phase 1 on the exact cell instead of the Chebyshev LP
         // (`Cell::with_halfspaces_from`; a cell thinner than the tolerance still gets the Chebyshev build). The QP's
         // optimum equals a cold build's up to rounding in the last bits.
-        let Some(cell) = node.cell.with_halfspaces_from(extra, start).map_err(|e| fs_err(e.to_string()))? else {
+        let Some(cell) = parent.with_halfspaces_from(extra, start).map_err(|e| fs_err(e.to_string()))? else {
             self.stats.cells_empty += 1;
             return Ok(None);
         };
@@ -938,7 +1013,7 @@ impl Search<'_, '_> {
             return Ok(None);
         }
         self.stats.qp_solves += 1;
-        let q = restrict_quadratic::<D>(&self.orientations[node.orientation].quadratic, fixed_z);
+        let q = restrict_quadratic::<D>(&self.orientations[orientation].quadratic, fixed_z);
         match minimise(&cell, &q).map_err(fs_err)? {
             Some(opt) => Ok(Some((cell, opt))),
             None => {
