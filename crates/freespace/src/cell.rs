@@ -340,28 +340,73 @@ impl<const D: usize> Cell<D> {
         let mut scratch = Scratch::take();
         let grown = self.phase_one_in(extra.iter().copied(), start, self.tolerance.linear, &mut scratch);
         scratch.clear();
-        let exact = match grown {
-            Ok(Some(_)) => self.phase_one_in(extra.iter().copied(), start, 0.0, &mut scratch),
-            _ => Ok(None),
+        let grown = match grown {
+            Ok(Some(_)) => Ok(()),
+            Ok(None) => {
+                scratch.put_back();
+                return Ok(None);
+            }
+            Err(e) => Err(e),
+        };
+        // the child itself: this cell's inequalities as they are (already unit), `extra` normalised; its exact phase
+        // 1 runs on its own rows (the same rows and offsets as the grown phase 1's without the growth, no copy)
+        let built = grown.and_then(|()| self.extended(extra));
+        let exact = match &built {
+            Ok(cell) if cell.shape != CellShape::Empty => {
+                let mask = &mut scratch.mask;
+                phase_one_rows(&cell.rows, &cell.offsets, start, mask, self.length_scale())
+            }
+            Ok(_) => Ok(None),
+            Err(e) => Err(e.clone()),
         };
         scratch.put_back();
-        match (grown?, exact?) {
-            (None, _) => Ok(None),
-            (Some(_), Some(point)) => {
-                let mut hs = Vec::with_capacity(self.halfspaces.len() + extra.len());
-                hs.extend_from_slice(&self.halfspaces);
-                hs.extend_from_slice(extra);
-                let mut cell = Self::normalised(hs, self.tolerance)?;
-                if cell.shape != CellShape::Empty {
-                    cell.shape = CellShape::Known { point: from_v4(&point) };
-                }
+        let mut cell = built?;
+        if cell.shape == CellShape::Empty {
+            return Ok(None);
+        }
+        match exact? {
+            Some(point) => {
+                cell.shape = CellShape::Known { point: from_v4(&point) };
                 Ok(Some(cell))
             }
-            (Some(_), None) => {
+            None => {
                 let cell = self.with_halfspaces(extra.iter().copied())?;
                 Ok((!cell.is_empty()).then_some(cell))
             }
         }
+    }
+
+    /// This cell (non-empty, so every inequality has a unit normal) with `extra` added, normalised as by
+    /// [`Cell::new`] (the same arithmetic): the lists are copied, not normalised again. Shape [`CellShape::Empty`] when
+    /// an extra inequality with a zero normal fails, otherwise (provisionally) [`CellShape::Known`] at the origin.
+    fn extended(&self, extra: &[Halfspace<D>]) -> Result<Self, CellError> {
+        let m = self.halfspaces.len() + extra.len();
+        let mut halfspaces = Vec::with_capacity(m);
+        let mut rows = Vec::with_capacity(m);
+        let mut offsets = Vec::with_capacity(m);
+        halfspaces.extend_from_slice(&self.halfspaces);
+        rows.extend_from_slice(&self.rows);
+        offsets.extend_from_slice(&self.offsets);
+        let mut trivially_empty = false;
+        for (k, h) in extra.iter().enumerate() {
+            if !h.offset.is_finite() || h.normal.iter().any(|c| !c.is_finite()) {
+                return Err(CellError::NonFinite { index: self.halfspaces.len() + k });
+            }
+            let len = h.normal.iter().map(|c| c * c).sum::<f64>().sqrt();
+            let kept = if len > 0.0 {
+                Halfspace { normal: h.normal.map(|c| c / len), offset: h.offset / len, tag: h.tag }
+            } else if h.offset < -self.tolerance.linear {
+                trivially_empty = true;
+                *h
+            } else {
+                continue;
+            };
+            halfspaces.push(kept);
+            rows.push(to_v4(&kept.normal));
+            offsets.push(kept.offset);
+        }
+        let shape = if trivially_empty { CellShape::Empty } else { CellShape::Known { point: [0.0; D] } };
+        Ok(Self { halfspaces, rows, offsets, tolerance: self.tolerance, shape })
     }
 
     /// The sequential phase 1 of [`Cell::is_empty_with`] on this cell with `extra` added, every offset grown by
@@ -391,48 +436,7 @@ impl<const D: usize> Cell<D> {
                 return Ok(None);
             }
         }
-        let (rows, grown) = (&rows[..], &grown[..]);
-        let m = rows.len();
-        let mut point = to_v4(start);
-        let satisfied_at = |j: usize, p: &V4| dot4(&rows[j], p) <= grown[j];
-        mask.extend((0..m).map(|j| satisfied_at(j, &point)));
-        for j in 0..m {
-            if mask[j] {
-                continue;
-            }
-            if satisfied_at(j, &point) {
-                mask[j] = true;
-                continue;
-            }
-            let prob = Problem {
-                n: D,
-                rows,
-                offsets: grown,
-                mask: Some(&mask[..]),
-                h: [0.0; MAX_N],
-                g: rows[j],
-                tie: default_tie(D),
-                length_scale: self.length_scale(),
-            };
-            // the closed-form iteration in 2-3 variables, the general one if it breaks down
-            let seek = match prob.seek_small(point, grown[j]) {
-                Some(s) => s,
-                None => {
-                    prob.seek(point, grown[j]).map_err(|source| CellError::Solver { purpose: "phase 1", source })?
-                }
-            };
-            match seek {
-                Seek::Reached(p) => point = p,
-                Seek::Minimum { point: p, value } => {
-                    if value > grown[j] {
-                        return Ok(None);
-                    }
-                    point = p;
-                }
-            }
-            mask[j] = true;
-        }
-        Ok(Some(point))
+        phase_one_rows(rows, grown, start, mask, self.length_scale())
     }
 
     /// The intersection of two cells (inequalities of `self`, then of `other`); tolerance of `self`.
@@ -588,6 +592,56 @@ impl<const D: usize> Cell<D> {
         }
         Ok(())
     }
+}
+
+/// The sequential phase 1 on the inequalities `rows . p <= offsets` from `start` ([`Cell::is_empty_with`]): the
+/// point reached (`None`: empty). `mask` (empty on entry) holds the satisfied set.
+fn phase_one_rows<const D: usize>(
+    rows: &[V4],
+    offsets: &[f64],
+    start: &[f64; D],
+    mask: &mut Vec<bool>,
+    length_scale: f64,
+) -> Result<Option<V4>, CellError> {
+    let m = rows.len();
+    let mut point = to_v4(start);
+    let satisfied_at = |j: usize, p: &V4| dot4(&rows[j], p) <= offsets[j];
+    mask.extend((0..m).map(|j| satisfied_at(j, &point)));
+    for j in 0..m {
+        if mask[j] {
+            continue;
+        }
+        if satisfied_at(j, &point) {
+            mask[j] = true;
+            continue;
+        }
+        let prob = Problem {
+            n: D,
+            rows,
+            offsets,
+            mask: Some(&mask[..]),
+            h: [0.0; MAX_N],
+            g: rows[j],
+            tie: default_tie(D),
+            length_scale,
+        };
+        // the closed-form iteration in 2-3 variables, the general one if it breaks down
+        let seek = match prob.seek_small(point, offsets[j]) {
+            Some(s) => s,
+            None => prob.seek(point, offsets[j]).map_err(|source| CellError::Solver { purpose: "phase 1", source })?,
+        };
+        match seek {
+            Seek::Reached(p) => point = p,
+            Seek::Minimum { point: p, value } => {
+                if value > offsets[j] {
+                    return Ok(None);
+                }
+                point = p;
+            }
+        }
+        mask[j] = true;
+    }
+    Ok(Some(point))
 }
 
 /// Per-thread lists for the LPs of a cell (rows, offsets, mask), reused between calls so that the hot paths

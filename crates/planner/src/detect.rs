@@ -309,6 +309,18 @@ pub struct AxesCache {
     /// `[orientation][moving][fixed]`: 0 never tested, 1 tested once, `k + 2` = `axes[k]`.
     index: Vec<Vec<Vec<u32>>>,
     axes: Vec<PairAxes>,
+    /// The lists of a finished [`CandidateQueue`] ([`CandidateQueue::recycle`]), emptied, for the next one (no
+    /// allocation per detection once warm).
+    spare: QueueLists,
+}
+
+/// The lists of a [`CandidateQueue`], kept between detections.
+#[derive(Debug, Clone, Default)]
+struct QueueLists {
+    moved: Vec<MovedComponent>,
+    near: Vec<usize>,
+    open: Vec<OpenPair>,
+    exact: Vec<Candidate>,
 }
 
 const UNSEEN: u32 = 0;
@@ -387,16 +399,15 @@ impl CandidateQueue {
         } else {
             Rule { weight: 0.0, stop: tol.max(clearance), inclusive: false }
         };
-        let mut queue = Self {
-            p,
-            clearance,
-            horizontal,
-            tol,
-            rule,
-            moved: vec![MovedComponent::default(); orientation.components.len()],
-            open: Vec::new(),
-            exact: Vec::new(),
-        };
+        let QueueLists { mut moved, mut near, open, exact } = std::mem::take(&mut cache.spare);
+        for m in &mut moved {
+            m.vertices.clear();
+            m.own.clear();
+        }
+        moved.resize_with(orientation.components.len(), MovedComponent::default);
+        let mut queue = Self { p, clearance, horizontal, tol, rule, moved, open, exact };
+        queue.open.clear();
+        queue.exact.clear();
         let margin = clearance + tol;
         // broad phase in two levels: the stack components near the whole part's box (a superset of each
         // component's, the sweep reaching up without bound), then each component's box
@@ -404,13 +415,15 @@ impl CandidateQueue {
             Some(_) => (orientation.lo + p, DVec3::new(orientation.hi.x + p.x, orientation.hi.y + p.y, f64::INFINITY)),
             None => (orientation.lo + p, orientation.hi + p),
         };
-        let near: Vec<usize> = scene
-            .components
-            .iter()
-            .enumerate()
-            .filter(|(_, f)| boxes_overlap(&part_box, &f.placed.aabb, margin))
-            .map(|(i, _)| i)
-            .collect();
+        near.clear();
+        near.extend(
+            scene
+                .components
+                .iter()
+                .enumerate()
+                .filter(|(_, f)| boxes_overlap(&part_box, &f.placed.aabb, margin))
+                .map(|(i, _)| i),
+        );
         for (mi, placed) in orientation.components.iter().enumerate() {
             if near.is_empty() {
                 break;
@@ -426,7 +439,7 @@ impl CandidateQueue {
                 Some(s) => (&s.axes[mi].0, &s.axes[mi].1),
                 None => (&placed.normal_axes, &placed.edge_directions),
             };
-            let AxesCache { index, axes: arena } = &mut *cache;
+            let AxesCache { index, axes: arena, .. } = &mut *cache;
             let row = {
                 if index.len() <= orientation.index {
                     index.resize_with(orientation.index + 1, Vec::new);
@@ -458,7 +471,8 @@ impl CandidateQueue {
                             vertices.push(vertices[k] + DVec3::new(0.0, 0.0, lift));
                         }
                     }
-                    moving.own = vec![(f64::NAN, f64::NAN); normals.len()];
+                    moving.own.clear();
+                    moving.own.resize(normals.len(), (f64::NAN, f64::NAN));
                 }
                 let mut best = f64::NEG_INFINITY;
                 // first test of the pair: on the fly; second: build and keep its axes; later: reuse them
@@ -480,7 +494,15 @@ impl CandidateQueue {
                 }
             }
         }
+        cache.spare.near = near;
         queue
+    }
+
+    /// Gives the queue's lists back to `cache` for the next detection (optional: a queue simply dropped costs only
+    /// the allocations of the next one).
+    pub fn recycle(self, cache: &mut AxesCache) {
+        let near = std::mem::take(&mut cache.spare.near);
+        cache.spare = QueueLists { moved: self.moved, near, open: self.open, exact: self.exact };
     }
 
     /// Upper bound of an open pair's violation: from the running maximum, plus (with a clearance, where
@@ -614,6 +636,7 @@ pub fn candidates(
     while let Some(c) = queue.next(scene, orientation, sweep, cache) {
         out.push(c);
     }
+    queue.recycle(cache);
     out
 }
 

@@ -821,6 +821,7 @@ impl Search<'_, '_> {
                         break;
                     }
                 }
+                queue.recycle(&mut self.axes);
             }
             let Some(id) = cutting else {
                 // free: a placement, unless it repeats one already found (cells share boundaries)
