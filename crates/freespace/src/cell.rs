@@ -178,6 +178,13 @@ impl<const D: usize> Cell<D> {
         Self::build(halfspaces, tolerance, true)
     }
 
+    /// [`Cell::new`] without the boundedness check (its `2 D` LPs), for a caller that knows the cell is bounded or
+    /// checks it with [`Cell::check_bounded`]: e.g. many cells with the same normals and different offsets (a
+    /// non-empty polyhedron `{A p <= b}` is bounded iff `{A p <= 0} = {0}`, which does not depend on `b`), checked once.
+    pub fn new_unchecked_bounds(halfspaces: Vec<Halfspace<D>>, tolerance: Tolerance) -> Result<Self, CellError> {
+        Self::build(halfspaces, tolerance, false)
+    }
+
     /// Builds without the boundedness check: only for subsets of a bounded cell.
     pub(crate) fn build(
         halfspaces: Vec<Halfspace<D>>,
@@ -580,7 +587,8 @@ impl<const D: usize> Cell<D> {
         if radius <= tol { Ok(CellShape::Flat { point: p }) } else { Ok(CellShape::Solid { centre: p, radius }) }
     }
 
-    fn check_bounded(&self) -> Result<(), CellError> {
+    /// [`CellError::Unbounded`] when the (non-empty) cell is unbounded: `2 D` LPs `max +-p_i`, as in [`Cell::new`].
+    pub fn check_bounded(&self) -> Result<(), CellError> {
         for i in 0..D {
             for sign in [1.0, -1.0] {
                 let mut dir = [0.0; D];

@@ -661,18 +661,28 @@ impl Search<'_, '_> {
                 None => return Ok(None),
             }
         };
-        let cell = Cell::new(hs, self.tol).map_err(fs_err)?;
+        // bounded iff the first non-empty root is (the normals do not depend on the orientation): checked in `run`
+        let cell = Cell::new_unchecked_bounds(hs, self.tol).map_err(fs_err)?;
         Ok((!cell.is_empty()).then_some(cell))
     }
 
     fn run<const D: usize>(&mut self, fixed_z: f64) -> Result<PlacementResult, PlacementError> {
         let t_roots = Instant::now();
-        // roots in parallel, collected in orientation order
+        // roots in parallel, collected in orientation order; Omega's normals are those of the floor's sides and
+        // (3-D) of the floor and the ceiling at every orientation, only the offsets change, so the first non-empty
+        // root's boundedness check (as `Cell::new` makes it) answers for all of them
+        let cells: Vec<Result<Option<Cell<D>>, PlacementError>> =
+            self.orientations.par_iter().map(|o| self.root_cell::<D>(o, fixed_z)).collect();
+        let mut cells: Vec<Option<Cell<D>>> = cells.into_iter().collect::<Result<_, _>>()?;
+        if let Some((i, cell)) = cells.iter().enumerate().find_map(|(i, c)| c.as_ref().map(|c| (i, c))) {
+            cell.check_bounded().map_err(|e| PlacementError::FreeSpace { orientation: i, reason: e.to_string() })?;
+        }
         let roots: Vec<Result<Option<(Cell<D>, QpOptimum<D>)>, PlacementError>> = self
             .orientations
             .par_iter()
-            .map(|o| {
-                let Some(cell) = self.root_cell::<D>(o, fixed_z)? else {
+            .zip(cells.par_iter_mut())
+            .map(|(o, cell)| {
+                let Some(cell) = cell.take() else {
                     return Ok(None);
                 };
                 let q = restrict_quadratic::<D>(&o.quadratic, fixed_z);
