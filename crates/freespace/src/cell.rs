@@ -355,8 +355,8 @@ impl<const D: usize> Cell<D> {
             }
             Err(e) => Err(e),
         };
-        // the child itself: this cell's inequalities as they are (already unit), `extra` normalised; its exact phase
-        // 1 runs on its own rows (the same rows and offsets as the grown phase 1's without the growth, no copy)
+        // the child itself (`Cell::extended`); its exact phase 1 runs on its own rows (the grown phase 1's rows,
+        // its offsets without the growth; no second copy)
         let built = grown.and_then(|()| self.extended(extra));
         let exact = match &built {
             Ok(cell) if cell.shape != CellShape::Empty => {
@@ -383,17 +383,23 @@ impl<const D: usize> Cell<D> {
         }
     }
 
-    /// This cell (non-empty, so every inequality has a unit normal) with `extra` added, normalised as by
-    /// [`Cell::new`] (the same arithmetic): the lists are copied, not normalised again. Shape [`CellShape::Empty`] when
-    /// an extra inequality with a zero normal fails, otherwise (provisionally) [`CellShape::Known`] at the origin.
+    /// This cell (non-empty, so every normal is non-zero) with `extra` added, normalised as by [`Cell::new`] (the
+    /// same arithmetic, the same lists as `Cell::new` of all the inequalities). Shape [`CellShape::Empty`] when an
+    /// extra inequality with a zero normal fails, otherwise (provisionally) [`CellShape::Known`] at the origin.
     fn extended(&self, extra: &[Halfspace<D>]) -> Result<Self, CellError> {
         let m = self.halfspaces.len() + extra.len();
         let mut halfspaces = Vec::with_capacity(m);
         let mut rows = Vec::with_capacity(m);
         let mut offsets = Vec::with_capacity(m);
-        halfspaces.extend_from_slice(&self.halfspaces);
-        rows.extend_from_slice(&self.rows);
-        offsets.extend_from_slice(&self.offsets);
+        // normalised again as `Cell::new` does (dividing a unit normal by its computed length can move its last
+        // bit, and the child must equal `with_halfspaces`'s bit for bit)
+        for h in &self.halfspaces {
+            let len = h.normal.iter().map(|c| c * c).sum::<f64>().sqrt();
+            let kept = Halfspace { normal: h.normal.map(|c| c / len), offset: h.offset / len, tag: h.tag };
+            halfspaces.push(kept);
+            rows.push(to_v4(&kept.normal));
+            offsets.push(kept.offset);
+        }
         let mut trivially_empty = false;
         for (k, h) in extra.iter().enumerate() {
             if !h.offset.is_finite() || h.normal.iter().any(|c| !c.is_finite()) {
