@@ -8,10 +8,12 @@
 //! 2. the best-first placement search ([`crate::search::place`]) returns up to [`PlanOptions::candidates`]
 //!    interference-free positions sorted by the part's term of cost (1), one per free-space cell; with
 //!    `insertion` every candidate can be lowered straight down into place (insertion obstacles);
-//! 3. the candidates are tested in cost order with [`stackplan_stability::check_added_part`] on the stack plus the
-//!    candidate (the new part's report of [`stackplan_stability::check::check_stack`], without re-checking the parts
-//!    that passed before): the new part statically stable on its supports (friction cones), the whole stack stable,
-//!    a suction face for the cup, insertable from above; the first that passes is taken;
+//! 3. the candidates are settled ([`crate::settle`]) and tested in cost order on the stack placed so far
+//!    ([`stackplan_stability::growing::GrowingStack`]: the verdicts of [`stackplan_stability::check_added_part`],
+//!    the new part's report of [`stackplan_stability::check::check_stack`], without re-checking the parts that
+//!    passed before, up to the first that fails, with the placed parts' contacts and the memos kept from candidate
+//!    to candidate): the new part statically stable on its supports (friction cones), the whole stack stable, a
+//!    suction face for the cup, insertable from above; the first that passes is taken;
 //! 4. the seed's two stages: stage 1 searches within the stack's current floor footprint (its bounding rectangle
 //!    grown by `nest_allowance`, clipped to the floor), so the stack's bounding box is not enlarged, or only
 //!    slightly to nest; stage 2 searches the whole floor. Stage 1's part is taken unless stage 2's is strictly
@@ -32,8 +34,8 @@ use serde::{Deserialize, Serialize};
 use stackplan_cspace::cache::ObstacleCache;
 use stackplan_geom::{Part, Pose, Tolerance};
 use stackplan_stability::check::{CheckOptions, check_stack};
-use stackplan_stability::check_added_part;
 use stackplan_stability::grasp::{GraspOptions, grasp_faces, is_graspable};
+use stackplan_stability::growing::{GrowingStack, Rejection};
 use stackplan_stability::world::PlacedPart;
 
 /// Options of a stacking plan.
@@ -141,6 +143,18 @@ pub struct PlanStats {
     /// Searches repeated with more candidates because every candidate failed the checks.
     #[serde(default)]
     pub repeated_searches: usize,
+    /// Candidates rejected as not stable on their supports.
+    #[serde(default)]
+    pub rejected_not_stable: usize,
+    /// Candidates rejected because the stack with them would not be stable.
+    #[serde(default)]
+    pub rejected_stack_not_stable: usize,
+    /// Candidates rejected for want of a suction face.
+    #[serde(default)]
+    pub rejected_not_graspable: usize,
+    /// Candidates rejected because they cannot be lowered straight down into place.
+    #[serde(default)]
+    pub rejected_not_insertable: usize,
     /// Component pairs whose obstacle was built, over all searches.
     pub pairs_evaluated: u64,
     /// Obstacles constructed (cache misses).
@@ -289,6 +303,9 @@ pub fn plan_stack_with_progress(
         Tolerance::for_scale((hi - lo).length()).linear
     };
     let mut caches = SearchCaches::new();
+    // the stack as the candidate tests see it: its parts in world coordinates, their contacts and the memos of the
+    // tests, kept from candidate to candidate and from part to part
+    let mut growing = GrowingStack::new(&check_options).map_err(|e| PlanError::Check(e.to_string()))?;
     let mut placed: Vec<Pose> = Vec::new();
     let mut planned: Vec<PlannedPart> = Vec::new();
     let mut stats = PlanStats::default();
@@ -357,7 +374,7 @@ pub fn plan_stack_with_progress(
                     }
                     stats.candidates_checked += 1;
                     let candidate = &settled(part, &rests, candidate, &scene, &cache, tol, &request.cost)?;
-                    match accept(part, &placed, &candidate.0, &check_options)? {
+                    match accept(&mut growing, part, &candidate.0, &mut stats)? {
                         Ok(grasp_radius) => {
                             accepted.push((stage, candidate.clone(), rejected, grasp_radius));
                             found = true;
@@ -389,6 +406,9 @@ pub fn plan_stack_with_progress(
         if let Some((stage, (candidate, release_drop), rejected, grasp_radius)) = best.cloned() {
             let pose = candidate.pose();
             placed.push(pose);
+            growing
+                .push(PlacedPart { part, rotation: pose.rotation, position: pose.position })
+                .map_err(|e| PlanError::Check(e.to_string()))?;
             planned.push(PlannedPart {
                 position: candidate.position,
                 rotation: candidate.rotation,
@@ -475,30 +495,30 @@ fn settled(
     Ok((settled, s.drop))
 }
 
-/// Tests one candidate: `Ok(Ok(grasp radius))` when it passes, `Ok(Err(reason))` when it does not.
+/// Tests one candidate on the stack placed so far: `Ok(Ok(grasp radius))` when it passes, `Ok(Err(reason))` when it
+/// does not. The stack passed these tests when its parts were added, so only the new part is tested
+/// ([`GrowingStack::check_candidate`]: the verdicts of [`stackplan_stability::check_added_part`]'s report that
+/// matter here, in this order, up to the first that fails).
 fn accept(
+    growing: &mut GrowingStack<'_>,
     part: &Part,
-    placed: &[Pose],
     candidate: &Placement,
-    options: &CheckOptions,
+    stats: &mut PlanStats,
 ) -> Result<Result<f64, String>, PlanError> {
     let pose = candidate.pose();
-    let mut world: Vec<PlacedPart<'_>> =
-        placed.iter().map(|p| PlacedPart { part, rotation: p.rotation, position: p.position }).collect();
-    world.push(PlacedPart { part, rotation: pose.rotation, position: pose.position });
-    // the stack before the candidate passed these checks when its parts were added: only the new part is checked
-    let new = check_added_part(&world, options).map_err(|e| PlanError::Check(e.to_string()))?;
-    let reason = if !new.stable.is_stable() {
-        "not stable on its supports"
-    } else if !new.stack_stable.is_stable() {
-        "the stack would not be stable"
-    } else if !new.graspable {
-        "no suction face for the cup"
-    } else if !new.insertable {
-        "cannot be lowered straight down into place"
-    } else {
-        return Ok(Ok(new.grasp_radius));
+    let tested = growing
+        .check_candidate(PlacedPart { part, rotation: pose.rotation, position: pose.position })
+        .map_err(|e| PlanError::Check(e.to_string()))?;
+    let (reason, count) = match tested {
+        Ok(accepted) => return Ok(Ok(accepted.grasp_radius)),
+        Err(Rejection::NotStable(_)) => ("not stable on its supports", &mut stats.rejected_not_stable),
+        Err(Rejection::StackNotStable(_)) => ("the stack would not be stable", &mut stats.rejected_stack_not_stable),
+        Err(Rejection::NotGraspable) => ("no suction face for the cup", &mut stats.rejected_not_graspable),
+        Err(Rejection::NotInsertable(_)) => {
+            ("cannot be lowered straight down into place", &mut stats.rejected_not_insertable)
+        }
     };
+    *count += 1;
     Ok(Err(format!("the best interference-free positions were rejected (last: {reason})")))
 }
 

@@ -54,7 +54,7 @@ pub fn check_added_part(stack: &[PlacedPart<'_>], options: &CheckOptions) -> Res
 }
 
 /// The parts connected to `last` through part-part contact patches (union-find over the patches; O(P + K alpha)).
-fn step_group(n: usize, patches: &[crate::contacts::ContactPatch], last: usize) -> Vec<bool> {
+pub(crate) fn step_group(n: usize, patches: &[crate::contacts::ContactPatch], last: usize) -> Vec<bool> {
     let mut sets = crate::union_find::UnionFind::new(n);
     for p in patches {
         if let Body::Part(a) = p.a

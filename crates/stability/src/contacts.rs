@@ -152,74 +152,87 @@ fn kind_of(points: &[DVec3]) -> PatchKind {
 /// Only parts for which `include(i)` holds take part (to analyse a prefix of a stack).
 pub fn analyse_contacts(parts: &[WorldPart], tol: f64, include: impl Fn(usize) -> bool) -> ContactAnalysis {
     let mut out = ContactAnalysis::default();
-    for (j, pb) in parts.iter().enumerate() {
-        if !include(j) {
-            continue;
-        }
-        // the floor
-        if pb.aabb.0.z <= tol {
-            for (cb, comp) in pb.components.iter().enumerate() {
-                match floor_contact(comp, tol) {
-                    Err(depth) => out.interferences.push(Interference {
-                        a: Body::Floor,
-                        b: j,
-                        component_a: None,
-                        component_b: cb,
-                        depth,
-                    }),
-                    Ok(Some((points, gap))) => out.patches.push(ContactPatch {
-                        a: Body::Floor,
-                        b: j,
-                        component_a: None,
-                        component_b: cb,
-                        normal: DVec3::Z,
-                        kind: kind_of(&points),
-                        points,
-                        gap,
-                    }),
-                    Ok(None) => {}
-                }
-            }
-        }
-        for (i, pa) in parts.iter().enumerate().take(j) {
-            if !include(i) || !aabb_overlap(&pa.aabb, &pb.aabb, tol) {
-                continue;
-            }
-            for (ca, a) in pa.components.iter().enumerate() {
-                if !aabb_overlap(&a.aabb, &pb.aabb, tol) {
-                    continue;
-                }
-                for (cb, b) in pb.components.iter().enumerate() {
-                    if !aabb_overlap(&a.aabb, &b.aabb, tol) {
-                        continue;
-                    }
-                    let sep = separation(&Shape::of(a), &Shape::of(b));
-                    if sep.distance < -tol {
-                        out.interferences.push(Interference {
-                            a: Body::Part(i),
-                            b: j,
-                            component_a: Some(ca),
-                            component_b: cb,
-                            depth: -sep.distance,
-                        });
-                    } else if sep.distance <= tol
-                        && let Some((points, normal)) = touching_patch(a, b, sep.axis, tol)
-                    {
-                        out.patches.push(ContactPatch {
-                            a: Body::Part(i),
-                            b: j,
-                            component_a: Some(ca),
-                            component_b: cb,
-                            normal,
-                            kind: kind_of(&points),
-                            points,
-                            gap: sep.distance,
-                        });
-                    }
-                }
-            }
+    for j in 0..parts.len() {
+        if include(j) {
+            contacts_of_part(parts, j, tol, &include, &mut out);
         }
     }
     tracing::debug!(patches = out.patches.len(), interferences = out.interferences.len(), "contacts analysed");
     out
+}
+
+/// The contacts and interferences of part `j` with the floor and with the parts `i < j` for which `include(i)`
+/// holds, appended to `out` in the order of [`analyse_contacts`] (which is this for every included `j` in turn: the
+/// analysis of a stack is that of the stack without its last part followed by the last part's).
+pub fn contacts_of_part(
+    parts: &[WorldPart],
+    j: usize,
+    tol: f64,
+    include: impl Fn(usize) -> bool,
+    out: &mut ContactAnalysis,
+) {
+    let pb = &parts[j];
+    // the floor
+    if pb.aabb.0.z <= tol {
+        for (cb, comp) in pb.components.iter().enumerate() {
+            match floor_contact(comp, tol) {
+                Err(depth) => out.interferences.push(Interference {
+                    a: Body::Floor,
+                    b: j,
+                    component_a: None,
+                    component_b: cb,
+                    depth,
+                }),
+                Ok(Some((points, gap))) => out.patches.push(ContactPatch {
+                    a: Body::Floor,
+                    b: j,
+                    component_a: None,
+                    component_b: cb,
+                    normal: DVec3::Z,
+                    kind: kind_of(&points),
+                    points,
+                    gap,
+                }),
+                Ok(None) => {}
+            }
+        }
+    }
+    for (i, pa) in parts.iter().enumerate().take(j) {
+        if !include(i) || !aabb_overlap(&pa.aabb, &pb.aabb, tol) {
+            continue;
+        }
+        for (ca, a) in pa.components.iter().enumerate() {
+            if !aabb_overlap(&a.aabb, &pb.aabb, tol) {
+                continue;
+            }
+            for (cb, b) in pb.components.iter().enumerate() {
+                if !aabb_overlap(&a.aabb, &b.aabb, tol) {
+                    continue;
+                }
+                let sep = separation(&Shape::of(a), &Shape::of(b));
+                if sep.distance < -tol {
+                    out.interferences.push(Interference {
+                        a: Body::Part(i),
+                        b: j,
+                        component_a: Some(ca),
+                        component_b: cb,
+                        depth: -sep.distance,
+                    });
+                } else if sep.distance <= tol
+                    && let Some((points, normal)) = touching_patch(a, b, sep.axis, tol)
+                {
+                    out.patches.push(ContactPatch {
+                        a: Body::Part(i),
+                        b: j,
+                        component_a: Some(ca),
+                        component_b: cb,
+                        normal,
+                        kind: kind_of(&points),
+                        points,
+                        gap: sep.distance,
+                    });
+                }
+            }
+        }
+    }
 }

@@ -45,6 +45,9 @@
 //! * flat supports in closed form: an edge whose points all push straight up from one horizontal plane has the
 //!   margin `min(mu, s / H)` (`FlatSupport`) and, when the least-squares normal forces are nonnegative, those as its
 //!   minimum-norm forces (friction 0), without a solve;
+//! * verdicts only (`EquilibriumOptions::verdict_only`): a support-tree edge whose c.g. lies over the support
+//!   polygon of its contacts that admit a vertical push is stable without a solve (`hull_certificate`), and a group
+//!   without a tree by nonnegative vertical forces at those contacts (`tree::vertical_certificate`, `vertical_qp`);
 //! * margins (`margin`): coplanar points with the same cone reduced to their hull's vertices; a triangle certificate
 //!   (three SOCPs) for problems that resist the current smallest margin in every direction (nested, locked parts);
 //! * a memo (`SolveCache`) of identical rigid-body problems across the calls of one stack check.
@@ -67,6 +70,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 mod cache;
+mod hull_certificate;
 mod margin;
 mod tree;
 mod vertical_qp;
@@ -115,8 +119,9 @@ pub struct EquilibriumOptions {
     pub equilibrium_by_socp_only: bool,
     /// Only the verdict is wanted: a group without a support tree may be certified stable by any admissible force
     /// distribution (vertical forces at its horizontal contacts: the least-squares one, `tree::vertical_certificate`,
-    /// else the minimum-norm nonnegative one, `vertical_qp`) instead of the minimum-norm solve; the result's forces
-    /// are then empty.
+    /// else the minimum-norm nonnegative one, `vertical_qp`), and a support-tree edge by vertical forces at the
+    /// contacts that admit a vertical push with the c.g. over their support polygon (`hull_certificate`), instead of
+    /// the minimum-norm solve; the result's forces are then empty.
     #[serde(default)]
     pub verdict_only: bool,
 }
@@ -361,13 +366,13 @@ fn group_equilibrium(
         let own = group.points(points);
         if !plain
             && options.verdict_only
-            && let Some(forces) = tree::vertical_certificate(bodies, &group.movers, &own)
+            && let Some(forces) = tree::vertical_certificate(bodies, &group.movers, &own, mu)
         {
             return Ok((Verdict::Stable, forces));
         }
         if !plain
             && options.verdict_only
-            && let Some(forces) = vertical_qp::vertical_qp_certificate(bodies, &group.movers, &own)?
+            && let Some(forces) = vertical_qp::vertical_qp_certificate(bodies, &group.movers, &own, mu)?
         {
             return Ok((Verdict::Stable, forces));
         }
@@ -379,13 +384,19 @@ fn group_equilibrium(
     let mut verdict = Verdict::Stable;
     for edge in &edges {
         let own: Vec<Point> = edge.points.iter().map(|&(k, holds_b)| tree::edge_point(&points[k], holds_b)).collect();
-        let (v, on_subtree) =
-            cache.equilibrium(cache::key(&[mu], &edge.union, &own), || {
+        // for a verdict, any admissible distribution will do: the vertical one over the support polygon first (not
+        // memoised: the memo holds minimum-norm answers)
+        let certified =
+            if options.verdict_only { hull_certificate::hull_certificate(&edge.union, &own, mu) } else { None };
+        let (v, on_subtree) = match certified {
+            Some(f) => (Verdict::Stable, f),
+            None => cache.equilibrium(cache::key(&[mu], &edge.union, &own), || {
                 match tree::flat_minimum_norm(&edge.union, &own) {
                     Some(f) => Ok((Verdict::Stable, f)),
                     None => socp(&[edge.union], &[0], &own.iter().collect::<Vec<_>>()),
                 }
-            })?;
+            })?,
+        };
         match v {
             Verdict::Stable => {
                 for (&(k, holds_b), f) in edge.points.iter().zip(on_subtree) {

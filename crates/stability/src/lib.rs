@@ -10,7 +10,9 @@
 //! * [`insertion`]: lowering straight down / lifting straight up;
 //! * [`clearance`]: horizontal clearance for robot positioning error;
 //! * [`check`]: everything for every part of a stack;
-//! * [`addition`]: the same for a part added to a stack that passed (the planner's per-candidate test).
+//! * [`addition`]: the same for a part added to a stack that passed;
+//! * [`growing`]: a stack that grows one part at a time and the verdict on a candidate for its next part (the
+//!   planner's per-candidate test).
 //!
 //! Helpers: [`sat`] (separating-axis test with sweeps), [`polygon2d`] (planar hulls and clipping), [`world`]
 //! (placed parts in world coordinates). Lengths in millimetres, angles in radians, forces in mass units times g.
@@ -21,6 +23,7 @@ pub mod clearance;
 pub mod contacts;
 pub mod equilibrium;
 pub mod grasp;
+pub mod growing;
 pub mod insertion;
 pub mod polygon2d;
 pub mod resting_poses;
@@ -35,6 +38,7 @@ pub use equilibrium::{
     Equilibrium, EquilibriumOptions, SolveCache, Verdict, solve_equilibrium, solve_equilibrium_with,
 };
 pub use grasp::{GraspFace, GraspOptions, grasp_faces};
+pub use growing::{Accepted, GrowingStack, Rejection};
 pub use resting_poses::{RestingPose, resting_poses};
 pub use world::{PlacedPart, WorldPart, world_stack};
 

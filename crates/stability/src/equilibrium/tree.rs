@@ -174,8 +174,16 @@ pub(super) fn flat_minimum_norm(union: &Rigid, points: &[Point]) -> Option<Vec<D
 /// `sum s n_z f_k (y_k - c_y) = 0`, `sum s n_z f_k (x_k - c_x) = 0` (vertical forces have no other moment and no
 /// horizontal resultant, and no load acts). Least squares through the normal equations `(A A^T) y = b` (3 M
 /// unknowns, dense Gaussian elimination with partial pivoting), O(M^3 + M K).
-pub(super) fn vertical_certificate(bodies: &[Rigid], movers: &[usize], points: &[&Point]) -> Option<Vec<DVec3>> {
-    parallel_certificate(bodies, movers, points, DVec3::Z)
+///
+/// The points whose normal lies in the friction cone of the vertical (`|n_xy| <= mu |n_z|`, see
+/// [`super::hull_certificate`]) also take a vertical force: it lies in their cones too.
+pub(super) fn vertical_certificate(
+    bodies: &[Rigid],
+    movers: &[usize],
+    points: &[&Point],
+    mu: f64,
+) -> Option<Vec<DVec3>> {
+    certificate_with(bodies, movers, points, DVec3::Z, &|p| super::hull_certificate::admits_vertical_force(p, mu))
 }
 
 /// [`vertical_certificate`] under the tilted gravity `g = z - alpha d` of a horizontal load `alpha d` (`alpha` at
@@ -190,7 +198,17 @@ pub(super) fn parallel_certificate(
     points: &[&Point],
     gravity: DVec3,
 ) -> Option<Vec<DVec3>> {
-    let vertical = |p: &Point| p.frame[0].z.abs() >= 1.0 - 1e-12;
+    certificate_with(bodies, movers, points, gravity, &|p| p.frame[0].z.abs() >= 1.0 - 1e-12)
+}
+
+/// [`parallel_certificate`] with forces along `gravity` at the points `vertical` admits.
+fn certificate_with(
+    bodies: &[Rigid],
+    movers: &[usize],
+    points: &[&Point],
+    gravity: DVec3,
+    vertical: &dyn Fn(&Point) -> bool,
+) -> Option<Vec<DVec3>> {
     let g = gravity.normalize();
     let (e1, e2) = crate::contacts::plane_basis(g);
     let rows = 3 * movers.len();

@@ -2,7 +2,8 @@
 //! verdicts only.
 //!
 //! A group of movable parts is stable when *some* admissible force distribution exists. Vertical forces `f_k >= 0` at
-//! the contact points whose normal is vertical, and none at the others, are admissible (inside every friction cone).
+//! the contact points whose normal is vertical or lies in the friction cone of the vertical (`|n_xy| <= mu |n_z|`,
+//! [`super::hull_certificate`]), and none at the others, are admissible (inside every friction cone).
 //! [`super::tree::vertical_certificate`] tries the least-squares distribution of such forces (closed form); when that
 //! one has a negative force — common in staggered walls and offset stacks of blocks, whose supports form cycles —
 //! a nonnegative one may still exist. This module looks for it: the minimum-norm nonnegative vertical distribution,
@@ -32,8 +33,9 @@ pub(super) fn vertical_qp_certificate(
     bodies: &[Rigid],
     movers: &[usize],
     points: &[&Point],
+    mu: f64,
 ) -> Result<Option<Vec<DVec3>>, EquilibriumError> {
-    let vertical = |p: &Point| p.frame[0].z.abs() >= 1.0 - 1e-12;
+    let vertical = |p: &Point| super::hull_certificate::admits_vertical_force(p, mu);
     let (e1, e2) = crate::contacts::plane_basis(DVec3::Z);
     let rows = 3 * movers.len();
     let union = Rigid::union(movers.iter().map(|&i| bodies[i]));

@@ -1,0 +1,194 @@
+//! `GrowingStack::check_candidate` (the planner's per-candidate verdict) against `check_added_part`'s report: for
+//! every prefix `stack[..=i]` whose stack without its last part is stable (the precondition), the candidate fails at
+//! the first of stable, stack stable, graspable, insertable that the report fails, with the same verdict, or passes
+//! with the report's grasp radius bit for bit. Stacks: columns of every fixture part in its two lowest resting poses,
+//! nested and shifted; the planned 15-part Channel stack; staggered brick walls; random box columns with planks; the
+//! same candidate tested twice and on a stack grown in between (the memos), and tilted copies of a part (the grasp
+//! memo per rotation).
+
+mod common;
+
+use common::{at, box_layers, box_part, build, fixture_columns, placements, planned_channels};
+use glam::{DMat3, DVec3};
+use proptest::prelude::*;
+use stackplan_geom::io::{ReadOptions, read_part};
+use stackplan_stability::check::{CheckOptions, PartCheck, check_stack};
+use stackplan_stability::check_added_part;
+use stackplan_stability::equilibrium::Verdict;
+use stackplan_stability::growing::{Accepted, GrowingStack, Rejection};
+use stackplan_stability::world::PlacedPart;
+
+fn options(mu: f64, cup_diameter: f64) -> CheckOptions {
+    let mut o = CheckOptions { mu, margin_directions: 0, prefix_stability: false, ..CheckOptions::default() };
+    o.grasp.cup_diameter = cup_diameter;
+    o
+}
+
+/// What the planner reads of a full report, in its order.
+fn expected(report: &PartCheck) -> Result<f64, Rejection> {
+    if !report.stable.is_stable() {
+        Err(Rejection::NotStable(report.stable.clone()))
+    } else if !report.stack_stable.is_stable() {
+        Err(Rejection::StackNotStable(report.stack_stable.clone()))
+    } else if !report.graspable {
+        Err(Rejection::NotGraspable)
+    } else if let Some(o) = report.insertion_obstruction {
+        Err(Rejection::NotInsertable(o))
+    } else {
+        Ok(report.grasp_radius)
+    }
+}
+
+fn is_unknown(v: &Verdict) -> bool {
+    matches!(v, Verdict::Unknown(_))
+}
+
+/// Grows `stack` part by part, comparing every candidate whose precondition holds; returns how many were compared.
+fn compare_candidates(stack: &[PlacedPart<'_>], options: &CheckOptions, what: &str) -> usize {
+    let mut growing = GrowingStack::new(options).expect("options");
+    let mut compared = 0;
+    for (i, &candidate) in stack.iter().enumerate() {
+        let before_stable = i == 0 || check_stack(&stack[..i], options).expect("check").stack.verdict.is_stable();
+        if before_stable {
+            let report = check_added_part(&stack[..=i], options).expect("added");
+            let tested = growing.check_candidate(candidate).expect("candidate");
+            // the same candidate again: the memos answer the same
+            assert_eq!(growing.check_candidate(candidate).expect("candidate"), tested, "{what}, part {i}: repeated");
+            let unknown = is_unknown(&report.stable) || is_unknown(&report.stack_stable);
+            match (expected(&report), tested) {
+                (Ok(radius), Ok(Accepted { grasp_radius })) => {
+                    assert_eq!(grasp_radius.to_bits(), radius.to_bits(), "{what}, part {i}: grasp radius");
+                }
+                (want, got) => {
+                    // a certificate may resolve an Unknown of the solver (never seen in these stacks)
+                    assert!(
+                        unknown || want.as_ref().err() == got.as_ref().err(),
+                        "{what}, part {i}: {want:?} vs {got:?}"
+                    );
+                    assert!(!unknown, "{what}, part {i}: an Unknown verdict {report:?}");
+                }
+            }
+            compared += 1;
+        }
+        growing.push(candidate).expect("push");
+    }
+    assert_eq!(growing.len(), stack.len());
+    compared
+}
+
+#[test]
+fn candidates_fail_and_pass_like_the_added_part_report_on_fixture_columns() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/parts");
+    let mut files: Vec<_> = std::fs::read_dir(dir).expect("fixtures").flatten().map(|e| e.path()).collect();
+    files.sort();
+    let mut compared = 0;
+    for file in files.iter().filter(|f| f.extension().is_some_and(|e| e == "json")) {
+        let part = read_part(file, &ReadOptions::default()).expect("fixture part");
+        for pose in 0..2 {
+            for (dx, dy) in [(0.0, 0.0), (7.0, -3.0), (40.0, 0.0)] {
+                let stack = fixture_columns(&part, pose, dx, dy);
+                for (mu, cup) in [(0.4, 5.0), (0.8, 10.0), (0.5, 400.0)] {
+                    let what = format!("{} pose {pose} shift ({dx}, {dy}) mu {mu} cup {cup}", file.display());
+                    compared += compare_candidates(&stack, &options(mu, cup), &what);
+                }
+            }
+        }
+    }
+    assert!(compared >= 150, "only {compared} candidates compared");
+}
+
+#[test]
+fn candidates_fail_and_pass_like_the_added_part_report_on_the_planned_channel_stack() {
+    let plan = planned_channels();
+    let stack = placements(&plan);
+    for mu in [0.5, 0.1] {
+        let compared = compare_candidates(&stack, &options(mu, 10.0), "planned channels");
+        assert!(compared >= 2);
+    }
+}
+
+#[test]
+fn candidates_fail_and_pass_like_the_added_part_report_on_brick_walls() {
+    let brick = box_part("brick", DVec3::new(40.0, 20.0, 10.0));
+    let mut compared = 0;
+    for (offset, overhang) in [(20.0, 0.0), (10.0, 0.0), (20.0, 35.0), (5.0, 90.0)] {
+        let mut positions = Vec::new();
+        for r in 0..4 {
+            let shift = if r % 2 == 1 { offset } else { 0.0 } + if r == 3 { overhang } else { 0.0 };
+            for k in 0..4 {
+                positions.push(DVec3::new(40.0 * k as f64 + shift, 0.0, 10.0 * r as f64));
+            }
+        }
+        let stack: Vec<PlacedPart<'_>> = positions.iter().map(|&p| at(&brick, p)).collect();
+        compared += compare_candidates(&stack, &options(0.5, 10.0), &format!("wall {offset} {overhang}"));
+    }
+    assert!(compared >= 40, "only {compared} candidates compared");
+}
+
+/// Copies of a part at the same rotation and other positions share the grasp memo; a tilted copy (no upward face
+/// for a large cup) and a cup just below and just above the largest radius are decided like the full report.
+#[test]
+fn the_grasp_memo_decides_like_the_grasp_at_each_pose() {
+    let plank = box_part("plank", DVec3::new(60.0, 30.0, 5.0));
+    let on_floor = |x: f64| at(&plank, DVec3::new(x, 0.0, 0.0));
+    // the largest inscribed radius of the 60 x 30 top face is 15
+    for cup in [29.0, 30.0 - 1e-9, 30.0, 30.0 + 1e-9, 31.0] {
+        let o = options(0.5, cup);
+        let mut growing = GrowingStack::new(&o).expect("options");
+        let mut stack = Vec::new();
+        for k in 0..4 {
+            let candidate = on_floor(100.0 * k as f64 + 0.1 * k as f64);
+            stack.push(candidate);
+            let report = check_added_part(&stack, &o).expect("added");
+            let tested = growing.check_candidate(candidate).expect("candidate");
+            assert_eq!(tested.map(|a| a.grasp_radius.to_bits()), expected(&report).map(f64::to_bits), "cup {cup}");
+            growing.push(candidate).expect("push");
+        }
+    }
+    // tipped on its side: the top face is 60 x 5
+    let side = PlacedPart {
+        part: &plank,
+        rotation: DMat3::from_rotation_x(std::f64::consts::FRAC_PI_2),
+        position: DVec3::new(0.0, 5.0, 0.0),
+    };
+    let o = options(0.5, 10.0);
+    let report = check_added_part(&[side], &o).expect("added");
+    assert!(!report.graspable);
+    let mut growing = GrowingStack::new(&o).expect("options");
+    assert_eq!(growing.check_candidate(side).expect("candidate"), Err(Rejection::NotGraspable));
+    let moved = PlacedPart { position: side.position + DVec3::new(3.0, 0.0, 0.0), ..side };
+    assert_eq!(growing.check_candidate(moved).expect("candidate"), Err(Rejection::NotGraspable));
+}
+
+#[test]
+fn options_a_growing_stack_cannot_honour_are_errors() {
+    let mut o = options(0.5, 10.0);
+    o.release_drops = vec![1.0];
+    assert!(GrowingStack::new(&o).is_err());
+    let mut o = options(0.5, 10.0);
+    o.grasp.cup_diameter = f64::NAN;
+    assert!(GrowingStack::new(&o).is_err());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: std::env::var("PROPTEST_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(16), ..ProptestConfig::default() })]
+
+    /// Random box columns (two or three, placed layer by layer) with an optional plank bridging them on top.
+    #[test]
+    fn candidates_fail_and_pass_like_the_added_part_report_on_random_box_stacks(
+        columns in 2usize..=3,
+        layers in box_layers(10.0f64..30.0, 15.0, 30.0f64..70.0),
+        bridge in prop::option::of((-30.0f64..30.0, 5.0f64..20.0)),
+        mu in 0.1f64..1.0,
+    ) {
+        let mut boxes: Vec<(DVec3, DVec3)> = build(&layers, columns).into_iter().map(|(_, lo, size)| (lo, size)).collect();
+        let z = boxes.iter().map(|(lo, size)| lo.z + size.z).fold(0.0, f64::max);
+        if let Some((dx, thickness)) = bridge {
+            let length = 200.0 * (columns - 1) as f64 + 40.0;
+            boxes.push((DVec3::new(dx - 20.0, -10.0, z), DVec3::new(length, 20.0, thickness)));
+        }
+        let parts: Vec<stackplan_geom::Part> = boxes.iter().map(|(_, size)| box_part("box", *size)).collect();
+        let stack: Vec<PlacedPart<'_>> = parts.iter().zip(&boxes).map(|(p, (lo, _))| at(p, *lo)).collect();
+        compare_candidates(&stack, &options(mu, 10.0), "random boxes");
+    }
+}
