@@ -228,6 +228,17 @@ struct Family<const D: usize> {
     children: Vec<(f64, u64, u32)>,
 }
 
+/// The state of the search's loop between calls ([`Search::advance`]): the open nodes, the next node id, the
+/// orientations expanded so far, the placements found so far (orientation, position) and the pops so far.
+struct RunState<const D: usize> {
+    fixed_z: f64,
+    heap: NodeHeap<D>,
+    next_id: u64,
+    considered: Vec<bool>,
+    found_points: Vec<(usize, DVec3)>,
+    pops: u64,
+}
+
 /// A popped entry: a solved node, or the next child of a family (its id and face; the family by index into
 /// [`NodeHeap::families`]).
 enum Popped<const D: usize> {
@@ -524,13 +535,15 @@ impl SearchCaches {
 
 /// [`place_with_cache`] sharing `caches` with earlier searches (see [`SearchCaches`]); the stacking planner passes
 /// the same caches to every search of a plan.
-pub fn place_with_caches(
-    request: &PlacementRequest<'_>,
-    cache: &ObstacleCache,
+/// The search's setup: validation, orientations (one symmetry period per resting pose), the scene, the
+/// statistics' constants, and the shared caches adopted (their contents move into the search until
+/// [`Search::give_back`]).
+fn prepare<'r, 'a>(
+    request: &'r PlacementRequest<'a>,
+    cache: &'r ObstacleCache,
     caches: &mut SearchCaches,
-) -> Result<PlacementResult, PlacementError> {
+) -> Result<Search<'r, 'a>, PlacementError> {
     request.validate()?;
-    let start = Instant::now();
     let part = request.part;
     let scale = request
         .stack
@@ -596,7 +609,7 @@ pub fn place_with_caches(
             list.push((moving, fixed));
         }
     }
-    let mut search = Search {
+    let search = Search {
         request,
         orientations,
         sweeps,
@@ -612,6 +625,16 @@ pub fn place_with_caches(
         intervals: std::mem::take(&mut caches.intervals),
         stats,
     };
+    Ok(search)
+}
+
+pub fn place_with_caches(
+    request: &PlacementRequest<'_>,
+    cache: &ObstacleCache,
+    caches: &mut SearchCaches,
+) -> Result<PlacementResult, PlacementError> {
+    let start = Instant::now();
+    let mut search = prepare(request, cache, caches)?;
     let before = cache.stats();
     search.stats.time_setup_ms = ms(start);
     let result = match request.fixed_z {
@@ -619,9 +642,7 @@ pub fn place_with_caches(
         Some(z) => search.run::<2>(z),
     };
     let after = cache.stats();
-    caches.axes = std::mem::take(&mut search.axes);
-    caches.derived = std::mem::take(&mut search.derived);
-    caches.intervals = std::mem::take(&mut search.intervals);
+    search.give_back(caches);
     let mut result = result?;
     result.stats.obstacles_constructed = after.constructions - before.constructions;
     result.stats.obstacle_cache_hits = after.hits - before.hits;
@@ -637,11 +658,119 @@ pub fn place_with_caches(
     Ok(result)
 }
 
+/// The search's state in 2 or 3 variables.
+enum States {
+    Two(RunState<2>),
+    Three(RunState<3>),
+}
+
+/// A placement search that can be continued: the same search as [`place_with_caches`], whose heap (and every other
+/// part of its state) is kept between calls of [`PlacementSearch::next_placements`], so asking for `a` placements
+/// and then for `b` more gives the same placements, in the same order and with the same values, as one search with
+/// `k = a + b` (the request's `k` is not used). The stacking planner, which asks for more candidates when all of the
+/// first ones fail its stability checks, continues instead of starting again with a larger `k`.
+///
+/// The shared caches are held until the search is dropped (then handed back, as [`place_with_caches`] does).
+///
+/// ```ignore
+/// let mut search = PlacementSearch::new(&request, &cache, &mut caches)?;
+/// let first = search.next_placements(8)?; // the 8 best
+/// let more = search.next_placements(24)?; // the next 24: as places 9..32 of a search with k = 32
+/// ```
+pub struct PlacementSearch<'r, 'a, 'c> {
+    search: Search<'r, 'a>,
+    caches: &'c mut SearchCaches,
+    /// `None`: Omega is empty at every orientation.
+    state: Option<States>,
+    cache: &'r ObstacleCache,
+    before: stackplan_cspace::cache::CacheStats,
+    /// Time spent in the calls so far (ms).
+    elapsed_ms: f64,
+}
+
+impl std::fmt::Debug for PlacementSearch<'_, '_, '_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PlacementSearch")
+            .field("empty_omega", &self.state.is_none())
+            .field("stats", &self.search.stats)
+            .finish_non_exhaustive()
+    }
+}
+
+impl<'r, 'a, 'c> PlacementSearch<'r, 'a, 'c> {
+    /// Prepares the search and solves the roots (the setup and root phases of [`place_with_caches`]).
+    pub fn new(
+        request: &'r PlacementRequest<'a>,
+        cache: &'r ObstacleCache,
+        caches: &'c mut SearchCaches,
+    ) -> Result<Self, PlacementError> {
+        let start = Instant::now();
+        let before = cache.stats();
+        let mut search = prepare(request, cache, caches)?;
+        search.stats.time_setup_ms = ms(start);
+        let state = match request.fixed_z {
+            None => search.start::<3>(0.0).map(|s| s.map(States::Three)),
+            Some(z) => search.start::<2>(z).map(|s| s.map(States::Two)),
+        };
+        let state = match state {
+            Ok(state) => state,
+            Err(e) => {
+                search.give_back(caches);
+                return Err(e);
+            }
+        };
+        Ok(Self { search, caches, state, cache, before, elapsed_ms: ms(start) })
+    }
+
+    /// The next `more` placements (fewer, with `exhausted` set, when the free space runs out); statistics over the
+    /// whole search so far.
+    pub fn next_placements(&mut self, more: usize) -> Result<PlacementResult, PlacementError> {
+        let start = Instant::now();
+        let placements = match &mut self.state {
+            None => {
+                return Ok(PlacementResult {
+                    placements: Vec::new(),
+                    exhausted: (more > 0).then_some(NoPlacement::EmptyOmega),
+                    stats: self.stats(),
+                });
+            }
+            Some(States::Two(state)) => self.search.advance(state, more)?,
+            Some(States::Three(state)) => self.search.advance(state, more)?,
+        };
+        self.elapsed_ms += ms(start);
+        let exhausted = (placements.len() < more).then_some(NoPlacement::FitsNowhere);
+        Ok(PlacementResult { placements, exhausted, stats: self.stats() })
+    }
+
+    /// The statistics of the search so far.
+    pub fn stats(&self) -> PlacementStats {
+        let mut stats = self.search.stats.clone();
+        let after = self.cache.stats();
+        stats.obstacles_constructed = after.constructions - self.before.constructions;
+        stats.obstacle_cache_hits = after.hits - self.before.hits;
+        stats.time_total_ms = self.elapsed_ms;
+        stats
+    }
+}
+
+impl Drop for PlacementSearch<'_, '_, '_> {
+    fn drop(&mut self) {
+        self.search.give_back(self.caches);
+    }
+}
+
 fn ms(since: Instant) -> f64 {
     since.elapsed().as_secs_f64() * 1e3
 }
 
 impl Search<'_, '_> {
+    /// Moves the shared caches' contents back into `caches`.
+    fn give_back(&mut self, caches: &mut SearchCaches) {
+        caches.axes = std::mem::take(&mut self.axes);
+        caches.derived = std::mem::take(&mut self.derived);
+        caches.intervals = std::mem::take(&mut self.intervals);
+    }
+
     fn root_cell<const D: usize>(&self, o: &Orientation, fixed_z: f64) -> Result<Option<Cell<D>>, PlacementError> {
         let fs_err = |e: stackplan_freespace::cell::CellError| PlacementError::FreeSpace {
             orientation: o.index,
@@ -667,6 +796,21 @@ impl Search<'_, '_> {
     }
 
     fn run<const D: usize>(&mut self, fixed_z: f64) -> Result<PlacementResult, PlacementError> {
+        let Some(mut state) = self.start::<D>(fixed_z)? else {
+            return Ok(PlacementResult {
+                placements: Vec::new(),
+                exhausted: Some(NoPlacement::EmptyOmega),
+                stats: self.stats.clone(),
+            });
+        };
+        let placements = self.advance(&mut state, self.request.k)?;
+        let exhausted = (placements.len() < self.request.k).then_some(NoPlacement::FitsNowhere);
+        Ok(PlacementResult { placements, exhausted, stats: self.stats.clone() })
+    }
+
+    /// The roots (one QP per orientation, in parallel) and the search's state; `None` when Omega is empty at every
+    /// orientation.
+    fn start<const D: usize>(&mut self, fixed_z: f64) -> Result<Option<RunState<D>>, PlacementError> {
         let t_roots = Instant::now();
         // roots in parallel, collected in orientation order; Omega's normals are those of the floor's sides and
         // (3-D) of the floor and the ceiling at every orientation, only the offsets change, so the first non-empty
@@ -713,22 +857,38 @@ impl Search<'_, '_> {
         self.stats.nodes_pushed = heap.len() as u64;
         self.stats.time_roots_ms = ms(t_roots);
         if heap.is_empty() {
-            return Ok(PlacementResult {
-                placements: Vec::new(),
-                exhausted: Some(NoPlacement::EmptyOmega),
-                stats: self.stats.clone(),
-            });
+            return Ok(None);
         }
-        let mut considered = vec![false; self.orientations.len()];
+        Ok(Some(RunState {
+            fixed_z,
+            heap,
+            next_id,
+            considered: vec![false; self.orientations.len()],
+            found_points: Vec::new(),
+            pops: 0,
+        }))
+    }
+
+    /// Continues the search from `state` until `want` more placements are found or the free space is exhausted
+    /// (fewer returned); the loop of the module documentation. Stopping after the `want`-th and calling again
+    /// continues exactly where one call with the sum of the `want`s would have been: the state is the whole loop's.
+    fn advance<const D: usize>(
+        &mut self,
+        state: &mut RunState<D>,
+        want: usize,
+    ) -> Result<Vec<Placement>, PlacementError> {
+        let RunState { fixed_z, heap, next_id, considered, found_points, pops } = state;
+        let fixed_z = *fixed_z;
         let mut placements: Vec<Placement> = Vec::new();
-        let mut found_points: Vec<(usize, DVec3)> = Vec::new();
+        if want == 0 {
+            return Ok(placements);
+        }
         let clearance = self.request.clearance;
         let tol = self.tol.linear;
-        let mut pops: u64 = 0;
         while let Some(popped) = heap.pop() {
-            pops += 1;
-            if pops > self.request.node_budget as u64 {
-                return Err(PlacementError::NodeBudget { budget: self.request.node_budget, found: placements.len() });
+            *pops += 1;
+            if *pops > self.request.node_budget as u64 {
+                return Err(PlacementError::NodeBudget { budget: self.request.node_budget, found: found_points.len() });
             }
             let node = match popped {
                 Popped::Pending { family, id, face } => {
@@ -841,7 +1001,7 @@ impl Search<'_, '_> {
                 if !dup {
                     found_points.push((node.orientation, p));
                     placements.push(self.placement(&node.cell, optimum, node.orientation, p));
-                    if placements.len() >= self.request.k {
+                    if placements.len() >= want {
                         break;
                     }
                 }
@@ -874,15 +1034,14 @@ impl Search<'_, '_> {
                     2.0 * tol,
                     tol,
                 ));
-                family.children.push((node.cost.max(bound), next_id, face));
-                next_id += 1;
+                family.children.push((node.cost.max(bound), *next_id, face));
+                *next_id += 1;
             }
             heap.push_family(family);
             self.stats.time_cells_ms += ms(t_cells);
         }
         self.stats.orientations_considered = considered.iter().filter(|c| **c).count();
-        let exhausted = (placements.len() < self.request.k).then_some(NoPlacement::FitsNowhere);
-        Ok(PlacementResult { placements, exhausted, stats: self.stats.clone() })
+        Ok(placements)
     }
 
     /// The id of the derived obstacle of a pair at an orientation, building it on first use.

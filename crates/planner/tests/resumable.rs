@@ -1,0 +1,69 @@
+//! The resumable search ([`PlacementSearch`]): asking for placements in several calls gives the placements of one
+//! search with the summed `k`, in the same order, with the same values and the same counters; the shared caches are
+//! handed back when it is dropped.
+
+use stackplan_cspace::ObstacleCache;
+use stackplan_planner::regress::{Scenario, scenario};
+use stackplan_planner::search::{PlacementSearch, SearchCaches, place_with_caches};
+use stackplan_planner::{Cost, PlacementRequest, StackPart, uniform_thetas};
+
+fn request<'a>(sc: &'a Scenario, k: usize) -> PlacementRequest<'a> {
+    let stack: Vec<StackPart<'a>> = sc.stack.iter().map(|p| StackPart { part: &sc.part, pose: *p }).collect();
+    let mut req = PlacementRequest::new(&sc.part, stack, sc.floor.clone());
+    req.resting_rotations = vec![sc.rest];
+    req.thetas = uniform_thetas(360);
+    req.cost = Cost::Target { target: sc.target };
+    req.fixed_z = sc.fixed_z;
+    req.k = k;
+    req
+}
+
+fn check(name: &str, chunks: &[usize]) {
+    let sc = scenario(name).expect("scenario").expect("known scenario");
+    let total: usize = chunks.iter().sum();
+    let whole =
+        place_with_caches(&request(&sc, total), &ObstacleCache::new(), &mut SearchCaches::new()).expect("one search");
+    assert!(whole.placements.len() > chunks[0], "{name}: too few placements to compare");
+    let req = request(&sc, 1);
+    let cache = ObstacleCache::new();
+    let mut caches = SearchCaches::new();
+    let mut got = Vec::new();
+    let mut last = None;
+    {
+        let mut search = PlacementSearch::new(&req, &cache, &mut caches).expect("prepared");
+        for &more in chunks {
+            let part = search.next_placements(more).expect("continued");
+            assert!(part.placements.len() <= more);
+            if part.placements.len() < more {
+                assert!(part.exhausted.is_some(), "{name}: fewer than asked without a reason");
+            }
+            got.extend(part.placements.iter().cloned());
+            last = Some(part);
+        }
+    }
+    assert_eq!(got, whole.placements, "{name}: chunks {chunks:?}");
+    let (a, b) = (last.expect("one call").stats, whole.stats);
+    assert_eq!(
+        (a.nodes_expanded, a.nodes_pushed, a.qp_solves, a.cells_empty, a.pairs_evaluated, a.interference_tests),
+        (b.nodes_expanded, b.nodes_pushed, b.qp_solves, b.cells_empty, b.pairs_evaluated, b.interference_tests),
+        "{name}: counters"
+    );
+    assert_eq!(a.orientations_considered, b.orientations_considered);
+    // the caches came back: a following search with them answers as a fresh one
+    let again = place_with_caches(&request(&sc, 2), &cache, &mut caches).expect("after");
+    let fresh = place_with_caches(&request(&sc, 2), &ObstacleCache::new(), &mut SearchCaches::new()).expect("fresh");
+    assert_eq!(again.placements.len(), fresh.placements.len());
+    for (x, y) in again.placements.iter().zip(&fresh.placements) {
+        assert!((x.cost - y.cost).abs() <= 1e-9 * (1.0 + y.cost.abs()), "{name}: {} vs {}", x.cost, y.cost);
+    }
+}
+
+#[test]
+fn continued_triangle_search_equals_one_search() {
+    check("triangle", &[1, 3, 0, 5]);
+}
+
+#[test]
+fn continued_complex_search_equals_one_search() {
+    check("complex", &[2, 4]);
+}
