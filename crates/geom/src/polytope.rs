@@ -278,6 +278,42 @@ impl ConvexPolytope {
         Ok(Self { vertices, faces, edges, face_edges })
     }
 
+    /// [`Self::from_faces_with_area`] with the edge table built by the caller: `edges` in the order the edge table of
+    /// [`Self::new`] gives them (increasing (smaller vertex, larger vertex); `vertices[0] < vertices[1]`, `faces[0]` the
+    /// face traversing the edge from the smaller to the larger vertex) and `face_edges` the edge of every face's
+    /// half-edges in face order (`face_edges[start(f) + k]` joins corner `k` and `k + 1` of face `f`, where `start(f)`
+    /// is the total length of the faces before `f`): for constructions that know their edges, such as the Gauss-map
+    /// Minkowski sums of `stackplan-cspace`. O(V + F); the vertices' finiteness and count are checked as in
+    /// [`Self::new`]; the table itself is trusted, and checked against the one [`Self::new`] would build only in debug
+    /// builds. When `face_edges` does not have one entry per half-edge, the table is built here (same checks as
+    /// [`Self::from_faces_with_area`]).
+    pub fn from_faces_and_edges(
+        vertices: Vec<DVec3>,
+        faces: Vec<Face>,
+        edges: Vec<Edge>,
+        face_edges: Vec<usize>,
+    ) -> Result<Self, PolytopeError> {
+        let mut starts = Vec::with_capacity(faces.len() + 1);
+        let mut total = 0;
+        starts.push(0);
+        for face in &faces {
+            total += face.vertices.len();
+            starts.push(total);
+        }
+        if face_edges.len() != total {
+            return Self::from_faces_with_area(vertices, faces);
+        }
+        check_vertices(&vertices)?;
+        let face_edges = FaceEdgeTable { edges: face_edges, starts };
+        #[cfg(debug_assertions)]
+        {
+            let built = edge_table(vertices.len(), &faces, |f| f.vertices.as_slice());
+            let same = matches!(&built, Ok((e, t)) if *e == edges && *t == face_edges);
+            debug_assert!(same, "the caller's edge table differs from the one geom builds: {built:?}");
+        }
+        Ok(Self { vertices, faces, edges, face_edges })
+    }
+
     /// The same topology (faces, edges) with new vertex coordinates and face planes, in O(V + F) without any
     /// search: for computed polytopes whose structure is known to be unchanged (e.g. c-space obstacles extrapolated
     /// within a constant-topology interval). `None` when the lengths do not match this polytope's.
