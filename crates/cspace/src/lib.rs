@@ -11,6 +11,7 @@
 //! * [`cache`]: an obstacle cache with construction/hit counters.
 
 pub mod cache;
+mod edge_table;
 pub mod interference;
 pub mod minkowski;
 pub mod offset;

@@ -40,12 +40,14 @@
 //! above rounding noise and merging faces closer than it moves vertices by less than `1e-9 * size`, inside the
 //! policy's length tolerance. Rotations about `z` keep `z` components exact, so horizontal faces merge exactly.
 //!
-//! The result is assembled into a [`ConvexPolytope`] whose construction checks that every edge is shared by exactly two
-//! consistently oriented faces; Euler's formula is checked too. If the overlay was inconsistent (only possible for input
+//! The result is assembled into a [`ConvexPolytope`] with an edge table that is checked while it is built (every edge
+//! shared by exactly two consistently oriented faces; `edge_table.rs`, exactly geom's table); Euler's formula is
+//! checked too. If the overlay was inconsistent (only possible for input
 //! within the tolerance of a degenerate configuration, not at one) the obstacle is built by the exact-predicate hull of
 //! the `nA * nB` difference points instead ([`obstacle_by_hull`]), and the route is recorded in [`Obstacle::route`].
 //!
-//! Complexity: O(FA FB + EA EB + (FA + FB)(EA + EB) + output); the pair loops are a few flops each, which for the
+//! Complexity: O(FA FB + EA EB + (FA + FB)(EA + EB) + output); with at most 64 arcs of `B` the arc crossings are
+//! found as bit sets, O(EA (FB + crossings)) instead of O(EA EB); the pair loops are a few flops each, which for the
 //! small components of sheet-metal parts beats the O(nA + nB + output) sweep of a true overlay (CGAL's
 //! `Gaussian_map`); each merged face costs O(|F| + |G|). The face count is at most `4 m n - 9 m - 9 n + 26` for `m`
 //! and `n` facets.
@@ -55,6 +57,8 @@ use serde::{Deserialize, Serialize};
 use stackplan_geom::polytope::{Containment, ConvexPolytope, Face, Plane, PolytopeError};
 use stackplan_geom::tolerance::{RELATIVE, Tolerance};
 use stackplan_geom::{HullError, convex_hull};
+
+use crate::edge_table::{self, EdgeScratch};
 
 /// Angular tolerance (radians) of the Gauss-map decisions: a face normal within this of an arc's circle lies on it;
 /// two face normals within half of it are the same direction.
@@ -446,10 +450,14 @@ struct Scratch {
     s_ba: Vec<i8>,
     merged_with_b: Vec<Option<usize>>,
     merged_with_a: Vec<Option<usize>>,
+    /// `from_mask[g]` / `to_mask[g]`: the B arcs (at most 64) starting / ending at B's face `g`, as bits.
+    from_mask: Vec<u64>,
+    to_mask: Vec<u64>,
     specs: Vec<FaceSpec>,
     index_of: Vec<u32>,
     cycle: Vec<[usize; 2]>,
     planar: PlanarScratch,
+    edges: EdgeScratch,
 }
 
 thread_local! {
@@ -490,10 +498,13 @@ fn overlay(
         s_ba,
         merged_with_b,
         merged_with_a,
+        from_mask,
+        to_mask,
         specs: faces,
         index_of,
         cycle,
         planar,
+        edges,
     } = scratch;
     ra.clear();
     ra.extend(moving.vertices().iter().map(|a| rotation * *a));
@@ -571,30 +582,83 @@ fn overlay(
         };
         faces.push(FaceSpec { normal: u, fixed: fixed_feature, moving: Feature::Face(f) });
     }
-    // 3. proper arc crossings
+    // 3. proper arc crossings, in (A arc, B arc) order. The B arcs whose end normals lie strictly on opposite sides of
+    // an A arc's circle: all B arcs tested one by one, or (at most 64 B arcs) as bit sets: with `from_mask[g]` /
+    // `to_mask[g]` the B arcs starting / ending at B's face g, the arcs from a face on the positive side to one on the
+    // negative side are `(OR of from_mask over positive g) & (OR of to_mask over negative g)`, and vice versa; the
+    // same pairs as the one-by-one test (the same signs), visited in the same order.
+    let small = b_arcs.len() <= 64 && !one_by_one_crossings();
+    if small {
+        from_mask.clear();
+        from_mask.resize(fb, 0);
+        to_mask.clear();
+        to_mask.resize(fb, 0);
+        for (eb, b_arc) in b_arcs.iter().enumerate() {
+            from_mask[b_arc.from] |= 1 << eb;
+            to_mask[b_arc.to] |= 1 << eb;
+        }
+    }
     for (ea, a_arc) in a_arcs.iter().enumerate() {
         let row = &s_ab[ea * fb..(ea + 1) * fb];
-        for (eb, b_arc) in b_arcs.iter().enumerate() {
-            let (sb0, sb1) = (row[b_arc.from], row[b_arc.to]);
-            if sb0 == 0 || sb0 != -sb1 {
-                continue;
-            }
+        let mut crossing = |eb: usize, b_arc: &Arc| {
             let (sa0, sa1) = (s_ba[eb * fa + a_arc.from], s_ba[eb * fa + a_arc.to]);
             if sa0 == 0 || sa0 != -sa1 {
-                continue;
+                return;
             }
             let mut x = a_arc.circle.cross(b_arc.circle);
             if x.dot(am[a_arc.from] + am[a_arc.to]) < 0.0 {
                 x = -x;
             }
             if x.dot(bn[b_arc.from] + bn[b_arc.to]) <= 0.0 {
-                continue;
+                return;
             }
             faces.push(FaceSpec { normal: x.normalize(), fixed: Feature::Edge(eb), moving: Feature::Edge(ea) });
+        };
+        if small {
+            let (mut from_pos, mut from_neg, mut to_pos, mut to_neg) = (0u64, 0u64, 0u64, 0u64);
+            for ((&sign, &from), &to) in row.iter().zip(from_mask.iter()).zip(to_mask.iter()) {
+                // all ones where the sign is +1 (resp. -1), else zero
+                let (pos, neg) = (0u64.wrapping_sub(u64::from(sign == 1)), 0u64.wrapping_sub(u64::from(sign == -1)));
+                from_pos |= from & pos;
+                from_neg |= from & neg;
+                to_pos |= to & pos;
+                to_neg |= to & neg;
+            }
+            let mut candidates = (from_pos & to_neg) | (from_neg & to_pos);
+            while candidates != 0 {
+                let eb = candidates.trailing_zeros() as usize;
+                candidates &= candidates - 1;
+                crossing(eb, &b_arcs[eb]);
+            }
+        } else {
+            for (eb, b_arc) in b_arcs.iter().enumerate() {
+                let (sb0, sb1) = (row[b_arc.from], row[b_arc.to]);
+                if sb0 == 0 || sb0 != -sb1 {
+                    continue;
+                }
+                crossing(eb, b_arc);
+            }
         }
     }
-    let buffers = AssemblyBuffers { index_of, cycle, planar, merged_with_b, neg_ra };
+    let buffers = AssemblyBuffers { index_of, cycle, planar, merged_with_b, neg_ra, edges };
     assemble(moving, fixed, rotation, ra, a_arcs, b_arcs, faces, buffers)
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Tests: take the one-by-one crossing test even for at most 64 B arcs.
+    static ONE_BY_ONE_CROSSINGS: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+#[cfg(test)]
+fn one_by_one_crossings() -> bool {
+    ONE_BY_ONE_CROSSINGS.with(std::cell::Cell::get)
+}
+
+#[cfg(not(test))]
+#[inline]
+fn one_by_one_crossings() -> bool {
+    false
 }
 
 struct FaceSpec {
@@ -713,6 +777,8 @@ struct AssemblyBuffers<'a> {
     merged_with_b: &'a [Option<usize>],
     /// The vertices of `-RA`.
     neg_ra: &'a [DVec3],
+    /// The edge table's buffers.
+    edges: &'a mut EdgeScratch,
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -726,7 +792,7 @@ fn assemble(
     specs: &[FaceSpec],
     buffers: AssemblyBuffers<'_>,
 ) -> Result<Obstacle, OverlayFailure> {
-    let AssemblyBuffers { index_of, cycle, planar: scratch, merged_with_b, neg_ra } = buffers;
+    let AssemblyBuffers { index_of, cycle, planar: scratch, merged_with_b, neg_ra, edges: edge_scratch } = buffers;
     let bv = fixed.vertices();
     let nb = bv.len();
     index_of.clear();
@@ -735,6 +801,7 @@ fn assemble(
     let mut vertex_pairs: Vec<[usize; 2]> = Vec::with_capacity(specs.len() * 2);
     let mut faces: Vec<Face> = Vec::with_capacity(specs.len());
     let mut kinds: Vec<FaceKind> = Vec::with_capacity(specs.len());
+    edge_scratch.clear();
     for spec in specs {
         cycle.clear();
         match (spec.fixed, spec.moving) {
@@ -787,8 +854,10 @@ fn assemble(
                 *slot = vertices.len() as u32;
                 vertices.push(bv[j] - ra[i]);
                 vertex_pairs.push([i, j]);
+                edge_scratch.vertex();
             }
             let v = *slot as usize;
+            edge_scratch.corner(v, faces.len());
             offset = offset.max(spec.normal.dot(vertices[v]));
             face.push(v);
         }
@@ -797,8 +866,13 @@ fn assemble(
     }
     let (v, f) = (vertices.len(), faces.len());
     // every face has a positive area by construction (a translated face of `A` or `B`, a sum containing one, or a
-    // parallelogram of two edges that cross properly, i.e. are not parallel): only the edge table is checked
-    let polytope = ConvexPolytope::from_faces_with_area(vertices, faces).map_err(OverlayFailure::Assembly)?;
+    // parallelogram of two edges that cross properly, i.e. are not parallel): only the edge table is checked. It is
+    // built from the faces in the reused buffers; when it does not exist, geom's own table reports the same error.
+    let polytope = match edge_table::build(v, &faces, edge_scratch) {
+        Some((edges, face_edges)) => ConvexPolytope::from_faces_and_edges(vertices, faces, edges, face_edges),
+        None => ConvexPolytope::from_faces_with_area(vertices, faces),
+    }
+    .map_err(OverlayFailure::Assembly)?;
     if v + f != polytope.edges().len() + 2 {
         return Err(OverlayFailure::Euler);
     }
@@ -1056,6 +1130,52 @@ mod tests {
             }
         }
         assert!(cases > 500);
+    }
+
+    #[test]
+    fn crossing_bit_sets_equal_the_one_by_one_test() {
+        // pairs with edge-edge faces (general rotations, point clouds) and without (boxes and prisms about z)
+        let cloud = |n: usize, seed: f64| {
+            let pts: Vec<DVec3> = (0..n)
+                .map(|k| {
+                    let t = k as f64 * 2.399 + seed;
+                    let z = 1.0 - 2.0 * (k as f64 + 0.5) / n as f64;
+                    let r = (1.0 - z * z).sqrt();
+                    DVec3::new(r * t.cos() * 3.0, r * t.sin() * 2.0, z)
+                })
+                .collect();
+            convex_hull(&pts).expect("hull").polytope
+        };
+        let shapes = [
+            cuboid(DVec3::ZERO, DVec3::new(1.0, 2.0, 3.0)),
+            cuboid(DVec3::new(-1.0, 0.5, 0.0), DVec3::new(4.0, 5.0, 0.5)),
+            cloud(8, 0.0),
+            cloud(14, 0.3),
+            cloud(24, 0.7),
+        ];
+        let rotations = [
+            DMat3::IDENTITY,
+            DMat3::from_rotation_z(0.3),
+            DMat3::from_rotation_x(std::f64::consts::FRAC_PI_2),
+            DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7),
+            DMat3::from_axis_angle(DVec3::new(-0.3, 0.2, 1.0).normalize(), 2.1),
+        ];
+        let mut edge_edge = 0;
+        for a in &shapes {
+            for b in &shapes {
+                for r in rotations {
+                    let bits = gauss_map_obstacle(a, r, b);
+                    ONE_BY_ONE_CROSSINGS.with(|c| c.set(true));
+                    let one_by_one = gauss_map_obstacle(a, r, b);
+                    ONE_BY_ONE_CROSSINGS.with(|c| c.set(false));
+                    assert_eq!(format!("{bits:?}"), format!("{one_by_one:?}"));
+                    if let Ok(o) = bits {
+                        edge_edge += o.face_kinds().iter().filter(|k| matches!(k, FaceKind::EdgeEdge { .. })).count();
+                    }
+                }
+            }
+        }
+        assert!(edge_edge > 100, "{edge_edge} edge-edge faces");
     }
 
     #[test]
