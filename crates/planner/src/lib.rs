@@ -33,7 +33,7 @@ pub mod symmetry;
 
 pub use request::{Cost, FloorVolume, PlacementError, PlacementRequest, StackPart, thetas_with_step, uniform_thetas};
 pub use search::{
-    Contact, NoPlacement, Placement, PlacementResult, PlacementStats, SearchCaches, place, place_with_cache,
-    place_with_caches,
+    Contact, NoPlacement, Placement, PlacementResult, PlacementSearch, PlacementStats, SearchCaches, place,
+    place_with_cache, place_with_caches,
 };
 pub use stack_plan::{Plan, PlanError, PlanOptions, PlannedPart, plan_stack};

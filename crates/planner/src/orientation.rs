@@ -132,7 +132,7 @@ impl Orientation {
     }
 
     /// `max_v d . (R v)` over the rotated vertices.
-    fn support(&self, d: DVec3) -> f64 {
+    pub(crate) fn support(&self, d: DVec3) -> f64 {
         self.vertices.iter().map(|v| d.dot(*v)).fold(f64::NEG_INFINITY, f64::max)
     }
 

@@ -51,7 +51,7 @@ use crate::interval_obstacles::{IntervalObstacles, ObstacleRoute};
 use crate::obstacles::DerivedObstacle;
 use crate::orientation::{Orientation, SeparableQuadratic};
 use crate::qp::{QpOptimum, Quadratic, minimise};
-use crate::request::{PlacementError, PlacementRequest};
+use crate::request::{FloorVolume, PlacementError, PlacementRequest};
 use crate::symmetry::{is_uniform_full_turn, period_length, rotational_order};
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
@@ -237,6 +237,24 @@ struct RunState<const D: usize> {
     considered: Vec<bool>,
     found_points: Vec<(usize, DVec3)>,
     pops: u64,
+    /// Solved nodes whose optimum was found free (placements and their duplicates on shared boundaries): with the
+    /// heap they cover every position not inside an obstacle applied so far, so a search into the grown stack can
+    /// continue from both ([`SearchCaches::carrying_frontiers`]).
+    free_nodes: Vec<Node<D>>,
+}
+
+impl<const D: usize> RunState<D> {
+    /// The state for a search into the grown stack: the free nodes are open again, nothing is found or considered
+    /// yet (the orientations' components are rebuilt when first popped).
+    fn reopened(mut self) -> Self {
+        for node in std::mem::take(&mut self.free_nodes) {
+            self.heap.push(node);
+        }
+        self.considered.fill(false);
+        self.found_points.clear();
+        self.pops = 0;
+        self
+    }
 }
 
 /// A popped entry: a solved node, or the next child of a family (its id and face; the family by index into
@@ -495,6 +513,55 @@ pub struct SearchCaches {
     axes: AxesCache,
     derived: HashMap<(usize, usize, usize), Arc<DerivedObstacle>>,
     intervals: IntervalObstacles,
+    /// Whether searches continue the open frontier of an earlier search ([`SearchCaches::carrying_frontiers`]).
+    carry: bool,
+    /// The derived obstacles by id (the ids the carried cells' tags and paths name).
+    table: ObstacleTable,
+    /// The states of the last searches, by floor and cost, newest last (at most [`CARRIED_FRONTIERS`]).
+    frontiers: Vec<(FrontierSignature, States)>,
+}
+
+/// How many frontiers [`SearchCaches`] keeps: the stacking planner alternates a stage-1 search (a floor that grows
+/// with the stack's footprint) and a stage-2 search (the whole floor).
+const CARRIED_FRONTIERS: usize = 2;
+
+/// The derived obstacles of a sequence of searches by id, and by orientation.
+#[derive(Debug, Default)]
+struct ObstacleTable {
+    obstacles: Vec<Arc<DerivedObstacle>>,
+    ids: HashMap<(usize, usize, usize), u32>,
+    by_orientation: Vec<KnownObstacles>,
+}
+
+/// What a search's open nodes depend on beyond [`CacheSignature`]: the floor volume, the fixed height and the cost.
+#[derive(Debug, Clone, PartialEq)]
+struct FrontierSignature {
+    floor: FloorVolume,
+    fixed_z: Option<u64>,
+    cost: String,
+}
+
+impl FrontierSignature {
+    fn of(request: &PlacementRequest<'_>) -> Self {
+        Self {
+            floor: request.floor.clone(),
+            fixed_z: request.fixed_z.map(f64::to_bits),
+            // `Debug` of an f64 round-trips: equal strings iff equal values
+            cost: format!("{:?}", request.cost),
+        }
+    }
+
+    /// Whether a frontier searched under `self` can be continued under `next`: the same cost and fixed height, and
+    /// `self`'s floor volume inside `next`'s (the same height; every corner of the old polygon inside the new one),
+    /// so every old cell lies in the new permissible set and only the difference needs new cells
+    /// ([`Search::widen`]).
+    fn continues_into(&self, next: &Self) -> bool {
+        self.fixed_z == next.fixed_z
+            && self.cost == next.cost
+            && self.floor.height.to_bits() == next.floor.height.to_bits()
+            && (self.floor == next.floor
+                || self.floor.polygon.iter().all(|&c| next.floor.side_planes().into_iter().all(|(n, d)| n.dot(c) <= d)))
+    }
 }
 
 #[derive(Debug, PartialEq)]
@@ -513,6 +580,16 @@ impl SearchCaches {
         Self::default()
     }
 
+    /// Empty caches that also carry each [`PlacementSearch`]'s state, when it is dropped, to the next search with the
+    /// same fixed height and cost and a floor volume that contains its floor, into the grown stack: that search
+    /// starts from the open cells and the cells found free of the earlier one (and the new strip of a grown floor,
+    /// [`Search::widen`]) instead of the roots. Its first placement is the same exact optimum; the later ones are one
+    /// per cell of a different partition of the free space, so they can differ from a fresh search's, as can the
+    /// counters (a carried search evaluates only pairs no earlier search did). The stacking planner uses these.
+    pub fn carrying_frontiers() -> Self {
+        Self { carry: true, ..Self::default() }
+    }
+
     /// Keeps the caches when `next` extends the signature they were built under, clears them otherwise.
     fn adopt(&mut self, next: CacheSignature) {
         let keep = self.signature.as_ref().is_some_and(|old| {
@@ -528,6 +605,8 @@ impl SearchCaches {
             self.axes.clear();
             self.derived.clear();
             self.intervals.clear();
+            self.table = ObstacleTable::default();
+            self.frontiers.clear();
         }
         self.signature = Some(next);
     }
@@ -602,13 +681,20 @@ fn prepare<'r, 'a>(
         stack: scene.components.iter().map(|c| c.placed.vertices.clone()).collect(),
     });
     let n_orientations = orientations.len();
-    // the pairs earlier searches built, by orientation (one pass over the shared derived obstacles)
+    // the pairs earlier searches built, by orientation (one pass over the shared derived obstacles); caches that
+    // carry frontiers keep the obstacle table itself (carried cells name obstacles by id)
     let mut shared_pairs = vec![Vec::new(); n_orientations];
-    for &(oi, moving, fixed) in caches.derived.keys() {
-        if let Some(list) = shared_pairs.get_mut(oi) {
-            list.push((moving, fixed));
+    let mut table = ObstacleTable::default();
+    if caches.carry {
+        table = std::mem::take(&mut caches.table);
+    } else {
+        for &(oi, moving, fixed) in caches.derived.keys() {
+            if let Some(list) = shared_pairs.get_mut(oi) {
+                list.push((moving, fixed));
+            }
         }
     }
+    table.by_orientation.resize_with(n_orientations, KnownObstacles::default);
     let search = Search {
         request,
         orientations,
@@ -616,9 +702,9 @@ fn prepare<'r, 'a>(
         scene,
         tol,
         cache,
-        obstacles: Vec::new(),
-        obstacle_ids: HashMap::new(),
-        by_orientation: (0..n_orientations).map(|_| KnownObstacles::default()).collect(),
+        obstacles: table.obstacles,
+        obstacle_ids: table.ids,
+        by_orientation: table.by_orientation,
         shared_pairs,
         axes: std::mem::take(&mut caches.axes),
         derived: std::mem::take(&mut caches.derived),
@@ -664,6 +750,20 @@ enum States {
     Three(RunState<3>),
 }
 
+impl std::fmt::Debug for States {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (dimensions, open, free) = match self {
+            States::Two(s) => (2, s.heap.len(), s.free_nodes.len()),
+            States::Three(s) => (3, s.heap.len(), s.free_nodes.len()),
+        };
+        f.debug_struct("States")
+            .field("dimensions", &dimensions)
+            .field("open_entries", &open)
+            .field("free_nodes", &free)
+            .finish()
+    }
+}
+
 /// A placement search that can be continued: the same search as [`place_with_caches`], whose heap (and every other
 /// part of its state) is kept between calls of [`PlacementSearch::next_placements`], so asking for `a` placements
 /// and then for `b` more gives the same placements, in the same order and with the same values, as one search with
@@ -683,9 +783,13 @@ pub struct PlacementSearch<'r, 'a, 'c> {
     /// `None`: Omega is empty at every orientation.
     state: Option<States>,
     cache: &'r ObstacleCache,
-    before: stackplan_cspace::cache::CacheStats,
+    /// Obstacle-cache constructions and hits during this search's own calls (the cache is shared: the caller may
+    /// build obstacles through it between two calls).
+    cache_counts: (u64, u64),
     /// Time spent in the calls so far (ms).
     elapsed_ms: f64,
+    /// Set when the caches carry frontiers and no call failed: the state goes back to the caches on drop.
+    signature: Option<FrontierSignature>,
 }
 
 impl std::fmt::Debug for PlacementSearch<'_, '_, '_> {
@@ -708,24 +812,46 @@ impl<'r, 'a, 'c> PlacementSearch<'r, 'a, 'c> {
         let before = cache.stats();
         let mut search = prepare(request, cache, caches)?;
         search.stats.time_setup_ms = ms(start);
-        let state = match request.fixed_z {
-            None => search.start::<3>(0.0).map(|s| s.map(States::Three)),
-            Some(z) => search.start::<2>(z).map(|s| s.map(States::Two)),
+        // the state of the last search with this floor, else of the newest one whose floor lies inside it
+        let signature = caches.carry.then(|| FrontierSignature::of(request));
+        let carried = signature.as_ref().and_then(|sig| {
+            let at = caches
+                .frontiers
+                .iter()
+                .position(|(s, _)| s == sig)
+                .or_else(|| caches.frontiers.iter().rposition(|(s, _)| s.continues_into(sig)))?;
+            let (old, state) = caches.frontiers.remove(at);
+            Some((state, (old.floor != request.floor).then_some(old.floor)))
+        });
+        let state = match (carried, request.fixed_z) {
+            (Some((States::Three(s), old)), None) => {
+                search.widen(s.reopened(), old.as_ref()).map(|s| Some(States::Three(s)))
+            }
+            (Some((States::Two(s), old)), Some(_)) => {
+                search.widen(s.reopened(), old.as_ref()).map(|s| Some(States::Two(s)))
+            }
+            (_, None) => search.start::<3>(0.0).map(|s| s.map(States::Three)),
+            (_, Some(z)) => search.start::<2>(z).map(|s| s.map(States::Two)),
         };
         let state = match state {
             Ok(state) => state,
             Err(e) => {
                 search.give_back(caches);
+                // the obstacle table the kept states name by id is lost with the search
+                caches.frontiers.clear();
                 return Err(e);
             }
         };
-        Ok(Self { search, caches, state, cache, before, elapsed_ms: ms(start) })
+        let after = cache.stats();
+        let cache_counts = (after.constructions - before.constructions, after.hits - before.hits);
+        Ok(Self { search, caches, state, cache, cache_counts, elapsed_ms: ms(start), signature })
     }
 
     /// The next `more` placements (fewer, with `exhausted` set, when the free space runs out); statistics over the
     /// whole search so far.
     pub fn next_placements(&mut self, more: usize) -> Result<PlacementResult, PlacementError> {
         let start = Instant::now();
+        let before = self.cache.stats();
         let placements = match &mut self.state {
             None => {
                 return Ok(PlacementResult {
@@ -734,10 +860,18 @@ impl<'r, 'a, 'c> PlacementSearch<'r, 'a, 'c> {
                     stats: self.stats(),
                 });
             }
-            Some(States::Two(state)) => self.search.advance(state, more)?,
-            Some(States::Three(state)) => self.search.advance(state, more)?,
+            Some(States::Two(state)) => self.search.advance(state, more),
+            Some(States::Three(state)) => self.search.advance(state, more),
         };
+        let after = self.cache.stats();
+        self.cache_counts.0 += after.constructions - before.constructions;
+        self.cache_counts.1 += after.hits - before.hits;
         self.elapsed_ms += ms(start);
+        if placements.is_err() {
+            // a failed call may have lost a popped node: this state is not carried on
+            self.signature = None;
+        }
+        let placements = placements?;
         let exhausted = (placements.len() < more).then_some(NoPlacement::FitsNowhere);
         Ok(PlacementResult { placements, exhausted, stats: self.stats() })
     }
@@ -745,9 +879,7 @@ impl<'r, 'a, 'c> PlacementSearch<'r, 'a, 'c> {
     /// The statistics of the search so far.
     pub fn stats(&self) -> PlacementStats {
         let mut stats = self.search.stats.clone();
-        let after = self.cache.stats();
-        stats.obstacles_constructed = after.constructions - self.before.constructions;
-        stats.obstacle_cache_hits = after.hits - self.before.hits;
+        (stats.obstacles_constructed, stats.obstacle_cache_hits) = self.cache_counts;
         stats.time_total_ms = self.elapsed_ms;
         stats
     }
@@ -756,6 +888,20 @@ impl<'r, 'a, 'c> PlacementSearch<'r, 'a, 'c> {
 impl Drop for PlacementSearch<'_, '_, '_> {
     fn drop(&mut self) {
         self.search.give_back(self.caches);
+        if self.caches.carry {
+            self.caches.table = ObstacleTable {
+                obstacles: std::mem::take(&mut self.search.obstacles),
+                ids: std::mem::take(&mut self.search.obstacle_ids),
+                by_orientation: std::mem::take(&mut self.search.by_orientation),
+            };
+            if let (Some(signature), Some(state)) = (self.signature.take(), self.state.take()) {
+                self.caches.frontiers.retain(|(s, _)| *s != signature);
+                self.caches.frontiers.push((signature, state));
+                if self.caches.frontiers.len() > CARRIED_FRONTIERS {
+                    self.caches.frontiers.remove(0);
+                }
+            }
+        }
     }
 }
 
@@ -771,24 +917,98 @@ impl Search<'_, '_> {
         caches.intervals = std::mem::take(&mut self.intervals);
     }
 
+    /// The permissible set `Omega(theta)` of orientation `o` in `floor` as half-spaces in the `D` variables
+    /// (`None`: empty at the fixed height).
+    fn omega<const D: usize>(&self, o: &Orientation, floor: &FloorVolume, fixed_z: f64) -> Option<Vec<Halfspace<D>>> {
+        if D == 3 {
+            let hs = o.omega_3d(floor);
+            Some(
+                hs.into_iter().map(|h| Halfspace::new(std::array::from_fn(|i| h.normal[i]), h.offset, h.tag)).collect(),
+            )
+        } else {
+            let hs = o.omega_2d(floor, fixed_z, self.tol.linear)?;
+            Some(
+                hs.into_iter().map(|h| Halfspace::new(std::array::from_fn(|i| h.normal[i]), h.offset, h.tag)).collect(),
+            )
+        }
+    }
+
+    /// A carried state ([`SearchCaches::carrying_frontiers`]) widened from the floor volume `old` (inside the
+    /// request's) to the request's: its cells lie in the old permissible set, so the difference
+    /// `Omega_new(theta) \ Omega_old(theta)` of every orientation is added as new roots, split as a subtraction
+    /// ([A] VI-A-3 with `Omega_old` as the convex set taken away): child `j` is `Omega_new` with `Omega_old`'s
+    /// half-space `j` reversed and those before it kept (tagged as cuts, not as floor sides). Sides the two sets
+    /// share give no child. O(orientations x sides) cells and QPs, in parallel.
+    fn widen<const D: usize>(
+        &mut self,
+        mut state: RunState<D>,
+        old: Option<&FloorVolume>,
+    ) -> Result<RunState<D>, PlacementError> {
+        let Some(old) = old else {
+            return Ok(state);
+        };
+        let t_roots = Instant::now();
+        let fixed_z = state.fixed_z;
+        let tol = self.tol;
+        let added: Vec<Result<Vec<(Cell<D>, QpOptimum<D>)>, PlacementError>> = self
+            .orientations
+            .par_iter()
+            .map(|o| {
+                let fs_err = |reason: String| PlacementError::FreeSpace { orientation: o.index, reason };
+                let Some(new_hs) = self.omega::<D>(o, &self.request.floor, fixed_z) else {
+                    return Ok(Vec::new());
+                };
+                let q = restrict_quadratic::<D>(&o.quadratic, fixed_z);
+                let solve = |hs: Vec<Halfspace<D>>| -> Result<Option<(Cell<D>, QpOptimum<D>)>, PlacementError> {
+                    let cell = Cell::new(hs, tol).map_err(|e| fs_err(e.to_string()))?;
+                    if cell.is_empty() {
+                        return Ok(None);
+                    }
+                    Ok(minimise(&cell, &q).map_err(fs_err)?.map(|opt| (cell, opt)))
+                };
+                let Some(old_hs) = self.omega::<D>(o, old, fixed_z) else {
+                    // nothing of this orientation was open before: its whole new set is a root
+                    return Ok(solve(new_hs)?.into_iter().collect());
+                };
+                let mut out = Vec::new();
+                for (j, h) in old_hs.iter().enumerate() {
+                    if new_hs.iter().any(|g| g.normal == h.normal && g.offset == h.offset) {
+                        continue;
+                    }
+                    let mut hs = new_hs.clone();
+                    hs.extend(old_hs[..j].iter().map(|g| Halfspace::new(g.normal, g.offset, Tag::User(2 * j as u64))));
+                    hs.push(h.flipped(Tag::User(2 * j as u64 + 1)));
+                    out.extend(solve(hs)?);
+                }
+                Ok(out)
+            })
+            .collect();
+        for (i, cells) in added.into_iter().enumerate() {
+            for (cell, optimum) in cells? {
+                self.stats.qp_solves += 1;
+                self.stats.nodes_pushed += 1;
+                state.heap.push(Node {
+                    cost: optimum.value,
+                    orientation: i,
+                    id: state.next_id,
+                    cell: Arc::new(cell),
+                    optimum,
+                    applied: Arc::new(Vec::new()),
+                });
+                state.next_id += 1;
+            }
+        }
+        self.stats.time_roots_ms += ms(t_roots);
+        Ok(state)
+    }
+
     fn root_cell<const D: usize>(&self, o: &Orientation, fixed_z: f64) -> Result<Option<Cell<D>>, PlacementError> {
         let fs_err = |e: stackplan_freespace::cell::CellError| PlacementError::FreeSpace {
             orientation: o.index,
             reason: e.to_string(),
         };
-        let hs: Vec<Halfspace<D>> = if D == 3 {
-            o.omega_3d(&self.request.floor)
-                .into_iter()
-                .map(|h| Halfspace::new(std::array::from_fn(|i| h.normal[i]), h.offset, h.tag))
-                .collect()
-        } else {
-            match o.omega_2d(&self.request.floor, fixed_z, self.tol.linear) {
-                Some(v) => v
-                    .into_iter()
-                    .map(|h| Halfspace::new(std::array::from_fn(|i| h.normal[i]), h.offset, h.tag))
-                    .collect(),
-                None => return Ok(None),
-            }
+        let Some(hs) = self.omega::<D>(o, &self.request.floor, fixed_z) else {
+            return Ok(None);
         };
         // bounded iff the first non-empty root is (the normals do not depend on the orientation): checked in `run`
         let cell = Cell::new_unchecked_bounds(hs, self.tol).map_err(fs_err)?;
@@ -866,6 +1086,7 @@ impl Search<'_, '_> {
             considered: vec![false; self.orientations.len()],
             found_points: Vec::new(),
             pops: 0,
+            free_nodes: Vec::new(),
         }))
     }
 
@@ -877,7 +1098,7 @@ impl Search<'_, '_> {
         state: &mut RunState<D>,
         want: usize,
     ) -> Result<Vec<Placement>, PlacementError> {
-        let RunState { fixed_z, heap, next_id, considered, found_points, pops } = state;
+        let RunState { fixed_z, heap, next_id, considered, found_points, pops, free_nodes } = state;
         let fixed_z = *fixed_z;
         let mut placements: Vec<Placement> = Vec::new();
         if want == 0 {
@@ -998,9 +1219,12 @@ impl Search<'_, '_> {
                 let dup = found_points
                     .iter()
                     .any(|(oi, q)| *oi == node.orientation && (*q - p).abs().max_element() <= 1e3 * tol);
-                if !dup {
-                    found_points.push((node.orientation, p));
-                    placements.push(self.placement(&node.cell, optimum, node.orientation, p));
+                let found = (!dup).then(|| self.placement(&node.cell, optimum, node.orientation, p));
+                let orientation = node.orientation;
+                free_nodes.push(node);
+                if let Some(placement) = found {
+                    found_points.push((orientation, p));
+                    placements.push(placement);
                     if placements.len() >= want {
                         break;
                     }
@@ -1216,7 +1440,20 @@ impl Search<'_, '_> {
                 }
                 Tag::Floor => Contact::Floor,
                 Tag::Ceiling => Contact::Ceiling,
-                Tag::FloorSide { side } => Contact::FloorSide { side },
+                // a side of the request's floor (a state carried from a smaller floor keeps that floor's sides as
+                // bounds of its old cells, which are not walls of this one)
+                Tag::FloorSide { side } => {
+                    let h = &cell.halfspaces()[j];
+                    let wall = self.request.floor.side_planes().get(side as usize).is_some_and(|&(n, d)| {
+                        let parallel = (h.normal[0] - n.x).abs() <= 1e-12 && (h.normal[1] - n.y).abs() <= 1e-12;
+                        let gap = n.x * p.x + n.y * p.y + o.support(DVec3::new(n.x, n.y, 0.0)) - d;
+                        parallel && gap.abs() <= self.tol.linear
+                    });
+                    if !wall {
+                        continue;
+                    }
+                    Contact::FloorSide { side }
+                }
                 Tag::ObstacleCut { .. } | Tag::User(_) => continue,
             };
             if !contacts.contains(&contact) {

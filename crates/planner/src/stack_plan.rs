@@ -5,9 +5,12 @@
 //! 1. candidate orientations: the part's stable resting poses that present an upward face holding the suction cup
 //!    ([`stackplan_stability::resting_poses`], [`stackplan_stability::grasp`]; at most
 //!    [`PlanOptions::max_resting_poses`], lowest c.g. first) x the discrete theta set;
-//! 2. the best-first placement search ([`crate::search::place`]) returns up to [`PlanOptions::candidates`]
-//!    interference-free positions sorted by the part's term of cost (1), one per free-space cell; with
-//!    `insertion` every candidate can be lowered straight down into place (insertion obstacles);
+//! 2. the best-first placement search ([`crate::search::PlacementSearch`]) gives interference-free positions one at
+//!    a time in the order of the part's term of cost (1), one per free-space cell, up to
+//!    [`PlanOptions::candidates`] per stage (the search stops at the first that passes step 3, so later ones are
+//!    never searched for); with `insertion` every candidate can be lowered straight down into place (insertion
+//!    obstacles). The searches of a plan carry their open cells to the next part's search with the same floor
+//!    (or a floor that grew: stage 1's footprint), [`crate::search::SearchCaches::carrying_frontiers`];
 //! 3. the candidates are settled ([`crate::settle`]) and tested in cost order on the stack placed so far
 //!    ([`stackplan_stability::growing::GrowingStack`]: the verdicts of [`stackplan_stability::check_added_part`],
 //!    the new part's report of [`stackplan_stability::check::check_stack`], without re-checking the parts that
@@ -27,7 +30,7 @@
 use crate::detect::StackScene;
 use crate::orientation::Orientation;
 use crate::request::{Cost, FloorVolume, PlacementError, PlacementRequest, StackPart, thetas_with_step};
-use crate::search::{Contact, NoPlacement, Placement, SearchCaches, place_with_caches};
+use crate::search::{Contact, NoPlacement, Placement, PlacementSearch, SearchCaches};
 use crate::settle::settle;
 use glam::{DMat3, DVec2, DVec3};
 use serde::{Deserialize, Serialize};
@@ -62,9 +65,9 @@ pub struct PlanOptions {
     pub insertion: bool,
     /// Interference-free candidates per part and stage, tested in cost order.
     pub candidates: usize,
-    /// When every candidate of the last stage fails the checks, the search there is repeated with four times as many
-    /// candidates, up to this many: a part fits nowhere only when the search is exhausted or this limit is reached.
-    /// Equal to `candidates`: no repetition.
+    /// When every candidate of the last stage fails the checks (and no stage accepted one), the search there
+    /// continues with more candidates, up to this many in all: a part fits nowhere only when the search is exhausted
+    /// or this limit is reached. Equal to `candidates`: no continuation.
     #[serde(default = "default_max_candidates")]
     pub max_candidates: usize,
     /// Resting poses considered (lowest c.g. first).
@@ -140,7 +143,7 @@ pub struct PlanStats {
     pub searches: usize,
     /// Interference-free candidates checked for stability, grasp and insertion.
     pub candidates_checked: usize,
-    /// Searches repeated with more candidates because every candidate failed the checks.
+    /// Searches continued past `candidates` candidates because every candidate failed the checks.
     #[serde(default)]
     pub repeated_searches: usize,
     /// Candidates rejected as not stable on their supports.
@@ -302,7 +305,7 @@ pub fn plan_stack_with_progress(
         let (lo, hi) = part.aabb();
         Tolerance::for_scale((hi - lo).length()).linear
     };
-    let mut caches = SearchCaches::new();
+    let mut caches = SearchCaches::carrying_frontiers();
     // the stack as the candidate tests see it: its parts in world coordinates, their contacts and the memos of the
     // tests, kept from candidate to candidate and from part to part
     let mut growing = GrowingStack::new(&check_options).map_err(|e| PlanError::Check(e.to_string()))?;
@@ -336,66 +339,65 @@ pub fn plan_stack_with_progress(
             request.horizontal_clearance = true;
             request.cost = Cost::Stacking { w: options.w, origin };
             request.insertion = options.insertion;
-            // candidates already rejected in this stage (by position and orientation): a repeated, larger search
-            // returns them again first
-            let mut rejected_here: std::collections::HashSet<([u64; 3], u64, usize)> = Default::default();
-            let mut k = options.candidates;
-            loop {
-                request.k = k;
+            // a stage tests `candidates` candidates; the last one, when nothing at all was accepted, continues the
+            // same search up to `max_candidates`
+            let limit =
+                if stage == last_stage && accepted.is_empty() { options.max_candidates } else { options.candidates };
+            let started = std::time::Instant::now();
+            let mut search = match PlacementSearch::new(&request, &cache, &mut caches) {
+                Ok(search) => search,
+                // stage 1's clipped floor may be malformed (a sliver): fall through to stage 2
+                Err(PlacementError::BadFloor(msg)) if stage == 1 => {
+                    tracing::debug!(index, "stage 1 floor rejected: {msg}");
+                    continue;
+                }
+                Err(e) => return Err(e.into()),
+            };
+            stats.seconds_search += started.elapsed().as_secs_f64();
+            stats.searches += 1;
+            // candidates one at a time: the search stops at the first that passes
+            for tested in 0..limit {
+                if tested == options.candidates {
+                    stats.repeated_searches += 1;
+                    tracing::debug!(index, "every candidate failed the checks: searching for more");
+                }
                 let started = std::time::Instant::now();
-                let result = match place_with_caches(&request, &cache, &mut caches) {
-                    Ok(r) => r,
-                    // stage 1's clipped floor may be malformed (a sliver): fall through to stage 2
-                    Err(PlacementError::BadFloor(msg)) if stage == 1 => {
-                        tracing::debug!(index, "stage 1 floor rejected: {msg}");
+                let next = search.next_placements(1)?;
+                stats.seconds_search += started.elapsed().as_secs_f64();
+                let Some(candidate) = next.placements.first() else {
+                    if tested == 0 {
+                        last_reason = match next.exhausted {
+                            Some(NoPlacement::EmptyOmega) => "the floor volume is too small for the part".into(),
+                            _ => "no interference-free position inside the floor volume".into(),
+                        };
+                    }
+                    break;
+                };
+                let started = std::time::Instant::now();
+                stats.candidates_checked += 1;
+                let candidate = settled(part, &rests, candidate, &scene, &cache, tol, &request.cost)?;
+                let verdict = accept(&mut growing, part, &candidate.0, &mut stats)?;
+                stats.seconds_checks += started.elapsed().as_secs_f64();
+                match verdict {
+                    Ok(grasp_radius) => {
+                        accepted.push((stage, candidate, tested, grasp_radius));
                         break;
                     }
-                    Err(e) => return Err(e.into()),
-                };
-                stats.seconds_search += started.elapsed().as_secs_f64();
-                stats.searches += 1;
-                stats.pairs_evaluated += result.stats.pairs_evaluated;
-                stats.obstacles_constructed += result.stats.obstacles_constructed;
-                stats.obstacles_extrapolated += result.stats.obstacles_extrapolated;
-                if result.placements.is_empty() {
-                    last_reason = match result.exhausted {
-                        Some(NoPlacement::EmptyOmega) => "the floor volume is too small for the part".into(),
-                        _ => "no interference-free position inside the floor volume".into(),
-                    };
-                    break;
+                    Err(reason) => last_reason = reason,
                 }
-                let started = std::time::Instant::now();
-                let mut found = false;
-                for (rejected, candidate) in result.placements.iter().enumerate() {
-                    let key =
-                        (candidate.position.map(f64::to_bits), candidate.theta_deg.to_bits(), candidate.resting_pose);
-                    if rejected_here.contains(&key) {
-                        continue;
-                    }
-                    stats.candidates_checked += 1;
-                    let candidate = &settled(part, &rests, candidate, &scene, &cache, tol, &request.cost)?;
-                    match accept(&mut growing, part, &candidate.0, &mut stats)? {
-                        Ok(grasp_radius) => {
-                            accepted.push((stage, candidate.clone(), rejected, grasp_radius));
-                            found = true;
-                            break;
-                        }
-                        Err(reason) => {
-                            last_reason = reason;
-                            rejected_here.insert(key);
-                        }
-                    }
-                }
-                stats.seconds_checks += started.elapsed().as_secs_f64();
-                // only the last stage, only when nothing at all was accepted, only when the search had more to give
-                let more = result.placements.len() == k && k < options.max_candidates;
-                if found || stage != last_stage || !accepted.is_empty() || !more {
-                    break;
-                }
-                k = (k * 4).min(options.max_candidates);
-                stats.repeated_searches += 1;
-                tracing::debug!(index, k, "every candidate failed the checks: searching for more");
             }
+            let searched = search.stats();
+            stats.pairs_evaluated += searched.pairs_evaluated;
+            stats.obstacles_constructed += searched.obstacles_constructed;
+            stats.obstacles_extrapolated += searched.obstacles_extrapolated;
+            tracing::debug!(
+                index,
+                stage,
+                nodes = searched.nodes_expanded,
+                pairs = searched.pairs_evaluated,
+                ms = searched.time_total_ms,
+                "stage searched"
+            );
         }
         // stage 1 (compact) wins unless stage 2 is strictly cheaper: ties and near-ties keep the stack compact
         let best = accepted.iter().min_by(|a, b| {

@@ -1,0 +1,84 @@
+//! Searches into a growing stack that carry their open cells to the next search ([`SearchCaches::carrying_frontiers`],
+//! the stacking planner's caches): the first placement of every search is the exact optimum a fresh search finds,
+//! also on a floor that grew since the carried search (stage 1's footprint).
+
+use glam::DVec3;
+use stackplan_cspace::ObstacleCache;
+use stackplan_geom::examples::part_by_name;
+use stackplan_geom::sheet_metal::Decomposition;
+use stackplan_geom::{Part, Pose};
+use stackplan_planner::{
+    Cost, FloorVolume, PlacementRequest, PlacementSearch, SearchCaches, StackPart, place_with_caches, uniform_thetas,
+};
+
+/// Searches into a growing stack through caches that carry their frontiers (as the stacking planner's): at every
+/// step the first placement costs what a fresh search's does (the exact optimum), also on a floor that grew since the
+/// last search with it (the carried cells plus the new strip); every placement is valid by the independent all-pairs
+/// check and they come in cost order.
+#[test]
+fn carried_frontiers_find_the_exact_best_placement_into_a_growing_stack() {
+    use stackplan_planner::reference::violations;
+    let part = part_by_name("l-corner", Decomposition::ConvexMerge).expect("example");
+    let whole = FloorVolume::rectangle(-200.0, -200.0, 200.0, 200.0, 300.0);
+    let cache = ObstacleCache::new();
+    let mut carrying = SearchCaches::carrying_frontiers();
+    let mut poses: Vec<Pose> = Vec::new();
+    let mut widened = 0;
+    for step in 0..6 {
+        let stack: Vec<StackPart<'_>> = poses.iter().map(|&pose| StackPart { part: &part, pose }).collect();
+        // a footprint-like floor that grows with the steps (as stage 1's), then the whole floor (as stage 2's)
+        let grow = 90.0 + 20.0 * step as f64;
+        let floors = [FloorVolume::rectangle(-grow, -grow, grow, grow, 300.0), whole.clone()];
+        for floor in floors {
+            let mut req = PlacementRequest::new(&part, stack.clone(), floor);
+            req.thetas = uniform_thetas(12);
+            req.cost = Cost::Stacking { w: 0.3, origin: DVec3::ZERO };
+            req.clearance = 2.0;
+            req.horizontal_clearance = true;
+            req.insertion = true;
+            req.k = 4;
+            let fresh = place_with_caches(&req, &ObstacleCache::new(), &mut SearchCaches::new()).expect("search");
+            let mut carried = Vec::new();
+            {
+                let mut search = PlacementSearch::new(&req, &cache, &mut carrying).expect("search");
+                while carried.len() < req.k {
+                    match search.next_placements(1).expect("step").placements.pop() {
+                        Some(p) => carried.push(p),
+                        None => break,
+                    }
+                }
+                widened += usize::from(step > 0 && search.stats().qp_solves > 0);
+            }
+            assert_eq!(carried.is_empty(), fresh.placements.is_empty(), "step {step}");
+            let (Some(a), Some(b)) = (carried.first(), fresh.placements.first()) else { continue };
+            assert!((a.cost - b.cost).abs() <= 1e-9 * (1.0 + b.cost.abs()), "step {step}: {} vs {}", a.cost, b.cost);
+            for w in carried.windows(2) {
+                assert!(w[0].cost <= w[1].cost + 1e-9 * (1.0 + w[1].cost.abs()), "cost order");
+            }
+            // interference, floor volume and insertion (the reference check's clearance is not horizontal: parts
+            // resting on each other touch)
+            let unspaced = PlacementRequest { clearance: 0.0, horizontal_clearance: false, ..req.clone() };
+            for p in &carried {
+                let pose = p.pose();
+                let v = violations(&part, pose.rotation, pose.position, &stack, &unspaced, 1e-6, 2.0);
+                assert!(v.is_empty(), "step {step}: {v:?} at {p:?}");
+            }
+        }
+        poses.push(fresh_best(&part, &poses, &whole));
+    }
+    assert!(widened > 0, "the growing floor was widened from a carried frontier");
+}
+
+/// The best whole-floor placement into the stack `poses` by a fresh search.
+fn fresh_best(part: &Part, poses: &[Pose], floor: &FloorVolume) -> Pose {
+    let stack: Vec<StackPart<'_>> = poses.iter().map(|&pose| StackPart { part, pose }).collect();
+    let mut req = PlacementRequest::new(part, stack, floor.clone());
+    req.thetas = uniform_thetas(12);
+    req.cost = Cost::Stacking { w: 0.3, origin: DVec3::ZERO };
+    req.clearance = 2.0;
+    req.horizontal_clearance = true;
+    req.insertion = true;
+    req.k = 1;
+    let res = place_with_caches(&req, &ObstacleCache::new(), &mut SearchCaches::new()).expect("search");
+    res.placements.first().expect("room on the floor").pose()
+}
