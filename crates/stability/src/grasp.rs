@@ -119,9 +119,11 @@ impl Region {
             && !self.obstacles.iter().any(|o| crate::polygon2d::signed_boundary_distance(p, o) > self.tol)
     }
 
-    /// `d(p)`: distance to the boundary when inside, 0 outside.
+    /// `d(p)`: distance to the boundary when inside, 0 outside. A region without boundary has no area (a bounded
+    /// region with interior has a boundary): material above covers its pieces exactly, and `contains` holds only
+    /// within the tolerance of their edges, so every point gets 0.
     pub fn clearance(&self, p: DVec2) -> f64 {
-        if !self.contains(p) {
+        if self.boundary.is_empty() || !self.contains(p) {
             return 0.0;
         }
         self.boundary.iter().map(|&(a, b)| point_segment_distance(p, a, b)).fold(f64::INFINITY, f64::min)

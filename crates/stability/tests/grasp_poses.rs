@@ -63,6 +63,30 @@ fn l_shaped_top_is_bounded() {
     assert!(f.fits_cup);
 }
 
+/// A step whose top is covered exactly by a wall standing on it (the flanges of sheet-metal parts: a component's top
+/// face under the next component, split by the convex decomposition) leaves no area for a cup: radius 0, not a
+/// radius without a boundary (it was infinite, and the face counted as graspable).
+#[test]
+fn a_face_covered_by_material_above_has_no_disc() {
+    let part = boxes_part(
+        "covered",
+        &[
+            (DVec3::ZERO, DVec3::new(2.0, 40.0, 60.0)),
+            (DVec3::new(0.0, 0.0, 60.0), DVec3::new(2.0, 40.0, 120.0)),
+            (DVec3::new(300.0, 0.0, 0.0), DVec3::new(302.0, 40.0, 60.0)),
+            (DVec3::new(300.0, 0.0, 60.0), DVec3::new(302.0, 40.0, 120.0)),
+        ],
+    );
+    let faces = grasp_faces(&part, DMat3::IDENTITY, DVec3::ZERO, &opts(10.0));
+    let covered = faces.iter().find(|f| (f.height - 60.0).abs() < 1e-9).expect("the covered step");
+    assert_eq!(covered.inscribed_radius, 0.0);
+    assert!(!covered.fits_cup);
+    let top = faces.iter().find(|f| (f.height - 120.0).abs() < 1e-9).expect("the top");
+    assert!(top.inscribed_radius.is_finite() && (top.inscribed_radius - 1.0).abs() < 1e-3, "{}", top.inscribed_radius);
+    assert!(faces.iter().all(|f| f.inscribed_radius.is_finite() && f.radius_upper_bound.is_finite()), "{faces:?}");
+    assert!(!is_graspable(&faces, &opts(10.0)), "2 mm wide strips hold no 10 mm cup");
+}
+
 #[test]
 fn material_above_and_holes_are_excluded() {
     // a base plate with a block on top: the plate's top is a frame around the block
