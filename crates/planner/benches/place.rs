@@ -10,15 +10,9 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use stackplan_planner::regress::{SCENARIOS, run, scenario};
 
-/// CPU time of every thread of the process (ns), where Linux reports it.
-fn process_cpu_ns() -> Option<u64> {
-    let mut total = 0;
-    for task in std::fs::read_dir("/proc/self/task").ok()? {
-        let stat = std::fs::read_to_string(task.ok()?.path().join("schedstat")).ok()?;
-        total += stat.split_whitespace().next()?.parse::<u64>().ok()?;
-    }
-    Some(total)
-}
+#[path = "common/cpu.rs"]
+mod cpu;
+use cpu::process_cpu_ns;
 
 fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("place");

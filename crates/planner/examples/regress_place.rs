@@ -7,15 +7,9 @@
 
 #![allow(clippy::print_stdout)] // an example program prints its results
 
-/// CPU time of every thread of the process (ns), where Linux reports it.
-fn process_cpu_ns() -> Option<u64> {
-    let mut total = 0;
-    for task in std::fs::read_dir("/proc/self/task").ok()? {
-        let stat = std::fs::read_to_string(task.ok()?.path().join("schedstat")).ok()?;
-        total += stat.split_whitespace().next()?.parse::<u64>().ok()?;
-    }
-    Some(total)
-}
+#[path = "../benches/common/cpu.rs"]
+mod cpu;
+use cpu::process_cpu_ns;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();

@@ -29,14 +29,9 @@ fn carried_frontiers_find_the_exact_best_placement_into_a_growing_stack() {
         // a footprint-like floor that grows with the steps (as stage 1's), then the whole floor (as stage 2's)
         let grow = 90.0 + 20.0 * step as f64;
         let floors = [FloorVolume::rectangle(-grow, -grow, grow, grow, 300.0), whole.clone()];
+        let mut next_pose = None;
         for floor in floors {
-            let mut req = PlacementRequest::new(&part, stack.clone(), floor);
-            req.thetas = uniform_thetas(12);
-            req.cost = Cost::Stacking { w: 0.3, origin: DVec3::ZERO };
-            req.clearance = 2.0;
-            req.horizontal_clearance = true;
-            req.insertion = true;
-            req.k = 4;
+            let req = request(&part, stack.clone(), floor);
             let fresh = place_with_caches(&req, &ObstacleCache::new(), &mut SearchCaches::new()).expect("search");
             let mut carried = Vec::new();
             {
@@ -50,6 +45,8 @@ fn carried_frontiers_find_the_exact_best_placement_into_a_growing_stack() {
                 widened += usize::from(step > 0 && search.stats().qp_solves > 0);
             }
             assert_eq!(carried.is_empty(), fresh.placements.is_empty(), "step {step}");
+            // the stack grows by the whole floor's best placement (the last floor searched)
+            next_pose = fresh.placements.first().map(|p| p.pose());
             let (Some(a), Some(b)) = (carried.first(), fresh.placements.first()) else { continue };
             assert!((a.cost - b.cost).abs() <= 1e-9 * (1.0 + b.cost.abs()), "step {step}: {} vs {}", a.cost, b.cost);
             for w in carried.windows(2) {
@@ -64,21 +61,19 @@ fn carried_frontiers_find_the_exact_best_placement_into_a_growing_stack() {
                 assert!(v.is_empty(), "step {step}: {v:?} at {p:?}");
             }
         }
-        poses.push(fresh_best(&part, &poses, &whole));
+        poses.push(next_pose.expect("room on the floor"));
     }
     assert!(widened > 0, "the growing floor was widened from a carried frontier");
 }
 
-/// The best whole-floor placement into the stack `poses` by a fresh search.
-fn fresh_best(part: &Part, poses: &[Pose], floor: &FloorVolume) -> Pose {
-    let stack: Vec<StackPart<'_>> = poses.iter().map(|&pose| StackPart { part, pose }).collect();
-    let mut req = PlacementRequest::new(part, stack, floor.clone());
+/// The request of every search of the test: 30-degree steps, clearance, insertion, the four best.
+fn request<'a>(part: &'a Part, stack: Vec<StackPart<'a>>, floor: FloorVolume) -> PlacementRequest<'a> {
+    let mut req = PlacementRequest::new(part, stack, floor);
     req.thetas = uniform_thetas(12);
     req.cost = Cost::Stacking { w: 0.3, origin: DVec3::ZERO };
     req.clearance = 2.0;
     req.horizontal_clearance = true;
     req.insertion = true;
-    req.k = 1;
-    let res = place_with_caches(&req, &ObstacleCache::new(), &mut SearchCaches::new()).expect("search");
-    res.placements.first().expect("room on the floor").pose()
+    req.k = 4;
+    req
 }

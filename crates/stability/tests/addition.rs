@@ -9,10 +9,11 @@
 
 mod common;
 
-use common::{at, box_layers, box_part, build, fixture_columns, placements, planned_channels, same_margin};
+use common::{
+    at, box_layers, box_part, build, fixture_columns, fixture_parts, placements, planned_channels, same_margin,
+};
 use glam::DVec3;
 use proptest::prelude::*;
-use stackplan_geom::io::{ReadOptions, read_part};
 use stackplan_stability::check::{CheckOptions, PartCheck, check_stack};
 use stackplan_stability::check_added_part;
 use stackplan_stability::equilibrium::ContactForce;
@@ -83,15 +84,11 @@ fn compare_additions(stack: &[PlacedPart<'_>], options: &CheckOptions, weight: f
 
 #[test]
 fn added_parts_report_like_the_whole_check_on_fixture_columns() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/parts");
-    let mut files: Vec<_> = std::fs::read_dir(dir).expect("fixtures").flatten().map(|e| e.path()).collect();
-    files.sort();
     let mut compared = 0;
-    for file in files.iter().filter(|f| f.extension().is_some_and(|e| e == "json")) {
-        let part = read_part(file, &ReadOptions::default()).expect("fixture part");
+    for (file, part) in &fixture_parts() {
         for pose in 0..2 {
             for (dx, dy) in [(0.0, 0.0), (7.0, -3.0), (40.0, 0.0)] {
-                let stack = fixture_columns(&part, pose, dx, dy);
+                let stack = fixture_columns(part, pose, dx, dy);
                 for (mu, directions, clearance) in [(0.4, 8, 0.0), (0.8, 0, 5.0)] {
                     let what = format!("{} pose {pose} shift ({dx}, {dy}) mu {mu}", file.display());
                     compared += compare_additions(&stack, &options(mu, directions, clearance), part.mass.mass, &what);

@@ -8,10 +8,9 @@
 
 mod common;
 
-use common::{at, box_layers, box_part, build, fixture_columns, placements, planned_channels};
+use common::{at, box_layers, box_part, build, fixture_columns, fixture_parts, placements, planned_channels};
 use glam::{DMat3, DVec3};
 use proptest::prelude::*;
-use stackplan_geom::io::{ReadOptions, read_part};
 use stackplan_stability::check::{CheckOptions, PartCheck, check_stack};
 use stackplan_stability::check_added_part;
 use stackplan_stability::equilibrium::Verdict;
@@ -78,15 +77,11 @@ fn compare_candidates(stack: &[PlacedPart<'_>], options: &CheckOptions, what: &s
 
 #[test]
 fn candidates_fail_and_pass_like_the_added_part_report_on_fixture_columns() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/parts");
-    let mut files: Vec<_> = std::fs::read_dir(dir).expect("fixtures").flatten().map(|e| e.path()).collect();
-    files.sort();
     let mut compared = 0;
-    for file in files.iter().filter(|f| f.extension().is_some_and(|e| e == "json")) {
-        let part = read_part(file, &ReadOptions::default()).expect("fixture part");
+    for (file, part) in &fixture_parts() {
         for pose in 0..2 {
             for (dx, dy) in [(0.0, 0.0), (7.0, -3.0), (40.0, 0.0)] {
-                let stack = fixture_columns(&part, pose, dx, dy);
+                let stack = fixture_columns(part, pose, dx, dy);
                 for (mu, cup) in [(0.4, 5.0), (0.8, 10.0), (0.5, 400.0)] {
                     let what = format!("{} pose {pose} shift ({dx}, {dy}) mu {mu} cup {cup}", file.display());
                     compared += compare_candidates(&stack, &options(mu, cup), &what);

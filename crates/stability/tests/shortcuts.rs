@@ -21,10 +21,11 @@
 
 mod common;
 
-use common::{at, box_layers, box_part, build, fixture_columns, placements, planned_channels, same_margin};
+use common::{
+    at, box_layers, box_part, build, fixture_columns, fixture_parts, placements, planned_channels, same_margin,
+};
 use glam::DVec3;
 use proptest::prelude::*;
-use stackplan_geom::io::{ReadOptions, read_part};
 use stackplan_stability::check::{CheckOptions, StackCheck, check_stack, check_stack_reference};
 use stackplan_stability::contacts::analyse_contacts;
 use stackplan_stability::equilibrium::{ContactForce, Equilibrium};
@@ -75,15 +76,10 @@ fn assert_checks_equivalent(fast: &StackCheck, plain: &StackCheck, weight: f64, 
 
 #[test]
 fn shortcuts_match_the_plain_socps_on_fixture_columns() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/parts");
-    let mut files: Vec<_> = std::fs::read_dir(dir).expect("fixtures").flatten().map(|e| e.path()).collect();
-    files.sort();
-    assert!(files.len() >= 6, "{files:?}");
-    for file in files.iter().filter(|f| f.extension().is_some_and(|e| e == "json")) {
-        let part = read_part(file, &ReadOptions::default()).expect("fixture part");
+    for (file, part) in &fixture_parts() {
         for pose in 0..2 {
             for (dx, dy) in [(0.0, 0.0), (7.0, -3.0)] {
-                let stack = fixture_columns(&part, pose, dx, dy);
+                let stack = fixture_columns(part, pose, dx, dy);
                 let mut options = options();
                 options.mu = 0.4;
                 let fast = check_stack(&stack, &options).expect("check");

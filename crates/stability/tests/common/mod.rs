@@ -69,6 +69,23 @@ pub fn nesting_height(placed: PlacedPart<'_>, dx: f64, dy: f64, upper: f64) -> f
 
 /// Two columns of three copies of `part` in resting pose `pose`, each copy shifted by `(dx, dy)` from the one below
 /// and lowered onto it.
+/// Every fixture part (`fixtures/parts/*.json`, sorted by file name) with its file, as the library reads it.
+pub fn fixture_parts() -> Vec<(std::path::PathBuf, Part)> {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/parts");
+    let mut files: Vec<_> = std::fs::read_dir(dir).expect("fixtures").flatten().map(|e| e.path()).collect();
+    files.sort();
+    let parts: Vec<_> = files
+        .into_iter()
+        .filter(|f| f.extension().is_some_and(|e| e == "json"))
+        .map(|f| {
+            let part = stackplan_geom::io::read_part(&f, &Default::default()).expect("fixture part");
+            (f, part)
+        })
+        .collect();
+    assert!(parts.len() >= 6, "the six fixture parts: {parts:?}");
+    parts
+}
+
 pub fn fixture_columns(part: &Part, pose: usize, dx: f64, dy: f64) -> Vec<PlacedPart<'_>> {
     let poses = resting_poses(part).expect("poses");
     let pose = &poses[pose.min(poses.len() - 1)];

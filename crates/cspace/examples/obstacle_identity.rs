@@ -1,12 +1,14 @@
-//! Identity harness for speed work on the obstacle construction (ignored tests, run by hand):
+//! Identity harness and profiling driver for speed work on the obstacle construction (a tool run by hand):
 //!
-//! * `dump` hashes the full `Debug` text of `gauss_map_obstacle` (the obstacle with its planes, edges, provenance and
-//!   kinds, or the failure) on 100 polytopes x 4 400 pairs x 86 rotations and writes one line per case to
-//!   `$IDENTITY_DUMP`: run it before and after a change (`IDENTITY_DUMP=/tmp/before.txt cargo test --release -p
-//!   stackplan-cspace --test identity_dump -- --ignored dump`), then `cmp` the two files;
-//! * `profile` builds and drops `$PROFILE_CALLS` obstacles of the benchmark's box or prism pair
-//!   (`PROFILE_CASE=box|prism|general`) in `build_and_drop`, for `valgrind --tool=callgrind
+//! * `cargo run --release -p stackplan-cspace --example obstacle_identity -- dump FILE` hashes the full `Debug` text
+//!   of `gauss_map_obstacle` (the obstacle with its planes, edges, provenance and kinds, or the failure) on 100
+//!   polytopes x 4 400 pairs x 86 rotations and writes one line per case to `FILE`: run it before and after a change,
+//!   then `cmp` the two files;
+//! * `... --example obstacle_identity -- profile box|prism|general [CALLS]` builds and drops `CALLS` (default 10 000)
+//!   obstacles of the benchmark's box or prism pair in `build_and_drop`, for `valgrind --tool=callgrind
 //!   --toggle-collect='*build_and_drop*'` or `perf stat -e task-clock`.
+
+#![allow(clippy::print_stdout, clippy::print_stderr)] // a command-line tool reports its counts
 
 use glam::{DMat3, DVec3};
 use stackplan_cspace::minkowski::gauss_map_obstacle;
@@ -14,6 +16,8 @@ use stackplan_geom::{ConvexPolytope, Decomposition, ReadOptions, convex_hull, re
 use std::hash::{Hash, Hasher};
 use std::io::Write;
 
+// the shapes the tests share (the module allows the ones this tool does not use)
+#[path = "../tests/common/mod.rs"]
 mod common;
 
 fn polytopes() -> Vec<ConvexPolytope> {
@@ -121,10 +125,7 @@ fn rotations() -> Vec<DMat3> {
     out
 }
 
-#[test]
-#[ignore = "throw-away identity harness: IDENTITY_DUMP=path cargo test --release --test identity_dump -- --ignored"]
-fn dump() {
-    let Ok(path) = std::env::var("IDENTITY_DUMP") else { return };
+fn dump(path: &str) {
     let ps = polytopes();
     let rs = rotations();
     let mut file = std::io::BufWriter::new(std::fs::File::create(path).expect("dump file"));
@@ -156,16 +157,13 @@ fn build_and_drop(a: &ConvexPolytope, r: DMat3, b: &ConvexPolytope) -> usize {
     o.polytope().faces().len()
 }
 
-#[test]
-#[ignore = "callgrind driver: PROFILE_CASE=box|prism|general cargo test --release --test identity_dump -- --ignored"]
-fn profile() {
-    let Ok(case) = std::env::var("PROFILE_CASE") else { return };
+fn profile(case: &str, n: usize) {
     let hex = [(0.0, 0.0), (60.0, 0.0), (90.0, 30.0), (80.0, 70.0), (20.0, 80.0), (-10.0, 40.0)];
     let prism = |s: f64| {
         let o: Vec<(f64, f64)> = hex.iter().map(|&(x, y)| (x * s, y * s)).collect();
         common::prism(&o, 0.0, 2.0, 2).expect("prism")
     };
-    let (a, b, r) = match case.as_str() {
+    let (a, b, r) = match case {
         "box" => (
             common::cuboid(DVec3::ZERO, DVec3::new(100.0, 50.0, 2.0)),
             common::cuboid(DVec3::ZERO, DVec3::new(80.0, 60.0, 2.0)),
@@ -178,10 +176,23 @@ fn profile() {
             DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7),
         ),
     };
-    let n: usize = std::env::var("PROFILE_CALLS").ok().and_then(|s| s.parse().ok()).unwrap_or(10_000);
     let mut total = 0;
     for _ in 0..n {
         total += build_and_drop(&a, r, &b);
     }
     eprintln!("{case}: {n} calls, {total} faces");
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    match (args.get(1).map(String::as_str), args.get(2)) {
+        (Some("dump"), Some(path)) => dump(path),
+        (Some("profile"), Some(case)) => {
+            profile(case, args.get(3).and_then(|s| s.parse().ok()).unwrap_or(10_000));
+        }
+        _ => {
+            eprintln!("usage: obstacle_identity dump FILE | obstacle_identity profile box|prism|general [CALLS]");
+            std::process::exit(2);
+        }
+    }
 }
