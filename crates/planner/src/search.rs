@@ -772,10 +772,26 @@ impl std::fmt::Debug for States {
 ///
 /// The shared caches are held until the search is dropped (then handed back, as [`place_with_caches`] does).
 ///
-/// ```ignore
-/// let mut search = PlacementSearch::new(&request, &cache, &mut caches)?;
-/// let first = search.next_placements(8)?; // the 8 best
-/// let more = search.next_placements(24)?; // the next 24: as places 9..32 of a search with k = 32
+/// ```
+/// use glam::DVec3;
+/// use stackplan_cspace::ObstacleCache;
+/// use stackplan_geom::{ConvexPolytope, Part, PartOrigin, Pose};
+/// use stackplan_planner::{FloorVolume, PlacementRequest, PlacementSearch, SearchCaches, StackPart, uniform_thetas};
+///
+/// let block = ConvexPolytope::cuboid(DVec3::ZERO, DVec3::new(40.0, 20.0, 10.0)).unwrap();
+/// let part = Part::from_components("block", vec![block], 1.0, PartOrigin::ConvexPieces).unwrap();
+/// let stack = vec![StackPart { part: &part, pose: Pose::IDENTITY }];
+/// let mut request = PlacementRequest::new(&part, stack, FloorVolume::rectangle(-50.0, -50.0, 90.0, 70.0, 100.0));
+/// request.thetas = uniform_thetas(8);
+/// let (cache, mut caches) = (ObstacleCache::new(), SearchCaches::new());
+/// let mut search = PlacementSearch::new(&request, &cache, &mut caches).unwrap();
+/// let first = search.next_placements(2).unwrap(); // the 2 best
+/// let more = search.next_placements(3).unwrap(); // the next 3: places 3..5 of a search with k = 5
+/// assert!(first.placements.last().unwrap().cost <= more.placements[0].cost);
+/// drop(search); // hands the caches back
+/// request.k = 5;
+/// let once = stackplan_planner::place_with_caches(&request, &ObstacleCache::new(), &mut SearchCaches::new()).unwrap();
+/// assert_eq!([first.placements, more.placements].concat(), once.placements);
 /// ```
 pub struct PlacementSearch<'r, 'a, 'c> {
     search: Search<'r, 'a>,
