@@ -188,6 +188,9 @@ pub enum NoPlacement {
     EmptyOmega,
     /// Every free-space cell of every orientation was exhausted: the part fits nowhere.
     FitsNowhere,
+    /// Every placement not yet returned costs more than the limit given to
+    /// [`PlacementSearch::next_placements_within`] (the search stopped there and can go on).
+    CostLimit,
 }
 
 /// The result of a placement search.
@@ -208,7 +211,7 @@ struct Node<const D: usize> {
     id: u64,
     cell: Arc<Cell<D>>,
     optimum: QpOptimum<D>,
-    applied: Arc<Vec<u32>>,
+    applied: Arc<[u32]>,
 }
 
 /// The pending children of one split: the parent's cell plus the extra inequalities of child `face` of obstacle
@@ -217,15 +220,18 @@ struct Node<const D: usize> {
 /// when popped. The heap holds one entry per family, keyed by its cheapest remaining child (`children` is sorted
 /// so that it is the last): the heap pops the children in the same order as with one entry each (a family's key
 /// is the least of its children's, and a total order's least over a union is the least of the least ones), without
-/// holding the many children that are never popped.
+/// holding the many children that are never popped. The children live in one arena of the heap
+/// ([`NodeHeap::children`]: no allocation per family).
 struct Family<const D: usize> {
     orientation: usize,
     cell: Arc<Cell<D>>,
-    applied: Arc<Vec<u32>>,
+    applied: Arc<[u32]>,
     obstacle: u32,
     start: [f64; D],
-    /// `(key, id, face)`, the cheapest (by [`HeapKey`]'s order) last.
-    children: Vec<(f64, u64, u32)>,
+    /// The family's children are `NodeHeap::children[first..first + left]` (`(key, id, face)`), the cheapest (by
+    /// [`HeapKey`]'s order) last; popping one decrements `left`.
+    first: usize,
+    left: u32,
 }
 
 /// The state of the search's loop between calls ([`Search::advance`]): the open nodes, the next node id, the
@@ -241,6 +247,21 @@ struct RunState<const D: usize> {
     /// heap they cover every position not inside an obstacle applied so far, so a search into the grown stack can
     /// continue from both ([`SearchCaches::carrying_frontiers`]).
     free_nodes: Vec<Node<D>>,
+    /// Lists reused from node to node (no allocation per node once warm).
+    buffers: Buffers<D>,
+}
+
+/// The loop's reusable lists: a child's extra inequalities, a split's outside half-spaces and its children's keys.
+struct Buffers<const D: usize> {
+    extra: Vec<Halfspace<D>>,
+    outside: Vec<Outside<D>>,
+    children: Vec<(f64, u64, u32)>,
+}
+
+impl<const D: usize> Default for Buffers<D> {
+    fn default() -> Self {
+        Self { extra: Vec::new(), outside: Vec::new(), children: Vec::new() }
+    }
 }
 
 impl<const D: usize> RunState<D> {
@@ -324,11 +345,13 @@ struct NodeHeap<const D: usize> {
     slab: Vec<Option<Node<D>>>,
     free: Vec<u32>,
     families: Vec<Family<D>>,
+    /// The families' children, each family's a contiguous run ([`Family::first`]).
+    children: Vec<(f64, u64, u32)>,
 }
 
 impl<const D: usize> Default for NodeHeap<D> {
     fn default() -> Self {
-        Self { keys: BinaryHeap::new(), slab: Vec::new(), free: Vec::new(), families: Vec::new() }
+        Self { keys: BinaryHeap::new(), slab: Vec::new(), free: Vec::new(), families: Vec::new(), children: Vec::new() }
     }
 }
 
@@ -349,29 +372,26 @@ impl<const D: usize> NodeHeap<D> {
         self.keys.push(HeapKey { slot, ..key });
     }
 
-    /// Pushes a family of pending children (none: nothing to push).
-    fn push_family(&mut self, mut family: Family<D>) {
-        if family.children.is_empty() {
+    /// Pushes a family with the pending children `children` (`(key, id, face)`; drained; none: nothing to push).
+    /// `family.first` and `family.left` are set here.
+    fn push_family(&mut self, mut family: Family<D>, children: &mut Vec<(f64, u64, u32)>) {
+        if children.is_empty() {
             return;
         }
         // descending in (rounded key, id): the cheapest last
-        family
-            .children
-            .sort_unstable_by(|a, b| quantised_cost(b.0).total_cmp(&quantised_cost(a.0)).then(b.1.cmp(&a.1)));
+        children.sort_unstable_by(|a, b| quantised_cost(b.0).total_cmp(&quantised_cost(a.0)).then(b.1.cmp(&a.1)));
+        family.first = self.children.len();
+        family.left = children.len() as u32;
+        let &(cost, id, _) = children.last().unwrap_or(&(f64::INFINITY, 0, 0));
+        self.children.append(children);
         let index = self.families.len() as u32;
-        self.push_family_key(&family, index);
+        self.keys.push(HeapKey {
+            cost: quantised_cost(cost),
+            orientation: family.orientation as u32,
+            slot: index | FAMILY,
+            id,
+        });
         self.families.push(family);
-    }
-
-    fn push_family_key(&mut self, family: &Family<D>, index: u32) {
-        if let Some(&(cost, id, _)) = family.children.last() {
-            self.keys.push(HeapKey {
-                cost: quantised_cost(cost),
-                orientation: family.orientation as u32,
-                slot: index | FAMILY,
-                id,
-            });
-        }
     }
 
     fn pop(&mut self) -> Option<Popped<D>> {
@@ -379,8 +399,10 @@ impl<const D: usize> NodeHeap<D> {
         if key.slot & FAMILY != 0 {
             let index = key.slot & !FAMILY;
             let family = &mut self.families[index as usize];
-            let (_, id, face) = family.children.pop()?;
-            if let Some(&(cost, next, _)) = family.children.last() {
+            family.left = family.left.checked_sub(1)?;
+            let (_, id, face) = self.children[family.first + family.left as usize];
+            if family.left > 0 {
+                let (cost, next, _) = self.children[family.first + family.left as usize - 1];
                 let orientation = family.orientation as u32;
                 self.keys.push(HeapKey { cost: quantised_cost(cost), orientation, slot: key.slot, id: next });
             }
@@ -392,6 +414,11 @@ impl<const D: usize> NodeHeap<D> {
 
     fn len(&self) -> usize {
         self.keys.len()
+    }
+
+    /// The cheapest key's (rounded) cost: a lower bound of every cost the heap still holds.
+    fn peek_cost(&self) -> Option<f64> {
+        self.keys.peek().map(|key| key.cost)
     }
 
     fn is_empty(&self) -> bool {
@@ -866,6 +893,17 @@ impl<'r, 'a, 'c> PlacementSearch<'r, 'a, 'c> {
     /// The next `more` placements (fewer, with `exhausted` set, when the free space runs out); statistics over the
     /// whole search so far.
     pub fn next_placements(&mut self, more: usize) -> Result<PlacementResult, PlacementError> {
+        self.next_placements_within(more, f64::INFINITY)
+    }
+
+    /// The next `more` placements that cost at most `max_cost`: as [`Self::next_placements`], but the search stops
+    /// (fewer returned, `exhausted` = [`NoPlacement::CostLimit`]) as soon as every open node's key exceeds
+    /// `max_cost`; the keys are lower bounds of the costs of every placement still to come, so none of those costs
+    /// `max_cost` or less. The placements returned are those of [`Self::next_placements`] up to the first dearer
+    /// than `max_cost` (to the keys' rounding, [`quantised_cost`]: one may cost up to `2^-40` relative more), and a
+    /// later call, with any limit, continues exactly where this one stopped. Use: a caller that needs only
+    /// placements cheaper than one it already has (the stacking planner's stage 2 against stage 1's part).
+    pub fn next_placements_within(&mut self, more: usize, max_cost: f64) -> Result<PlacementResult, PlacementError> {
         let start = Instant::now();
         let before = self.cache.stats();
         let placements = match &mut self.state {
@@ -876,8 +914,8 @@ impl<'r, 'a, 'c> PlacementSearch<'r, 'a, 'c> {
                     stats: self.stats(),
                 });
             }
-            Some(States::Two(state)) => self.search.advance(state, more),
-            Some(States::Three(state)) => self.search.advance(state, more),
+            Some(States::Two(state)) => self.search.advance(state, more, max_cost),
+            Some(States::Three(state)) => self.search.advance(state, more, max_cost),
         };
         let after = self.cache.stats();
         self.cache_counts.0 += after.constructions - before.constructions;
@@ -887,8 +925,12 @@ impl<'r, 'a, 'c> PlacementSearch<'r, 'a, 'c> {
             // a failed call may have lost a popped node: this state is not carried on
             self.signature = None;
         }
-        let placements = placements?;
-        let exhausted = (placements.len() < more).then_some(NoPlacement::FitsNowhere);
+        let (placements, limited) = placements?;
+        let exhausted = (placements.len() < more).then_some(if limited {
+            NoPlacement::CostLimit
+        } else {
+            NoPlacement::FitsNowhere
+        });
         Ok(PlacementResult { placements, exhausted, stats: self.stats() })
     }
 
@@ -1009,7 +1051,7 @@ impl Search<'_, '_> {
                     id: state.next_id,
                     cell: Arc::new(cell),
                     optimum,
-                    applied: Arc::new(Vec::new()),
+                    applied: Arc::from([]),
                 });
                 state.next_id += 1;
             }
@@ -1039,7 +1081,7 @@ impl Search<'_, '_> {
                 stats: self.stats.clone(),
             });
         };
-        let placements = self.advance(&mut state, self.request.k)?;
+        let (placements, _) = self.advance(&mut state, self.request.k, f64::INFINITY)?;
         let exhausted = (placements.len() < self.request.k).then_some(NoPlacement::FitsNowhere);
         Ok(PlacementResult { placements, exhausted, stats: self.stats.clone() })
     }
@@ -1083,7 +1125,7 @@ impl Search<'_, '_> {
                         id: next_id,
                         cell: Arc::new(cell),
                         optimum,
-                        applied: Arc::new(Vec::new()),
+                        applied: Arc::from([]),
                     });
                 }
                 None => self.stats.orientations_empty_omega += 1,
@@ -1103,26 +1145,36 @@ impl Search<'_, '_> {
             found_points: Vec::new(),
             pops: 0,
             free_nodes: Vec::new(),
+            buffers: Buffers::default(),
         }))
     }
 
-    /// Continues the search from `state` until `want` more placements are found or the free space is exhausted
-    /// (fewer returned); the loop of the module documentation. Stopping after the `want`-th and calling again
-    /// continues exactly where one call with the sum of the `want`s would have been: the state is the whole loop's.
+    /// Continues the search from `state` until `want` more placements are found, the free space is exhausted or
+    /// the cheapest open key exceeds `max_cost` (fewer returned; `true` for the last); the loop of the module
+    /// documentation. Stopping after the `want`-th (or at the limit) and calling again continues exactly where one
+    /// call with the sum of the `want`s would have been: the state is the whole loop's.
     fn advance<const D: usize>(
         &mut self,
         state: &mut RunState<D>,
         want: usize,
-    ) -> Result<Vec<Placement>, PlacementError> {
-        let RunState { fixed_z, heap, next_id, considered, found_points, pops, free_nodes } = state;
+        max_cost: f64,
+    ) -> Result<(Vec<Placement>, bool), PlacementError> {
+        let RunState { fixed_z, heap, next_id, considered, found_points, pops, free_nodes, buffers } = state;
         let fixed_z = *fixed_z;
         let mut placements: Vec<Placement> = Vec::new();
         if want == 0 {
-            return Ok(placements);
+            return Ok((placements, false));
         }
         let clearance = self.request.clearance;
         let tol = self.tol.linear;
-        while let Some(popped) = heap.pop() {
+        let mut limited = false;
+        loop {
+            // the keys are lower bounds of every cost still to come: past the limit, nothing within it is left
+            if heap.peek_cost().is_some_and(|cost| cost > max_cost) {
+                limited = true;
+                break;
+            }
+            let Some(popped) = heap.pop() else { break };
             *pops += 1;
             if *pops > self.request.node_budget as u64 {
                 return Err(PlacementError::NodeBudget { budget: self.request.node_budget, found: found_points.len() });
@@ -1134,8 +1186,8 @@ impl Search<'_, '_> {
                     let f = &heap.families[family as usize];
                     let (orientation, cell, applied, obstacle, start) =
                         (f.orientation, Arc::clone(&f.cell), Arc::clone(&f.applied), f.obstacle, f.start);
-                    let extra = self.child_inequalities::<D>(obstacle, face, fixed_z);
-                    let solved = self.solve_child::<D>(orientation, &cell, &extra, &start, fixed_z)?;
+                    self.child_inequalities::<D>(obstacle, face, fixed_z, &mut buffers.extra);
+                    let solved = self.solve_child::<D>(orientation, &cell, &buffers.extra, &start, fixed_z)?;
                     if let Some((cell, optimum)) = solved {
                         heap.push(Node {
                             cost: optimum.value,
@@ -1248,20 +1300,22 @@ impl Search<'_, '_> {
                 continue;
             };
             let t_cells = Instant::now();
-            let children = self.split::<D>(node.orientation, id, fixed_z)?;
-            let mut applied: Vec<u32> = Vec::with_capacity(node.applied.len() + 1);
-            applied.extend_from_slice(&node.applied);
-            applied.push(id);
+            self.split::<D>(node.orientation, id, fixed_z, &mut buffers.outside)?;
+            // one allocation (an exact-size iterator collected into the shared slice)
+            let applied: Arc<[u32]> = node.applied.iter().copied().chain(std::iter::once(id)).collect();
             let q = restrict_quadratic::<D>(&self.orientations[node.orientation].quadratic, fixed_z);
-            let mut family = Family {
+            let family = Family {
                 orientation: node.orientation,
                 cell: Arc::clone(&node.cell),
-                applied: Arc::new(applied),
+                applied,
                 obstacle: id,
                 start: optimum.point,
-                children: Vec::with_capacity(children.len()),
+                first: 0,
+                left: 0,
             };
-            for (outside, face) in children {
+            let children = &mut buffers.children;
+            children.clear();
+            for &(outside, face) in &buffers.outside {
                 self.stats.nodes_pushed += 1;
                 // key: a lower bound of the child's cost, the largest of the parent's cost, the cost's minimum over
                 // the child's half-space outside the obstacle face (slack: twice the cell tolerance) and the bound
@@ -1274,14 +1328,14 @@ impl Search<'_, '_> {
                     2.0 * tol,
                     tol,
                 ));
-                family.children.push((node.cost.max(bound), *next_id, face));
+                children.push((node.cost.max(bound), *next_id, face));
                 *next_id += 1;
             }
-            heap.push_family(family);
+            heap.push_family(family, children);
             self.stats.time_cells_ms += ms(t_cells);
         }
         self.stats.orientations_considered = considered.iter().filter(|c| **c).count();
-        Ok(placements)
+        Ok((placements, limited))
     }
 
     /// The id of the derived obstacle of a pair at an orientation, building it on first use.
@@ -1350,10 +1404,11 @@ impl Search<'_, '_> {
         orientation: usize,
         id: u32,
         fixed_z: f64,
-    ) -> Result<Vec<Outside<D>>, PlacementError> {
+        children: &mut Vec<Outside<D>>,
+    ) -> Result<(), PlacementError> {
         let tol = self.tol.linear;
         let obstacle = &self.obstacles[id as usize];
-        let mut children = Vec::with_capacity(obstacle.planes.len());
+        children.clear();
         for (k, plane) in obstacle.planes.iter().enumerate() {
             match restrict::<D>(plane.normal, plane.offset, fixed_z, tol) {
                 Ok(outside) => children.push((outside, k as u32)),
@@ -1370,16 +1425,16 @@ impl Search<'_, '_> {
                 }
             }
         }
-        Ok(children)
+        Ok(())
     }
 
     /// The extra inequalities of child `face` of obstacle `id`: the inside cuts `n_j . p <= d_j` of the faces before
     /// it (restricted to the `D` variables; planes that do not depend on them are skipped, as in [`Search::split`])
-    /// and the outside `n_face . p >= d_face`. O(faces); the same values every time.
-    fn child_inequalities<const D: usize>(&self, id: u32, face: u32, fixed_z: f64) -> Vec<Halfspace<D>> {
+    /// and the outside `n_face . p >= d_face`, into `extra` (cleared first). O(faces); the same values every time.
+    fn child_inequalities<const D: usize>(&self, id: u32, face: u32, fixed_z: f64, extra: &mut Vec<Halfspace<D>>) {
         let tol = self.tol.linear;
         let planes = &self.obstacles[id as usize].planes;
-        let mut extra = Vec::with_capacity(face as usize + 1);
+        extra.clear();
         for (k, plane) in planes.iter().enumerate().take(face as usize + 1) {
             let Ok((normal, offset)) = restrict::<D>(plane.normal, plane.offset, fixed_z, tol) else {
                 continue;
@@ -1396,7 +1451,6 @@ impl Search<'_, '_> {
                 ));
             }
         }
-        extra
     }
 
     /// Builds a pending child's cell and solves its QP (`None` when empty).

@@ -343,6 +343,7 @@ pub fn plan_stack_with_progress(
             // same search up to `max_candidates`
             let limit =
                 if stage == last_stage && accepted.is_empty() { options.max_candidates } else { options.candidates };
+            let beaten_at = accepted.iter().map(|a| a.1.0.cost).reduce(f64::min);
             let started = std::time::Instant::now();
             let mut search = match PlacementSearch::new(&request, &cache, &mut caches) {
                 Ok(search) => search,
@@ -362,9 +363,13 @@ pub fn plan_stack_with_progress(
                     tracing::debug!(index, "every candidate failed the checks: searching for more");
                 }
                 let started = std::time::Instant::now();
-                let next = search.next_placements(1)?;
+                // a later stage's part is taken only when strictly cheaper than an earlier stage's (below): past the
+                // cheapest accepted cost the search has nothing left that could be taken
+                let next = search.next_placements_within(1, beaten_at.unwrap_or(f64::INFINITY))?;
                 stats.seconds_search += started.elapsed().as_secs_f64();
-                let Some(candidate) = next.placements.first() else {
+                let Some(candidate) =
+                    next.placements.first().filter(|c| beaten_at.is_none_or(|at| cheaper(c.cost, at)))
+                else {
                     if tested == 0 {
                         last_reason = match next.exhausted {
                             Some(NoPlacement::EmptyOmega) => "the floor volume is too small for the part".into(),
@@ -395,6 +400,14 @@ pub fn plan_stack_with_progress(
                 stage,
                 nodes = searched.nodes_expanded,
                 pairs = searched.pairs_evaluated,
+                known_cuts = searched.known_obstacle_cuts,
+                detections = searched.interference_tests,
+                pushed = searched.nodes_pushed,
+                qps = searched.qp_solves,
+                orientations = searched.orientations_considered,
+                ms_detect = searched.time_interference_ms,
+                ms_obstacles = searched.time_obstacles_ms,
+                ms_cells = searched.time_cells_ms,
                 ms = searched.time_total_ms,
                 "stage searched"
             );
@@ -402,8 +415,7 @@ pub fn plan_stack_with_progress(
         // stage 1 (compact) wins unless stage 2 is strictly cheaper: ties and near-ties keep the stack compact
         let best = accepted.iter().min_by(|a, b| {
             let (ca, cb) = (a.1.0.cost, b.1.0.cost);
-            let tie = (ca - cb).abs() <= 1e-9 * (1.0 + ca.abs().max(cb.abs()));
-            if tie { a.0.cmp(&b.0) } else { ca.total_cmp(&cb) }
+            if cheaper(ca, cb) || cheaper(cb, ca) { ca.total_cmp(&cb) } else { a.0.cmp(&b.0) }
         });
         if let Some((stage, (candidate, release_drop), rejected, grasp_radius)) = best.cloned() {
             let pose = candidate.pose();
@@ -460,6 +472,12 @@ pub fn plan_stack_with_progress(
 }
 
 /// The xy bounding rectangle of the placed parts.
+/// Whether cost `a` beats cost `b` outright: cheaper by more than a near-tie (`1e-9` relative), which keeps the
+/// earlier (more compact) stage's part.
+fn cheaper(a: f64, b: f64) -> bool {
+    b - a > 1e-9 * (1.0 + a.abs().max(b.abs()))
+}
+
 fn footprint(part: &Part, placed: &[Pose]) -> (DVec2, DVec2) {
     let mut lo = DVec2::splat(f64::INFINITY);
     let mut hi = DVec2::splat(f64::NEG_INFINITY);

@@ -5,7 +5,7 @@
 use stackplan_cspace::ObstacleCache;
 use stackplan_planner::regress::{Scenario, scenario};
 use stackplan_planner::search::{PlacementSearch, SearchCaches, place_with_caches};
-use stackplan_planner::{Cost, PlacementRequest, StackPart, uniform_thetas};
+use stackplan_planner::{Cost, NoPlacement, PlacementRequest, StackPart, uniform_thetas};
 
 fn request<'a>(sc: &'a Scenario, k: usize) -> PlacementRequest<'a> {
     let stack: Vec<StackPart<'a>> = sc.stack.iter().map(|p| StackPart { part: &sc.part, pose: *p }).collect();
@@ -66,4 +66,32 @@ fn continued_triangle_search_equals_one_search() {
 #[test]
 fn continued_complex_search_equals_one_search() {
     check("complex", &[2, 4]);
+}
+
+/// A search stopped by a cost limit returns exactly the placements of the unlimited search that cost at most the
+/// limit, says why it stopped ([`NoPlacement::CostLimit`]), and a later call without the limit goes on with the
+/// rest, as one search would.
+#[test]
+fn cost_limited_calls_return_the_cheap_prefix_and_continue() {
+    let sc = scenario("triangle").expect("scenario").expect("known scenario");
+    let whole = place_with_caches(&request(&sc, 8), &ObstacleCache::new(), &mut SearchCaches::new()).expect("one");
+    assert!(whole.placements.len() == 8, "too few placements to compare");
+    // a limit between two distinct costs of the sequence
+    let split = (1..whole.placements.len())
+        .rev()
+        .find(|&i| whole.placements[i].cost > whole.placements[i - 1].cost * (1.0 + 1e-9))
+        .expect("two distinct costs");
+    let limit = 0.5 * (whole.placements[split - 1].cost + whole.placements[split].cost);
+    let req = request(&sc, 1);
+    let (cache, mut caches) = (ObstacleCache::new(), SearchCaches::new());
+    let mut search = PlacementSearch::new(&req, &cache, &mut caches).expect("prepared");
+    let cheap = search.next_placements_within(100, limit).expect("limited");
+    assert_eq!(cheap.placements, whole.placements[..split], "the placements within the limit");
+    assert_eq!(cheap.exhausted, Some(NoPlacement::CostLimit));
+    // nothing more within the same limit
+    let none = search.next_placements_within(1, limit).expect("again");
+    assert!(none.placements.is_empty());
+    assert_eq!(none.exhausted, Some(NoPlacement::CostLimit));
+    let rest = search.next_placements(whole.placements.len() - split).expect("continued");
+    assert_eq!(rest.placements, whole.placements[split..], "the rest after the limit");
 }
