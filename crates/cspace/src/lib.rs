@@ -15,6 +15,7 @@ mod edge_table;
 pub mod interference;
 pub mod minkowski;
 pub mod offset;
+mod z_prism;
 
 pub use cache::{CacheStats, ObstacleCache};
 pub use interference::{InterferencePair, PairContact, PlacedConvex, PlacedScene, Placement};

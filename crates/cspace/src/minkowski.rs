@@ -59,6 +59,7 @@ use stackplan_geom::tolerance::{RELATIVE, Tolerance};
 use stackplan_geom::{HullError, convex_hull};
 
 use crate::edge_table::{self, EdgeScratch};
+use crate::z_prism;
 
 /// Angular tolerance (radians) of the Gauss-map decisions: a face normal within this of an arc's circle lies on it;
 /// two face normals within half of it are the same direction.
@@ -395,8 +396,6 @@ struct Arc {
     from: usize,
     /// Face at the end of the arc.
     to: usize,
-    /// End vertices of the edge.
-    vertices: [usize; 2],
 }
 
 /// Arcs of a polytope whose vertices are `vertices` and face normals `normals` (edge topology from `p`), into `out`.
@@ -406,7 +405,7 @@ fn arcs(p: &ConvexPolytope, vertices: &[DVec3], normals: &[DVec3], out: &mut Vec
         let d = (vertices[e.vertices[1]] - vertices[e.vertices[0]]).normalize();
         let (n0, n1) = (normals[e.faces[0]], normals[e.faces[1]]);
         let circle = if n0.cross(n1).dot(d) >= 0.0 { d } else { -d };
-        Arc { circle, from: e.faces[0], to: e.faces[1], vertices: e.vertices }
+        Arc { circle, from: e.faces[0], to: e.faces[1] }
     }));
 }
 
@@ -458,6 +457,7 @@ struct Scratch {
     cycle: Vec<[usize; 2]>,
     planar: PlanarScratch,
     edges: EdgeScratch,
+    prism: z_prism::Scratch,
 }
 
 thread_local! {
@@ -505,6 +505,7 @@ fn overlay(
         cycle,
         planar,
         edges,
+        prism,
     } = scratch;
     ra.clear();
     ra.extend(moving.vertices().iter().map(|a| rotation * *a));
@@ -516,15 +517,7 @@ fn overlay(
     let bv = fixed.vertices();
     bn.clear();
     bn.extend(fixed.faces().iter().map(|f| f.plane.normal));
-    arcs(moving, neg_ra, am, a_arcs);
-    arcs(fixed, bv, bn, b_arcs);
-    let (am, bn, a_arcs, b_arcs) = (&*am, &*bn, &*a_arcs, &*b_arcs);
     let (fa, fb) = (am.len(), bn.len());
-
-    // sides: s_ab[e * fb + g] = side of B's normal g w.r.t. the circle of A-arc e; s_ba[e * fa + f] likewise.
-    sign_table(a_arcs, bn, s_ab);
-    sign_table(b_arcs, am, s_ba);
-    let (s_ab, s_ba) = (&*s_ab, &*s_ba);
 
     // parallel faces: merged_with_b[f] = Some(g) when -R n_f == n_g within half the tolerance.
     merged_with_b.clear();
@@ -539,8 +532,29 @@ fn overlay(
             }
         }
     }
-
     faces.clear();
+
+    // two z-prisms turned about z (sheet metal): the same faces without sign tables or crossings (`z_prism.rs`)
+    if !general_route_only()
+        && z_prism::vertical_arcs(moving, neg_ra, am, &mut prism.classes, &mut prism.a)
+        && z_prism::vertical_arcs(fixed, bv, bn, &mut prism.classes, &mut prism.b)
+    {
+        #[cfg(test)]
+        z_prism::TAKEN.with(|c| c.set(c.get() + 1));
+        z_prism::face_specs(am, bn, &prism.a, &prism.b, neg_ra, bv, merged_with_a, merged_with_b, faces)?;
+        let buffers = AssemblyBuffers { index_of, cycle, planar, merged_with_b, neg_ra, edges };
+        return assemble(moving, fixed, rotation, ra, faces, buffers);
+    }
+
+    arcs(moving, neg_ra, am, a_arcs);
+    arcs(fixed, bv, bn, b_arcs);
+    let (am, bn, a_arcs, b_arcs) = (&*am, &*bn, &*a_arcs, &*b_arcs);
+
+    // sides: s_ab[e * fb + g] = side of B's normal g w.r.t. the circle of A-arc e; s_ba[e * fa + f] likewise.
+    sign_table(a_arcs, bn, s_ab);
+    sign_table(b_arcs, am, s_ba);
+    let (s_ab, s_ba) = (&*s_ab, &*s_ba);
+
     // 1. faces of B
     for (g, &u) in bn.iter().enumerate() {
         let moving_feature = if let Some(f) = merged_with_a[g] {
@@ -641,7 +655,7 @@ fn overlay(
         }
     }
     let buffers = AssemblyBuffers { index_of, cycle, planar, merged_with_b, neg_ra, edges };
-    assemble(moving, fixed, rotation, ra, a_arcs, b_arcs, faces, buffers)
+    assemble(moving, fixed, rotation, ra, faces, buffers)
 }
 
 #[cfg(test)]
@@ -661,13 +675,30 @@ fn one_by_one_crossings() -> bool {
     false
 }
 
-struct FaceSpec {
-    normal: DVec3,
-    fixed: Feature,
-    moving: Feature,
+#[cfg(test)]
+thread_local! {
+    /// Tests: take the general overlay even for a z-prism pair (`z_prism.rs`).
+    pub(crate) static GENERAL_ROUTE_ONLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
-fn argmax(points: &[DVec3], u: DVec3) -> usize {
+#[cfg(test)]
+fn general_route_only() -> bool {
+    GENERAL_ROUTE_ONLY.with(std::cell::Cell::get)
+}
+
+#[cfg(not(test))]
+#[inline]
+fn general_route_only() -> bool {
+    false
+}
+
+pub(crate) struct FaceSpec {
+    pub(crate) normal: DVec3,
+    pub(crate) fixed: Feature,
+    pub(crate) moving: Feature,
+}
+
+pub(crate) fn argmax(points: &[DVec3], u: DVec3) -> usize {
     let mut best = 0;
     let mut best_value = f64::NEG_INFINITY;
     for (i, p) in points.iter().enumerate() {
@@ -701,7 +732,6 @@ impl Polygon {
         &mut self,
         p: &ConvexPolytope,
         feature: Feature,
-        arcs: &[Arc],
         reflect: bool,
         points: &[DVec3],
         normal: DVec3,
@@ -714,7 +744,7 @@ impl Polygon {
         across.clear();
         match feature {
             Feature::Vertex(v) => corners.push(v),
-            Feature::Edge(e) => corners.extend_from_slice(&arcs[e].vertices),
+            Feature::Edge(e) => corners.extend_from_slice(&p.edges()[e].vertices),
             Feature::Face(f) => {
                 let cycle = &p.faces()[f].vertices;
                 if reflect {
@@ -787,8 +817,6 @@ fn assemble(
     fixed: &ConvexPolytope,
     rotation: DMat3,
     ra: &[DVec3],
-    a_arcs: &[Arc],
-    b_arcs: &[Arc],
     specs: &[FaceSpec],
     buffers: AssemblyBuffers<'_>,
 ) -> Result<Obstacle, OverlayFailure> {
@@ -812,8 +840,8 @@ fn assemble(
                 cycle.extend(moving.faces()[f].vertices.iter().rev().map(|&i| [i, j]));
             }
             (Feature::Edge(eb), Feature::Edge(ea)) => {
-                let [j0, j1] = b_arcs[eb].vertices;
-                let [i0, i1] = a_arcs[ea].vertices;
+                let [j0, j1] = fixed.edges()[eb].vertices;
+                let [i0, i1] = moving.edges()[ea].vertices;
                 // p00 -> p01 runs along B's edge, p01 -> p11 along -RA's edge
                 let d_b = bv[j1] - bv[j0];
                 let d_a = ra[i0] - ra[i1];
@@ -825,21 +853,21 @@ fn assemble(
             }
             (Feature::Face(g), Feature::Edge(ea)) => {
                 let corners = &fixed.faces()[g].vertices;
-                let [i0, i1] = a_arcs[ea].vertices;
+                let [i0, i1] = moving.edges()[ea].vertices;
                 face_plus_segment::<true>(corners, bv, [i0, i1], neg_ra, spec.normal, &mut scratch.classes, cycle);
             }
             (Feature::Edge(eb), Feature::Face(f)) => {
                 let corners = &mut scratch.a.corners;
                 corners.clear();
                 corners.extend(moving.faces()[f].vertices.iter().rev());
-                let [j0, j1] = b_arcs[eb].vertices;
+                let [j0, j1] = fixed.edges()[eb].vertices;
                 face_plus_segment::<false>(corners, neg_ra, [j0, j1], bv, spec.normal, &mut scratch.classes, cycle);
             }
             (fixed_feature, moving_feature) => {
                 let n = spec.normal;
                 let both_faces = matches!((fixed_feature, moving_feature), (Feature::Face(_), Feature::Face(_)));
-                let r = scratch.b.build(fixed, fixed_feature, b_arcs, false, bv, n, None, both_faces);
-                scratch.a.build(moving, moving_feature, a_arcs, true, neg_ra, n, Some(r), both_faces);
+                let r = scratch.b.build(fixed, fixed_feature, false, bv, n, None, both_faces);
+                scratch.a.build(moving, moving_feature, true, neg_ra, n, Some(r), both_faces);
                 planar_merge(merged_with_b, n, both_faces, scratch, cycle);
             }
         }

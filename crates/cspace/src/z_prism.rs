@@ -1,0 +1,266 @@
+//! The Gauss-map overlay of two z-prisms turned about `z`: the sheet-metal case of [`crate::minkowski`], exactly.
+//!
+//! Paper: Ayyadevara et al. 2002 ([A]) App. B, eq. 12 (`C(A, B) = ConvexHull{ V_j^B - R V_i^A }`); the overlay of the
+//! two normal fans is the one of [`crate::minkowski`] (its module documentation has the algorithm and the tolerance).
+//!
+//! A *z-prism* here is a polytope whose every face normal is either a **side** normal (`z` component exactly 0) or a
+//! **pole** (`x` and `y` components exactly 0), whose edges between two side faces are exactly vertical (end points
+//! with equal `x` and `y`), whose edges between a side face and a pole are exactly horizontal (equal `z`), and with no
+//! edge between two poles; for `-RA` this is tested on the rotated data, so it holds for a z-prism rotated about `z`
+//! (`R` keeps `z` components exact) and fails otherwise. Sheet-metal plates and their obstacles under the planner's
+//! rotations about `z` are such pairs. For them most numbers the general overlay computes are exactly zero, by the
+//! data, not by a tolerance:
+//!
+//! * the circle of a vertical edge's arc is `(±0, ±0, c)`, so its product with a side normal is exactly `±0`; the
+//!   circle of a horizontal edge's arc is `(x, y, ±0)`, so its product with a pole is exactly `±0`;
+//! * hence no two arcs cross properly (a crossing needs both end normals of each arc strictly on opposite sides of the
+//!   other's circle, and every arc has an end normal with a zero product with the circles of the other kind): there
+//!   are no `edge_edge` faces;
+//! * a side normal lies strictly inside no horizontal arc (one of the two cross products the test takes is of two side
+//!   normals, `(±0, ±0, w)`, against a circle with zero `z`: exactly `±0`, not positive), and a pole lies strictly
+//!   inside no arc at all (pole x pole is the zero vector; side x pole against a vertical circle is `±0`).
+//!
+//! So the support feature of a side face of one summand is found among the vertical arcs of the other with the
+//! general route's own test (`strictly_inside_arc`, in the same order, with the same ambiguity check; with a circle
+//! `(±0, ±0, c)` and normals with zero `z` its value is exactly `w * c` for the `z` component `w` of the cross
+//! product, the only term computed here), a pole that is not merged with a face of the other summand is supported by a
+//! vertex, and the face list is the general route's steps 1 and 2 with step 3 empty: the same `FaceSpec`s in the same
+//! order, handed to the same assembly, so the obstacle is bit for bit the general route's (checked by
+//! `examples/obstacle_identity.rs dump` and by the unit test in `minkowski.rs` on pairs of prisms at many angles).
+//! What is saved: both sign tables (`EA FB + EB FA` products), the arc-crossing pass, the circles of the horizontal
+//! arcs and most of the support tests' arithmetic.
+//!
+//! Complexity: O(E + F) to recognise the pair, O(FA FB) for the parallel faces (as in the general route) and
+//! O(FB EA_v + FA EB_v) for the support searches over the `EA_v`, `EB_v` vertical arcs.
+
+use glam::DVec3;
+use stackplan_geom::polytope::ConvexPolytope;
+
+use crate::minkowski::{FaceSpec, Feature, OverlayFailure, argmax};
+
+/// A vertical arc: its edge, the `x`, `y` of the normals at its start and end, and the `z` of its circle (the general
+/// route's circle is `(±0, ±0, cz)`).
+#[derive(Clone, Copy)]
+pub(crate) struct VerticalArc {
+    edge: usize,
+    from: [f64; 2],
+    to: [f64; 2],
+    cz: f64,
+}
+
+/// Working buffers, kept per thread with the overlay's.
+#[derive(Default)]
+pub(crate) struct Scratch {
+    /// The kind of every face normal of the polytope being looked at: 0 side, 1 pole.
+    pub(crate) classes: Vec<u8>,
+    /// The vertical arcs of `-RA` and of `B`.
+    pub(crate) a: Vec<VerticalArc>,
+    pub(crate) b: Vec<VerticalArc>,
+}
+
+const SIDE: u8 = 0;
+const POLE: u8 = 1;
+
+/// Whether `d` is a usable edge vector: its squared length is a positive normal number (so its normalisation is
+/// finite, and a zero component stays an exact zero).
+#[inline]
+fn proper(d: DVec3) -> bool {
+    let l = d.length_squared();
+    l >= f64::MIN_POSITIVE && l.is_finite()
+}
+
+/// The vertical arcs of `p` (vertices `vertices`, face normals `normals`) into `out`, in edge order, when `p` is a
+/// z-prism (see the module documentation), else `false` (the buffers then hold garbage). The circle is the general
+/// route's (`minkowski::arcs`, the same operations).
+pub(crate) fn vertical_arcs(
+    p: &ConvexPolytope,
+    vertices: &[DVec3],
+    normals: &[DVec3],
+    classes: &mut Vec<u8>,
+    out: &mut Vec<VerticalArc>,
+) -> bool {
+    classes.clear();
+    for n in normals {
+        classes.push(if n.z == 0.0 && n.x.is_finite() && n.y.is_finite() {
+            SIDE
+        } else if n.x == 0.0 && n.y == 0.0 && n.z.is_finite() {
+            POLE
+        } else {
+            return false;
+        });
+    }
+    out.clear();
+    for (k, e) in p.edges().iter().enumerate() {
+        let [f0, f1] = e.faces;
+        let d = vertices[e.vertices[1]] - vertices[e.vertices[0]];
+        match classes[f0] + classes[f1] {
+            0 => {
+                if !(d.x == 0.0 && d.y == 0.0 && proper(d)) {
+                    return false;
+                }
+                let (n0, n1) = (normals[f0], normals[f1]);
+                // exactly the general route's circle (`minkowski::arcs`)
+                let d = d.normalize();
+                let circle = if n0.cross(n1).dot(d) >= 0.0 { d } else { -d };
+                if circle.z == 0.0 || !circle.z.is_finite() {
+                    return false;
+                }
+                out.push(VerticalArc { edge: k, from: [n0.x, n0.y], to: [n1.x, n1.y], cz: circle.z });
+            }
+            1 => {
+                if !(d.z == 0.0 && proper(d)) {
+                    return false;
+                }
+            }
+            _ => return false,
+        }
+    }
+    true
+}
+
+/// The support feature of the other summand for the face normal `u` that is merged with none of its faces: an edge
+/// whose (vertical) arc holds `u` strictly inside, else the vertex `argmax(points, u)`; as the general route decides.
+#[inline]
+fn support(u: DVec3, arcs: &[VerticalArc], points: &[DVec3]) -> Result<Feature, OverlayFailure> {
+    if u.z != 0.0 {
+        // a pole lies strictly inside no arc
+        return Ok(Feature::Vertex(argmax(points, u)));
+    }
+    let mut found = None;
+    for arc in arcs {
+        // `strictly_inside_arc`: the z components of `from x u` and `u x to` (glam's operand order) times the
+        // circle's z; the other terms of the general route's dot products are exact zeros
+        let ([fx, fy], [tx, ty]) = (arc.from, arc.to);
+        if (fx * u.y - u.x * fy) * arc.cz > 0.0 && (u.x * ty - tx * u.y) * arc.cz > 0.0 {
+            if found.is_some() {
+                return Err(OverlayFailure::AmbiguousSupport);
+            }
+            found = Some(arc.edge);
+        }
+    }
+    Ok(match found {
+        Some(e) => Feature::Edge(e),
+        None => Feature::Vertex(argmax(points, u)),
+    })
+}
+
+/// Steps 1 and 2 of the overlay (step 3, the arc crossings, is empty) for a z-prism pair whose vertical arcs came
+/// from [`vertical_arcs`]: the faces of `B`, then those of `-RA` not parallel to a face of `B`, into `faces`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn face_specs(
+    am: &[DVec3],
+    bn: &[DVec3],
+    a_arcs: &[VerticalArc],
+    b_arcs: &[VerticalArc],
+    neg_ra: &[DVec3],
+    bv: &[DVec3],
+    merged_with_a: &[Option<usize>],
+    merged_with_b: &[Option<usize>],
+    faces: &mut Vec<FaceSpec>,
+) -> Result<(), OverlayFailure> {
+    for (g, &u) in bn.iter().enumerate() {
+        let moving = match merged_with_a[g] {
+            Some(f) => Feature::Face(f),
+            None => support(u, a_arcs, neg_ra)?,
+        };
+        faces.push(FaceSpec { normal: u, fixed: Feature::Face(g), moving });
+    }
+    for (f, &u) in am.iter().enumerate() {
+        if merged_with_b[f].is_some() {
+            continue;
+        }
+        let fixed = support(u, b_arcs, bv)?;
+        faces.push(FaceSpec { normal: u, fixed, moving: Feature::Face(f) });
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Tests: how many overlays took this route.
+    pub(crate) static TAKEN: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::minkowski::{GENERAL_ROUTE_ONLY, gauss_map_obstacle};
+    use glam::{DMat3, DVec3};
+    use stackplan_geom::{ConvexPolytope, convex_hull};
+
+    /// The outline `(x, y)` extruded over `[z0, z1]` along `z` (`axis` 2) or along `x` (`axis` 0).
+    fn prism(outline: &[(f64, f64)], z0: f64, z1: f64, axis: usize) -> ConvexPolytope {
+        let pts: Vec<DVec3> = outline
+            .iter()
+            .flat_map(|&(x, y)| [z0, z1].map(|z| if axis == 0 { DVec3::new(z, x, y) } else { DVec3::new(x, y, z) }))
+            .collect();
+        convex_hull(&pts).expect("prism").polytope
+    }
+
+    #[test]
+    fn z_prism_route_equals_the_general_overlay() {
+        // boxes, the bench's hexagons, regular and irregular outlines (some sharing edge directions), extruded along
+        // z (this route) or x (the general one); rotations about z at generic angles, quarter turns (rounded and
+        // exact), angles around the angular tolerance, and one general rotation
+        let hex = [(0.0, 0.0), (60.0, 0.0), (90.0, 30.0), (80.0, 70.0), (20.0, 80.0), (-10.0, 40.0)];
+        let mut shapes = vec![
+            ConvexPolytope::cuboid(DVec3::ZERO, DVec3::new(100.0, 50.0, 2.0)).expect("box"),
+            ConvexPolytope::cuboid(DVec3::new(-1.0, 0.5, 0.0), DVec3::new(4.0, 5.0, 6.0)).expect("box"),
+            prism(&hex, 0.0, 2.0, 2),
+            prism(&hex.map(|(x, y)| (x * 0.7, y * 0.7)), 0.0, 2.0, 2),
+            prism(&[(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 2.0)], -0.5, 0.25, 2),
+            prism(&[(0.0, 0.0), (1.5, 0.5), (0.5, 1.5)], 0.0, 0.75, 2),
+            prism(&[(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 2.0)], -0.5, 0.25, 0),
+        ];
+        for (n, turn) in [(5, 0.1), (8, 0.0), (7, 1.3)] {
+            let outline: Vec<(f64, f64)> = (0..n)
+                .map(|k| {
+                    let t = turn + k as f64 * std::f64::consts::TAU / n as f64;
+                    (3.0 * t.cos(), 2.0 * t.sin())
+                })
+                .collect();
+            shapes.push(prism(&outline, -1.0, 1.0, 2));
+        }
+        let mut rotations: Vec<DMat3> = (0..52).map(|k| DMat3::from_rotation_z(k as f64 * 0.1234)).collect();
+        for t in [1e-12, 3e-10, 5e-10, 7e-10, 1e-9, 2e-9, 1e-6] {
+            rotations.push(DMat3::from_rotation_z(t));
+            rotations.push(DMat3::from_rotation_z(-t));
+            rotations.push(DMat3::from_rotation_z(std::f64::consts::FRAC_PI_2 + t));
+        }
+        for k in 1..8 {
+            rotations.push(DMat3::from_rotation_z(k as f64 * std::f64::consts::FRAC_PI_4));
+        }
+        rotations.push(DMat3::from_cols(DVec3::Y, -DVec3::X, DVec3::Z));
+        rotations.push(DMat3::from_cols(-DVec3::X, -DVec3::Y, DVec3::Z));
+        rotations.push(DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7));
+        // the z-prisms among them (not the x-extruded one; not the 7-gon, whose top normal has a rounded x of 3e-17)
+        let z_prisms = shapes
+            .iter()
+            .filter(|s| {
+                let n: Vec<DVec3> = s.faces().iter().map(|f| f.plane.normal).collect();
+                super::vertical_arcs(s, s.vertices(), &n, &mut Vec::new(), &mut Vec::new())
+            })
+            .count();
+        assert_eq!(z_prisms, 8);
+        let taken_before = super::TAKEN.with(std::cell::Cell::get);
+        let (mut cases, mut merged) = (0, 0);
+        for a in &shapes {
+            for b in &shapes {
+                for &r in &rotations {
+                    let fast = format!("{:?}", gauss_map_obstacle(a, r, b));
+                    GENERAL_ROUTE_ONLY.with(|c| c.set(true));
+                    let general = gauss_map_obstacle(a, r, b);
+                    GENERAL_ROUTE_ONLY.with(|c| c.set(false));
+                    assert_eq!(fast, format!("{general:?}"), "{a:?} {r:?} {b:?}");
+                    cases += 1;
+                    if let Ok(o) = general {
+                        merged += o.polytope().faces().len();
+                    }
+                }
+            }
+        }
+        let taken = super::TAKEN.with(std::cell::Cell::get) - taken_before;
+        // every pair of z-prisms under every rotation about z (all but the last rotation), and no other
+        assert_eq!(taken, z_prisms * z_prisms * (rotations.len() - 1), "{taken} of {cases}");
+        assert!(merged > 0);
+    }
+}
