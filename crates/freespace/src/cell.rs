@@ -147,10 +147,82 @@ pub enum CellError {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Cell<const D: usize> {
     halfspaces: Vec<Halfspace<D>>,
-    rows: Vec<V4>,
-    offsets: Vec<f64>,
+    /// The solvers' lists in one buffer: the `m` normals as 4-vectors, then the `m` offsets packed four to an entry
+    /// (see [`Cell::rows`], [`Cell::offsets`]).
+    lists: Vec<V4>,
     tolerance: Tolerance,
     shape: CellShape<D>,
+    /// Whether every normal is a fixed point of [`unit_halfspace`] (its computed length is exactly 1.0), so that
+    /// normalising the inequalities again is the identity ([`Cell::extended`] then copies them). `false` only makes
+    /// `extended` normalise them again.
+    unit: bool,
+}
+
+/// Euclidean length of a normal as the cells compute it (sum of squares in order, then the square root).
+#[inline]
+fn length<const D: usize>(normal: &[f64; D]) -> f64 {
+    normal.iter().map(|c| c * c).sum::<f64>().sqrt()
+}
+
+/// `h` scaled to a unit normal (`None` for a zero normal): the normal and the offset divided by the computed length.
+/// The flag says whether the result is a fixed point: its computed length is exactly 1.0, so normalising it again
+/// divides by 1.0 and leaves it unchanged, bit for bit. (About three in four normals; the others move by an ulp
+/// when normalised again, some of them back and forth.) O(D).
+#[inline]
+fn unit_halfspace<const D: usize>(h: &Halfspace<D>) -> Option<(Halfspace<D>, bool)> {
+    let len = length(&h.normal);
+    (len > 0.0).then(|| {
+        let u = Halfspace { normal: h.normal.map(|c| c / len), offset: h.offset / len, tag: h.tag };
+        (u, length(&u.normal) == 1.0)
+    })
+}
+
+/// The packed lists of a cell's (normalised) inequalities: their normals as 4-vectors, then their offsets four to an
+/// entry. One allocation.
+fn pack<const D: usize>(halfspaces: &[Halfspace<D>]) -> Vec<V4> {
+    let m = halfspaces.len();
+    let mut lists = Vec::with_capacity(m + m.div_ceil(MAX_N));
+    lists.extend(halfspaces.iter().map(|h| to_v4(&h.normal)));
+    for chunk in halfspaces.chunks(MAX_N) {
+        let mut v = [0.0; MAX_N];
+        for (slot, h) in v.iter_mut().zip(chunk) {
+            *slot = h.offset;
+        }
+        lists.push(v);
+    }
+    lists
+}
+
+/// Appends `halfspaces` normalised ([`unit_halfspace`]) to `kept`, as [`Cell::new`] keeps them: a non-finite
+/// coefficient is an error (index `first_index + k`); a zero normal is dropped when it holds (`0 <= offset + tol`)
+/// and kept when it fails. Returns whether one failed (the cell is empty); `unit` is cleared when a kept inequality
+/// is not a fixed point of the normalisation. O(1) per inequality.
+fn push_normalised<const D: usize>(
+    kept: &mut Vec<Halfspace<D>>,
+    unit: &mut bool,
+    halfspaces: &[Halfspace<D>],
+    first_index: usize,
+    tolerance: Tolerance,
+) -> Result<bool, CellError> {
+    let mut trivially_empty = false;
+    for (k, h) in halfspaces.iter().enumerate() {
+        if !h.offset.is_finite() || h.normal.iter().any(|c| !c.is_finite()) {
+            return Err(CellError::NonFinite { index: first_index + k });
+        }
+        match unit_halfspace(h) {
+            Some((u, fixed)) => {
+                kept.push(u);
+                *unit &= fixed;
+            }
+            None if h.offset < -tolerance.linear => {
+                trivially_empty = true;
+                kept.push(*h);
+                *unit = false;
+            }
+            None => {}
+        }
+    }
+    Ok(trivially_empty)
 }
 
 /// The default tie-break order: lowest z, then y, then x (D = 3); lowest y then x (D = 2).
@@ -206,23 +278,11 @@ impl<const D: usize> Cell<D> {
     fn normalised(halfspaces: Vec<Halfspace<D>>, tolerance: Tolerance) -> Result<Self, CellError> {
         let () = Self::DIM_OK;
         let mut kept = Vec::with_capacity(halfspaces.len());
-        let mut trivially_empty = false;
-        for (index, h) in halfspaces.into_iter().enumerate() {
-            if !h.offset.is_finite() || h.normal.iter().any(|c| !c.is_finite()) {
-                return Err(CellError::NonFinite { index });
-            }
-            let len = h.normal.iter().map(|c| c * c).sum::<f64>().sqrt();
-            if len > 0.0 {
-                kept.push(Halfspace { normal: h.normal.map(|c| c / len), offset: h.offset / len, tag: h.tag });
-            } else if h.offset < -tolerance.linear {
-                trivially_empty = true;
-                kept.push(h);
-            }
-        }
-        let rows: Vec<V4> = kept.iter().map(|h| to_v4(&h.normal)).collect();
-        let offsets: Vec<f64> = kept.iter().map(|h| h.offset).collect();
+        let mut unit = true;
+        let trivially_empty = push_normalised(&mut kept, &mut unit, &halfspaces, 0, tolerance)?;
+        let lists = pack(&kept);
         let shape = if trivially_empty { CellShape::Empty } else { CellShape::Known { point: [0.0; D] } };
-        Ok(Self { halfspaces: kept, rows, offsets, tolerance, shape })
+        Ok(Self { halfspaces: kept, lists, tolerance, shape, unit })
     }
 
     /// The inequalities (unit normals), in order; active-constraint indices refer to this list.
@@ -361,7 +421,7 @@ impl<const D: usize> Cell<D> {
         let exact = match &built {
             Ok(cell) if cell.shape != CellShape::Empty => {
                 let mask = &mut scratch.mask;
-                phase_one_rows(&cell.rows, &cell.offsets, start, mask, self.length_scale())
+                phase_one_rows(cell.rows(), cell.offsets(), start, mask, self.length_scale())
             }
             Ok(_) => Ok(None),
             Err(e) => Err(e.clone()),
@@ -384,42 +444,44 @@ impl<const D: usize> Cell<D> {
     }
 
     /// This cell (non-empty, so every normal is non-zero) with `extra` added, normalised as by [`Cell::new`] (the
-    /// same arithmetic, the same lists as `Cell::new` of all the inequalities). Shape [`CellShape::Empty`] when an
-    /// extra inequality with a zero normal fails, otherwise (provisionally) [`CellShape::Known`] at the origin.
+    /// same arithmetic, the same lists as `Cell::new` of all the inequalities, bit for bit). Shape
+    /// [`CellShape::Empty`] when an extra inequality with a zero normal fails, otherwise (provisionally)
+    /// [`CellShape::Known`] at the origin.
+    ///
+    /// When every inequality of this cell is a fixed point of the normalisation (`unit`), normalising them again is
+    /// the identity, so they are copied (`extend_from_slice` of the inequalities, the rows and the offsets: O(m)
+    /// copies, no square root or division); only `extra` is normalised. Otherwise they are normalised again one by
+    /// one, as `Cell::new` would. One allocation for the inequalities, one for the rows and offsets.
     fn extended(&self, extra: &[Halfspace<D>]) -> Result<Self, CellError> {
-        let m = self.halfspaces.len() + extra.len();
-        let mut halfspaces = Vec::with_capacity(m);
-        let mut rows = Vec::with_capacity(m);
-        let mut offsets = Vec::with_capacity(m);
-        // normalised again as `Cell::new` does (dividing a unit normal by its computed length can move its last
-        // bit, and the child must equal `with_halfspaces`'s bit for bit)
-        for h in &self.halfspaces {
-            let len = h.normal.iter().map(|c| c * c).sum::<f64>().sqrt();
-            let kept = Halfspace { normal: h.normal.map(|c| c / len), offset: h.offset / len, tag: h.tag };
-            halfspaces.push(kept);
-            rows.push(to_v4(&kept.normal));
-            offsets.push(kept.offset);
+        let mut halfspaces = Vec::with_capacity(self.halfspaces.len() + extra.len());
+        let mut unit = true;
+        if self.unit {
+            // every inequality is a fixed point of `unit_halfspace`: normalising them again is the identity
+            halfspaces.extend_from_slice(&self.halfspaces);
+        } else {
+            push_normalised(&mut halfspaces, &mut unit, &self.halfspaces, 0, self.tolerance)?;
         }
-        let mut trivially_empty = false;
-        for (k, h) in extra.iter().enumerate() {
-            if !h.offset.is_finite() || h.normal.iter().any(|c| !c.is_finite()) {
-                return Err(CellError::NonFinite { index: self.halfspaces.len() + k });
+        let first_extra = halfspaces.len();
+        let trivially_empty =
+            push_normalised(&mut halfspaces, &mut unit, extra, self.halfspaces.len(), self.tolerance)?;
+        let lists = if self.unit {
+            // the parent's lists copied, the extra rows and offsets after them
+            let (m0, m) = (first_extra, halfspaces.len());
+            let mut lists = Vec::with_capacity(m + m.div_ceil(MAX_N));
+            lists.extend_from_slice(self.rows());
+            lists.extend(halfspaces[m0..].iter().map(|h| to_v4(&h.normal)));
+            lists.resize(m + m.div_ceil(MAX_N), [0.0; MAX_N]);
+            let offsets = &mut lists[m..].as_flattened_mut()[..m];
+            offsets[..m0].copy_from_slice(self.offsets());
+            for (b, h) in offsets[m0..].iter_mut().zip(&halfspaces[m0..]) {
+                *b = h.offset;
             }
-            let len = h.normal.iter().map(|c| c * c).sum::<f64>().sqrt();
-            let kept = if len > 0.0 {
-                Halfspace { normal: h.normal.map(|c| c / len), offset: h.offset / len, tag: h.tag }
-            } else if h.offset < -self.tolerance.linear {
-                trivially_empty = true;
-                *h
-            } else {
-                continue;
-            };
-            halfspaces.push(kept);
-            rows.push(to_v4(&kept.normal));
-            offsets.push(kept.offset);
-        }
+            lists
+        } else {
+            pack(&halfspaces)
+        };
         let shape = if trivially_empty { CellShape::Empty } else { CellShape::Known { point: [0.0; D] } };
-        Ok(Self { halfspaces, rows, offsets, tolerance: self.tolerance, shape })
+        Ok(Self { halfspaces, lists, tolerance: self.tolerance, shape, unit })
     }
 
     /// The sequential phase 1 of [`Cell::is_empty_with`] on this cell with `extra` added, every offset grown by
@@ -432,19 +494,19 @@ impl<const D: usize> Cell<D> {
         scratch: &mut Scratch,
     ) -> Result<Option<V4>, CellError> {
         let tol = grow;
-        let first_extra = self.rows.len();
+        let first_extra = self.len();
         let Scratch { rows, offsets: grown, mask } = scratch;
-        rows.extend_from_slice(&self.rows);
+        rows.extend_from_slice(self.rows());
         // the grown cell's offsets
-        grown.extend(self.offsets.iter().map(|b| b + tol));
+        grown.extend(self.offsets().iter().map(|b| b + tol));
         for (k, h) in extra.into_iter().enumerate() {
             if !h.offset.is_finite() || h.normal.iter().any(|c| !c.is_finite()) {
                 return Err(CellError::NonFinite { index: first_extra + k });
             }
-            let len = h.normal.iter().map(|c| c * c).sum::<f64>().sqrt();
-            if len > 0.0 {
-                rows.push(to_v4(&h.normal.map(|c| c / len)));
-                grown.push(h.offset / len + tol);
+            // normalised as by `Cell::new`
+            if let Some((u, _)) = unit_halfspace(&h) {
+                rows.push(to_v4(&u.normal));
+                grown.push(u.offset + tol);
             } else if h.offset < -self.tolerance.linear {
                 return Ok(None);
             }
@@ -479,9 +541,9 @@ impl<const D: usize> Cell<D> {
         }
         let hs: Vec<Halfspace<D>> =
             self.halfspaces.iter().zip(&mask).filter(|(_, keep)| **keep).map(|(h, _)| *h).collect();
-        let rows: Vec<V4> = hs.iter().map(|h| to_v4(&h.normal)).collect();
-        let offsets: Vec<f64> = hs.iter().map(|h| h.offset).collect();
-        Ok(Self { halfspaces: hs, rows, offsets, tolerance: self.tolerance, shape: self.shape })
+        let lists = pack(&hs);
+        // a subset of fixed points is fixed
+        Ok(Self { halfspaces: hs, lists, tolerance: self.tolerance, shape: self.shape, unit: self.unit })
     }
 
     /// Maximum of `direction . p` over the cell with a maximiser (lowest z, y, x among maximisers); `None` if empty.
@@ -495,12 +557,15 @@ impl<const D: usize> Cell<D> {
         }
     }
 
+    /// The normals as 4-vectors (the solvers' rows), in the order of [`Cell::halfspaces`].
     pub(crate) fn rows(&self) -> &[V4] {
-        &self.rows
+        &self.lists[..self.halfspaces.len()]
     }
 
+    /// The offsets, in the order of [`Cell::halfspaces`].
     pub(crate) fn offsets(&self) -> &[f64] {
-        &self.offsets
+        let m = self.halfspaces.len();
+        &self.lists[m..].as_flattened()[..m]
     }
 
     /// The characteristic length used for relative thresholds of the solvers.
@@ -520,8 +585,8 @@ impl<const D: usize> Cell<D> {
         };
         let prob = Problem {
             n: D,
-            rows: &self.rows,
-            offsets: &self.offsets,
+            rows: self.rows(),
+            offsets: self.offsets(),
             mask,
             h: [0.0; MAX_N],
             g: to_v4(objective),
@@ -552,7 +617,7 @@ impl<const D: usize> Cell<D> {
         let cap = 1e6 * self.length_scale();
         let Scratch { rows, offsets, .. } = scratch;
         let mut r0 = cap;
-        for (row, &b) in self.rows.iter().zip(&self.offsets) {
+        for (row, &b) in self.rows().iter().zip(self.offsets()) {
             let mut r = *row;
             r[D] = 1.0;
             rows.push(r);
@@ -754,6 +819,107 @@ mod tests {
         assert!(Cell::new(hs, tol).expect("empty").is_empty());
         let nan = vec![Halfspace::new([f64::NAN, 0.0, 0.0], 1.0, Tag::Floor)];
         assert_eq!(Cell::new(nan, tol), Err(CellError::NonFinite { index: 0 }));
+    }
+
+    /// A small deterministic generator for the tests below.
+    fn lcg(state: &mut u64) -> f64 {
+        *state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((*state >> 11) as f64) / ((1u64 << 53) as f64) * 2.0 - 1.0
+    }
+
+    type Bits = (Vec<([u64; 3], u64, Tag)>, Vec<[u64; 4]>, Vec<u64>, bool);
+
+    /// Bit patterns of everything the solvers read: inequalities, rows, offsets and the fixed-point flag.
+    fn bits(c: &Cell<3>) -> Bits {
+        (
+            c.halfspaces().iter().map(|h| (h.normal.map(f64::to_bits), h.offset.to_bits(), h.tag)).collect(),
+            c.rows().iter().map(|r| r.map(f64::to_bits)).collect(),
+            c.offsets().iter().map(|b| b.to_bits()).collect(),
+            c.unit,
+        )
+    }
+
+    /// A normal that oscillates between two neighbours when normalised again and again (computed length
+    /// `1 - 2^-53`, then `1 + 2^-52`, ...): never a fixed point.
+    const OSCILLATING: [f64; 3] = [0.5449716003159704, 0.5644172136257368, 0.6200315829149431];
+
+    #[test]
+    fn normalisation_is_the_identity_on_its_fixed_points() {
+        let mut state = 7u64;
+        let mut fixed_count = 0;
+        let total = 20_000;
+        for k in 0..total {
+            let scale = 10f64.powf(3.0 * lcg(&mut state));
+            let mut n = [lcg(&mut state) * scale, lcg(&mut state) * scale, lcg(&mut state) * scale];
+            if k % 5 == 0 {
+                n[k % 3] = 0.0;
+            }
+            let h = Halfspace::new(n, 10.0 * lcg(&mut state), Tag::User(k as u64));
+            let (u, fixed) = unit_halfspace(&h).expect("non-zero normal");
+            assert!((length(&u.normal) - 1.0).abs() <= 1e-15, "{u:?}");
+            assert_eq!(fixed, length(&u.normal) == 1.0);
+            if fixed {
+                fixed_count += 1;
+                let (again, still) = unit_halfspace(&u).expect("unit");
+                assert!(still);
+                assert_eq!(again.normal.map(f64::to_bits), u.normal.map(f64::to_bits));
+                assert_eq!(again.offset.to_bits(), u.offset.to_bits());
+            }
+        }
+        assert!(fixed_count > total / 2, "{fixed_count} of {total} fixed");
+        let (u, fixed) = unit_halfspace(&Halfspace::new(OSCILLATING, 1.0, Tag::User(0))).expect("unit");
+        assert!(!fixed && u.normal != OSCILLATING);
+        assert_eq!(unit_halfspace(&u).expect("unit").0.normal, OSCILLATING);
+        assert_eq!(unit_halfspace(&Halfspace::new([0.0; 3], 1.0, Tag::Floor)), None);
+    }
+
+    /// `Cell::extended` (the parent's lists copied when they are fixed points) equals `Cell::new` of all the
+    /// inequalities bit for bit, for parents whose normals are all fixed points (the box) and for parents with some
+    /// that are not (then every inequality is normalised again), with extra inequalities of any length, dropped zero
+    /// inequalities and an empty result.
+    #[test]
+    fn extended_equals_a_fresh_build_bit_for_bit() {
+        let tol = Tolerance::for_scale(10.0);
+        let mut state = 11u64;
+        let mut copied = 0;
+        for case in 0..400 {
+            let mut hs = boxed([-5.0, -4.0, -3.0], [5.0, 4.0, 3.0]);
+            for k in 0..(case % 7) {
+                let n = [lcg(&mut state), lcg(&mut state), lcg(&mut state)];
+                hs.push(Halfspace::new(n.map(|c| 3.0 * c), 4.0 + lcg(&mut state), Tag::User(10 + k as u64)));
+            }
+            if case % 4 == 1 {
+                hs.push(Halfspace::new(OSCILLATING, 4.0, Tag::User(99)));
+            }
+            let parent = Cell::new(hs, tol).expect("parent");
+            assert!(!parent.is_empty());
+            if case % 7 == 0 && case % 4 != 1 {
+                assert!(parent.unit);
+            }
+            if case % 4 == 1 {
+                assert!(!parent.unit);
+            }
+            copied += usize::from(parent.unit);
+            let mut extra = Vec::new();
+            for k in 0..(1 + case % 3) {
+                let n = [lcg(&mut state), lcg(&mut state), lcg(&mut state)];
+                let s = 10f64.powf(2.0 * lcg(&mut state));
+                extra.push(Halfspace::new(n.map(|c| s * c), s * lcg(&mut state), Tag::User(50 + k as u64)));
+            }
+            match case % 5 {
+                2 => extra.push(Halfspace::new([0.0; 3], 1.0, Tag::User(70))),
+                3 => extra.push(Halfspace::new([0.0; 3], -1.0, Tag::User(71))),
+                _ => {}
+            }
+            let child = parent.extended(&extra).expect("extended");
+            let all: Vec<Halfspace<3>> = parent.halfspaces().iter().chain(&extra).copied().collect();
+            let fresh = Cell::normalised(all, tol).expect("fresh");
+            assert_eq!(bits(&child), bits(&fresh), "case {case}");
+            assert_eq!(child.shape, fresh.shape);
+            assert_eq!(child.is_empty(), case % 5 == 3);
+        }
+        // both paths of `extended` ran
+        assert!((50..=350).contains(&copied), "{copied} of 400 parents copied");
     }
 
     #[test]
