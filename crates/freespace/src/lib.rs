@@ -27,7 +27,7 @@ pub use active_set::ActiveSetError;
 pub use cell::{Cell, CellError, CellShape, Halfspace, Tag};
 pub use cost::{CostError, RotatedExtents, SeparableCost, SeparableQuadratic, desired_position_cost, stacking_cost};
 pub use omega::{FloorVolume, OmegaError, omega, omega_fixed_z, omega_for_part};
-pub use qp::{QpError, QpSolution, minimize, minimize_clarabel, verify_kkt};
+pub use qp::{QpError, QpSolution, ShortList, minimize, minimize_clarabel, verify_kkt};
 pub use ranking::{Placement, RankedPlacements, ranked_placements};
 pub use subtract::{Obstacle, SubtractError, SubtractOptions, Subtraction, subtract, subtract_from_all};
 pub use vertices::CellPolyhedron;

@@ -25,6 +25,85 @@ use crate::cost::SeparableQuadratic;
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus};
 
+/// A short list read as a slice: up to [`ShortList::INLINE`] entries inline (the working set of the exact solver has
+/// at most `D <= 3`), longer ones on the heap (clarabel's tight set), so that an exact QP solution allocates nothing
+/// for its working set and multipliers. Compares equal to a `Vec`, an array or a slice with the same entries.
+#[derive(Clone)]
+pub struct ShortList<T> {
+    inline: [T; ShortList::<()>::INLINE],
+    len: usize,
+    spill: Vec<T>,
+}
+
+impl ShortList<()> {
+    /// The most entries kept inline.
+    pub const INLINE: usize = MAX_N;
+}
+
+impl<T: Copy + Default> ShortList<T> {
+    /// The list of `items` (inline when there are at most [`ShortList::INLINE`]).
+    pub fn from_slice(items: &[T]) -> Self {
+        let mut inline = [T::default(); ShortList::<()>::INLINE];
+        if items.len() <= inline.len() {
+            inline[..items.len()].copy_from_slice(items);
+            Self { inline, len: items.len(), spill: Vec::new() }
+        } else {
+            Self { inline, len: items.len(), spill: items.to_vec() }
+        }
+    }
+}
+
+impl<T: Copy + Default> Default for ShortList<T> {
+    fn default() -> Self {
+        Self::from_slice(&[])
+    }
+}
+
+impl<T> std::ops::Deref for ShortList<T> {
+    type Target = [T];
+    fn deref(&self) -> &[T] {
+        if self.len <= self.inline.len() { &self.inline[..self.len] } else { &self.spill }
+    }
+}
+
+impl<'a, T> IntoIterator for &'a ShortList<T> {
+    type Item = &'a T;
+    type IntoIter = std::slice::Iter<'a, T>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.iter()
+    }
+}
+
+impl<T: std::fmt::Debug> std::fmt::Debug for ShortList<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_list().entries(self.iter()).finish()
+    }
+}
+
+impl<T: PartialEq> PartialEq for ShortList<T> {
+    fn eq(&self, other: &Self) -> bool {
+        **self == **other
+    }
+}
+
+impl<T: PartialEq> PartialEq<Vec<T>> for ShortList<T> {
+    fn eq(&self, other: &Vec<T>) -> bool {
+        **self == **other
+    }
+}
+
+impl<T: PartialEq> PartialEq<[T]> for ShortList<T> {
+    fn eq(&self, other: &[T]) -> bool {
+        **self == *other
+    }
+}
+
+impl<T: PartialEq, const N: usize> PartialEq<[T; N]> for ShortList<T> {
+    fn eq(&self, other: &[T; N]) -> bool {
+        **self == other[..]
+    }
+}
+
 /// An optimum over a cell.
 #[derive(Debug, Clone, PartialEq)]
 pub struct QpSolution<const D: usize> {
@@ -34,9 +113,9 @@ pub struct QpSolution<const D: usize> {
     pub cost: f64,
     /// Indices (into [`Cell::halfspaces`]) of the working set at the optimum: linearly independent active
     /// inequalities (at most D), sorted. For the clarabel path: the tight inequalities.
-    pub active: Vec<usize>,
+    pub active: ShortList<usize>,
     /// Lagrange multipliers of `active` (same order; >= 0). Empty for the clarabel path.
-    pub multipliers: Vec<f64>,
+    pub multipliers: ShortList<f64>,
     /// All inequalities within the cell's tolerance of equality at `point`, sorted.
     pub tight: Vec<usize>,
     /// Active-set iterations (0 for the clarabel path).
@@ -158,6 +237,12 @@ fn solution<const D: usize>(
             }
             let pairs = &mut pairs[..k];
             pairs.sort_unstable_by_key(|x| x.0);
+            let mut active = [0usize; MAX_N];
+            let mut lambda = [0.0f64; MAX_N];
+            for (a, &(j, l)) in pairs.iter().enumerate() {
+                active[a] = j;
+                lambda[a] = l;
+            }
             // one pass over the inequalities: primal feasibility and the tight set
             let tol = cell.tolerance().linear;
             let mut worst = f64::NEG_INFINITY;
@@ -172,8 +257,8 @@ fn solution<const D: usize>(
             let sol = QpSolution {
                 point: p,
                 cost: cost.evaluate(&p),
-                active: pairs.iter().map(|x| x.0).collect(),
-                multipliers: pairs.iter().map(|x| x.1).collect(),
+                active: ShortList::from_slice(&active[..k]),
+                multipliers: ShortList::from_slice(&lambda[..k]),
                 tight,
                 iterations,
             };
@@ -268,8 +353,8 @@ pub fn minimize_clarabel<const D: usize>(
     Ok(QpSolution {
         point: p,
         cost: cost.evaluate(&p),
-        active: tight.clone(),
-        multipliers: Vec::new(),
+        active: ShortList::from_slice(&tight),
+        multipliers: ShortList::default(),
         tight,
         iterations: 0,
     })
@@ -357,6 +442,22 @@ mod tests {
         assert!((s.multipliers[0] - 4.0).abs() < 1e-12 && (s.multipliers[1] - 2.0).abs() < 1e-12);
         let k = minimize_clarabel(&c, &f).expect("clarabel");
         assert!((k.cost - s.cost).abs() < 1e-8);
+    }
+
+    #[test]
+    fn short_lists_read_as_slices_inline_or_spilled() {
+        let short = ShortList::from_slice(&[3usize, 5, 6]);
+        assert_eq!(short, vec![3, 5, 6]);
+        assert_eq!(short, [3, 5, 6]);
+        assert_eq!(short.len(), 3);
+        assert_eq!((&short).into_iter().copied().sum::<usize>(), 14);
+        assert_eq!(format!("{short:?}"), "[3, 5, 6]");
+        let long = ShortList::from_slice(&[1usize, 2, 3, 4, 5, 6]);
+        assert_eq!(long, vec![1, 2, 3, 4, 5, 6]);
+        assert_ne!(long, short);
+        assert_eq!(ShortList::from_slice(&long[..3]), ShortList::from_slice(&[1, 2, 3]));
+        let empty = ShortList::<f64>::default();
+        assert!(empty.is_empty() && empty == Vec::<f64>::new());
     }
 
     #[test]
