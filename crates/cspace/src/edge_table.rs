@@ -24,12 +24,14 @@ pub(crate) struct EdgeScratch {
     start: Vec<u32>,
     /// `(target, half-edge)`; half-edge `h` is corner `k` of face `f` with `h = (lengths of the faces before f) + k`.
     out: Vec<(u32, u32)>,
-    /// The face of every half-edge.
+    /// The face of every half-edge (star sort only; filled while the half-edges are placed).
     face_of: Vec<u32>,
+    /// The number of corners announced (half-edges).
+    total: usize,
     /// Small polytopes: bit `b` of `targets[a]` says that the half-edge `a -> b` exists, ...
     targets: Vec<u64>,
-    /// ... and `half_edge[a * 64 + b]` is it (only read where the bit is set, so never cleared).
-    half_edge: Vec<u32>,
+    /// ... and `half_edge[a][b]` is it and its face (only read where the bit is set, so never cleared).
+    half_edge: Vec<[(u32, u32); 64]>,
 }
 
 impl EdgeScratch {
@@ -37,7 +39,7 @@ impl EdgeScratch {
     pub(crate) fn clear(&mut self) {
         self.start.clear();
         self.start.extend([0, 0]);
-        self.face_of.clear();
+        self.total = 0;
     }
 
     /// A new vertex (vertices are numbered in the order of these calls).
@@ -46,12 +48,12 @@ impl EdgeScratch {
         self.start.push(0);
     }
 
-    /// Corner `v` of face `f`: called for every corner of every face, faces in order, corners in cycle order (the
-    /// counting pass of the sort, done while the faces are assembled).
+    /// Corner `v` of a face: called for every corner of every face, faces in order, corners in cycle order (the
+    /// counting pass of the star sort, done while the faces are assembled).
     #[inline]
-    pub(crate) fn corner(&mut self, v: usize, f: usize) {
+    pub(crate) fn corner(&mut self, v: usize) {
         self.start[v + 2] += 1;
-        self.face_of.push(f as u32);
+        self.total += 1;
     }
 }
 
@@ -64,17 +66,18 @@ pub(crate) fn build(nv: usize, faces: &[Face], scratch: &mut EdgeScratch) -> Opt
 
 /// [`build`] by the star sort (any number of vertices).
 fn build_stars(nv: usize, faces: &[Face], scratch: &mut EdgeScratch) -> Option<(Vec<Edge>, Vec<usize>)> {
-    let EdgeScratch { start, out, face_of, .. } = scratch;
+    let EdgeScratch { start, out, face_of, total, .. } = scratch;
     debug_assert_eq!(start.len(), nv + 2, "every vertex announced");
-    let total = face_of.len();
+    let total = *total;
     for a in 2..nv + 2 {
         start[a] += start[a - 1];
     }
     // pass 2: place the half-edges (start[a + 1] is the cursor of star a, and ends as its end)
     out.clear();
     out.resize(total, (0, 0));
+    face_of.clear();
     let mut h = 0u32;
-    for face in faces {
+    for (f, face) in faces.iter().enumerate() {
         let Some((&first, rest)) = face.vertices.split_first() else { continue };
         let mut a = first;
         for &b in rest.iter().chain(std::iter::once(&first)) {
@@ -84,6 +87,7 @@ fn build_stars(nv: usize, faces: &[Face], scratch: &mut EdgeScratch) -> Option<(
             let slot = &mut start[a + 1];
             out[*slot as usize] = (b as u32, h);
             *slot += 1;
+            face_of.push(f as u32);
             h += 1;
             a = b;
         }
@@ -131,45 +135,52 @@ fn build_stars(nv: usize, faces: &[Face], scratch: &mut EdgeScratch) -> Option<(
 /// bit already set), the edges of `lo` are the bits above `lo` in increasing order, each reverse half-edge one bit test;
 /// the same table and the same failures as the star sort, with no sort at all.
 fn build_small(nv: usize, faces: &[Face], scratch: &mut EdgeScratch) -> Option<(Vec<Edge>, Vec<usize>)> {
-    let EdgeScratch { face_of, targets, half_edge, .. } = scratch;
-    let total = face_of.len();
+    let EdgeScratch { total, targets, half_edge, .. } = scratch;
+    let total = *total;
     targets.clear();
     targets.resize(nv, 0);
-    if half_edge.len() < 64 * nv {
-        half_edge.resize(64 * nv, 0);
+    if half_edge.len() < nv {
+        half_edge.resize(nv, [(0, 0); 64]);
     }
+    let (targets, half_edge) = (&mut targets[..nv], &mut half_edge[..nv]);
     let mut h = 0u32;
-    for face in faces {
+    // the half-edge `a -> b` of face `f`: `None` for `a == b`, a vertex that does not exist or the same directed
+    // half-edge twice
+    let mut half = |a: usize, b: usize, f: u32| -> Option<()> {
+        let star = targets.get_mut(a)?;
+        let bit = 1u64 << (b & 63);
+        if a == b || b >= nv || *star & bit != 0 {
+            return None;
+        }
+        *star |= bit;
+        half_edge[a][b & 63] = (h, f);
+        h += 1;
+        Some(())
+    };
+    for (f, face) in faces.iter().enumerate() {
         let Some((&first, rest)) = face.vertices.split_first() else { continue };
         let mut a = first;
-        for &b in rest.iter().chain(std::iter::once(&first)) {
-            let bit = 1u64 << b;
-            let star = &mut targets[a];
-            // `a == b` or the same directed half-edge twice
-            if a == b || *star & bit != 0 {
-                return None;
-            }
-            *star |= bit;
-            half_edge[a * 64 + b] = h;
-            h += 1;
+        for &b in rest {
+            half(a, b, f as u32)?;
             a = b;
         }
+        half(a, first, f as u32)?;
     }
     let mut edges = Vec::with_capacity(total / 2);
     let mut face_edges = vec![0; total];
     for lo in 0..nv {
         let mut above = targets[lo] & (u64::MAX << lo);
         while above != 0 {
-            let hi = above.trailing_zeros() as usize;
+            let hi = (above.trailing_zeros() & 63) as usize;
             above &= above - 1;
             if targets[hi] & (1u64 << lo) == 0 {
                 return None;
             }
-            let (forward, reverse) = (half_edge[lo * 64 + hi] as usize, half_edge[hi * 64 + lo] as usize);
+            let ((forward, forward_face), (reverse, reverse_face)) = (half_edge[lo][hi], half_edge[hi][lo]);
             let e = edges.len();
-            edges.push(Edge { vertices: [lo, hi], faces: [face_of[forward] as usize, face_of[reverse] as usize] });
-            face_edges[forward] = e;
-            face_edges[reverse] = e;
+            edges.push(Edge { vertices: [lo, hi], faces: [forward_face as usize, reverse_face as usize] });
+            face_edges[forward as usize] = e;
+            face_edges[reverse as usize] = e;
         }
     }
     // a half-edge `hi -> lo` without its forward twin was not reached
@@ -199,9 +210,9 @@ mod tests {
         for _ in 0..nv {
             scratch.vertex();
         }
-        for (f, face) in faces.iter().enumerate() {
+        for face in faces {
             for &v in &face.vertices {
-                scratch.corner(v, f);
+                scratch.corner(v);
             }
         }
         method(nv, faces, &mut scratch)

@@ -885,7 +885,7 @@ fn assemble(
                 edge_scratch.vertex();
             }
             let v = *slot as usize;
-            edge_scratch.corner(v, faces.len());
+            edge_scratch.corner(v);
             offset = offset.max(spec.normal.dot(vertices[v]));
             face.push(v);
         }

@@ -61,17 +61,12 @@ pub(crate) struct Scratch {
 const SIDE: u8 = 0;
 const POLE: u8 = 1;
 
-/// Whether `d` is a usable edge vector: its squared length is a positive normal number (so its normalisation is
-/// finite, and a zero component stays an exact zero).
-#[inline]
-fn proper(d: DVec3) -> bool {
-    let l = d.length_squared();
-    l >= f64::MIN_POSITIVE && l.is_finite()
-}
-
 /// The vertical arcs of `p` (vertices `vertices`, face normals `normals`) into `out`, in edge order, when `p` is a
 /// z-prism (see the module documentation), else `false` (the buffers then hold garbage). The circle is the general
-/// route's (`minkowski::arcs`, the same operations).
+/// route's (`minkowski::arcs`, the same operations); a vertical arc's must come out as `(±0, ±0, cz)` (it does unless
+/// the normalisation divides by an underflowed length), a horizontal arc's is `d * s` for an edge vector `d` with
+/// `d.z == 0` and some `s`: its `z` is `±0` or NaN, and either way its product with a pole is not a sign, and no test
+/// with it is positive (NaN compares false), which is all the module documentation uses.
 pub(crate) fn vertical_arcs(
     p: &ConvexPolytope,
     vertices: &[DVec3],
@@ -95,20 +90,22 @@ pub(crate) fn vertical_arcs(
         let d = vertices[e.vertices[1]] - vertices[e.vertices[0]];
         match classes[f0] + classes[f1] {
             0 => {
-                if !(d.x == 0.0 && d.y == 0.0 && proper(d)) {
+                if !(d.x == 0.0 && d.y == 0.0) {
                     return false;
                 }
                 let (n0, n1) = (normals[f0], normals[f1]);
                 // exactly the general route's circle (`minkowski::arcs`)
                 let d = d.normalize();
                 let circle = if n0.cross(n1).dot(d) >= 0.0 { d } else { -d };
-                if circle.z == 0.0 || !circle.z.is_finite() {
+                // `0 * s` is 0 exactly when `s` is finite; then `cz` is finite or NaN, and `w * cz` is the general
+                // route's test value up to exact zeros
+                if !(circle.x == 0.0 && circle.y == 0.0) {
                     return false;
                 }
                 out.push(VerticalArc { edge: k, from: [n0.x, n0.y], to: [n1.x, n1.y], cz: circle.z });
             }
             1 => {
-                if !(d.z == 0.0 && proper(d)) {
+                if d.z != 0.0 {
                     return false;
                 }
             }
