@@ -682,11 +682,13 @@ fn phase_one_rows<const D: usize>(
     mask: &mut Vec<bool>,
     length_scale: f64,
 ) -> Result<Option<V4>, CellError> {
-    let m = rows.len();
     let mut point = to_v4(start);
     let satisfied_at = |j: usize, p: &V4| dot4(&rows[j], p) <= offsets[j];
-    mask.extend((0..m).map(|j| satisfied_at(j, &point)));
-    for j in 0..m {
+    // (a copy of the start point and zipped slices: no bounds checks, and the point stays in registers although
+    // the mask's byte stores could alias it)
+    let p0 = point;
+    mask.extend(rows.iter().zip(offsets).map(|(row, &b)| dot4(row, &p0) <= b));
+    for j in 0..rows.len() {
         if mask[j] {
             continue;
         }
