@@ -519,26 +519,31 @@ fn overlay(
     bn.extend(fixed.faces().iter().map(|f| f.plane.normal));
     let (fa, fb) = (am.len(), bn.len());
 
+    // two z-prisms turned about z (sheet metal): the same faces without sign tables or crossings (`z_prism.rs`)
+    let z_prisms = !general_route_only()
+        && z_prism::vertical_arcs(moving, neg_ra, am, &mut prism.a_classes, &mut prism.a)
+        && z_prism::vertical_arcs(fixed, bv, bn, &mut prism.b_classes, &mut prism.b);
+
     // parallel faces: merged_with_b[f] = Some(g) when -R n_f == n_g within half the tolerance.
     merged_with_b.clear();
     merged_with_b.resize(fa, None);
     merged_with_a.clear();
     merged_with_a.resize(fb, None);
-    for (f, m) in am.iter().enumerate() {
-        for (g, n) in bn.iter().enumerate() {
-            if (*m - *n).length_squared() <= PARALLEL_SQ {
-                merged_with_b[f] = Some(g);
-                merged_with_a[g] = Some(f);
+    let by_class =
+        z_prisms && z_prism::parallel_faces(am, bn, &prism.a_classes, &prism.b_classes, merged_with_a, merged_with_b);
+    if !by_class {
+        for (f, m) in am.iter().enumerate() {
+            for (g, n) in bn.iter().enumerate() {
+                if (*m - *n).length_squared() <= PARALLEL_SQ {
+                    merged_with_b[f] = Some(g);
+                    merged_with_a[g] = Some(f);
+                }
             }
         }
     }
     faces.clear();
 
-    // two z-prisms turned about z (sheet metal): the same faces without sign tables or crossings (`z_prism.rs`)
-    if !general_route_only()
-        && z_prism::vertical_arcs(moving, neg_ra, am, &mut prism.classes, &mut prism.a)
-        && z_prism::vertical_arcs(fixed, bv, bn, &mut prism.classes, &mut prism.b)
-    {
+    if z_prisms {
         #[cfg(test)]
         z_prism::TAKEN.with(|c| c.set(c.get() + 1));
         z_prism::face_specs(am, bn, &prism.a, &prism.b, neg_ra, bv, merged_with_a, merged_with_b, faces)?;
@@ -909,7 +914,7 @@ fn assemble(
 
 /// `(ANGULAR_TOLERANCE / 2)^2`: the squared sine below which two edge directions are parallel, and the squared
 /// distance below which two unit face normals are the same direction.
-const PARALLEL_SQ: f64 = (0.5 * ANGULAR_TOLERANCE) * (0.5 * ANGULAR_TOLERANCE);
+pub(crate) const PARALLEL_SQ: f64 = (0.5 * ANGULAR_TOLERANCE) * (0.5 * ANGULAR_TOLERANCE);
 
 /// The convex polygon `F + G` of a merged face with outward normal `normal`, where `F` is `B`'s polygon
 /// (`scratch.pj`/`pe`) and `G` is `-RA`'s (`scratch.qi`/`qe`), both counter-clockwise about `normal` (a face, or an

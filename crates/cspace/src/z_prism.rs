@@ -36,7 +36,7 @@
 use glam::DVec3;
 use stackplan_geom::polytope::ConvexPolytope;
 
-use crate::minkowski::{FaceSpec, Feature, OverlayFailure, argmax};
+use crate::minkowski::{FaceSpec, Feature, OverlayFailure, PARALLEL_SQ, argmax};
 
 /// A vertical arc: its edge, the `x`, `y` of the normals at its start and end, and the `z` of its circle (the general
 /// route's circle is `(±0, ±0, cz)`).
@@ -51,8 +51,9 @@ pub(crate) struct VerticalArc {
 /// Working buffers, kept per thread with the overlay's.
 #[derive(Default)]
 pub(crate) struct Scratch {
-    /// The kind of every face normal of the polytope being looked at: 0 side, 1 pole.
-    pub(crate) classes: Vec<u8>,
+    /// The kind of every face normal of `-RA` and of `B`: 0 side, 1 pole.
+    pub(crate) a_classes: Vec<u8>,
+    pub(crate) b_classes: Vec<u8>,
     /// The vertical arcs of `-RA` and of `B`.
     pub(crate) a: Vec<VerticalArc>,
     pub(crate) b: Vec<VerticalArc>,
@@ -93,16 +94,21 @@ pub(crate) fn vertical_arcs(
                 if !(d.x == 0.0 && d.y == 0.0) {
                     return false;
                 }
-                let (n0, n1) = (normals[f0], normals[f1]);
-                // exactly the general route's circle (`minkowski::arcs`)
-                let d = d.normalize();
-                let circle = if n0.cross(n1).dot(d) >= 0.0 { d } else { -d };
-                // `0 * s` is 0 exactly when `s` is finite; then `cz` is finite or NaN, and `w * cz` is the general
-                // route's test value up to exact zeros
-                if !(circle.x == 0.0 && circle.y == 0.0) {
+                // the general route's circle (`minkowski::arcs`): `d.normalize()` is `d * s` with
+                // `s = 1 / sqrt((0 * 0 + 0 * 0) + dz * dz)`, whose x and y are `±0` exactly when `s` is finite (else
+                // NaN: refused); then `cz` is finite or NaN, and `w * cz` is the general route's test value up to
+                // exact zeros
+                let s = (d.z * d.z).sqrt().recip();
+                if !s.is_finite() {
                     return false;
                 }
-                out.push(VerticalArc { edge: k, from: [n0.x, n0.y], to: [n1.x, n1.y], cz: circle.z });
+                let (n0, n1) = (normals[f0], normals[f1]);
+                // its orientation: `(n0 x n1) . d` is `(±0 + ±0) + w * cz` (glam's operand order), `>= 0` exactly when
+                // `w * cz >= 0` (a zero of either sign passes, NaN fails)
+                let cz = d.z * s;
+                let w = n0.x * n1.y - n1.x * n0.y;
+                let cz = if w * cz >= 0.0 { cz } else { -cz };
+                out.push(VerticalArc { edge: k, from: [n0.x, n0.y], to: [n1.x, n1.y], cz });
             }
             1 => {
                 if d.z != 0.0 {
@@ -110,6 +116,36 @@ pub(crate) fn vertical_arcs(
                 }
             }
             _ => return false,
+        }
+    }
+    true
+}
+
+/// The parallel faces of a z-prism pair (classes from [`vertical_arcs`]) into `merged_with_a` / `merged_with_b`
+/// (cleared, sized), exactly as the general route's loop over all pairs (`|m - n|^2 <= PARALLEL_SQ`, every pair in
+/// the same order, the last match kept), but skipping the pairs of a side normal and a pole: their squared distance
+/// is at least the pole's `z^2` (a sum of squares rounds to at least each term), so when every pole has
+/// `z^2 > PARALLEL_SQ` no such pair can match. `false` (nothing written) when some pole does not.
+pub(crate) fn parallel_faces(
+    am: &[DVec3],
+    bn: &[DVec3],
+    a_classes: &[u8],
+    b_classes: &[u8],
+    merged_with_a: &mut [Option<usize>],
+    merged_with_b: &mut [Option<usize>],
+) -> bool {
+    let far = |normals: &[DVec3], classes: &[u8]| {
+        normals.iter().zip(classes).all(|(n, &c)| c != POLE || n.z * n.z > PARALLEL_SQ)
+    };
+    if !(far(am, a_classes) && far(bn, b_classes)) {
+        return false;
+    }
+    for ((f, m), &cf) in am.iter().enumerate().zip(a_classes) {
+        for ((g, n), &cg) in bn.iter().enumerate().zip(b_classes) {
+            if cf == cg && (*m - *n).length_squared() <= PARALLEL_SQ {
+                merged_with_b[f] = Some(g);
+                merged_with_a[g] = Some(f);
+            }
         }
     }
     true
