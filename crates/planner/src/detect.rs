@@ -169,73 +169,6 @@ impl MovedComponent {
     }
 }
 
-/// The separating axes of one (orientation, moving component, stack component) pair with the stack component's
-/// projection on each: everything of the separating-axis test that does not depend on the position, kept for the
-/// pair's next test ([`AxesCache`]). The axes are those of `stackplan_cspace::interference::sat_gap` and of
-/// [`horizontal_slack`] in their order (the moving component's normal axes, the stack component's, then the unit
-/// cross products of their edge directions longer than `1e-9`), computed with the same arithmetic, so every
-/// per-axis value is bit-identical to theirs.
-#[derive(Debug, Clone)]
-pub struct PairAxes {
-    /// Per axis: the unit axis `u`, the stack component's projection `[lo, hi]` on it, and `|u_xy|`.
-    axes: Vec<(DVec3, f64, f64, f64)>,
-    /// The axis that separated last time: tried first (the maximum over the axes does not depend on their order).
-    witness: usize,
-}
-
-impl PairAxes {
-    fn new(moving_normals: &[DVec3], moving_edges: &[DVec3], fixed: &PlacedConvex) -> Self {
-        let mut axes = Vec::with_capacity(
-            moving_normals.len() + fixed.normal_axes.len() + moving_edges.len() * fixed.edge_directions.len(),
-        );
-        let mut push = |u: DVec3| {
-            let (lo, hi) = project(&fixed.vertices, u);
-            axes.push((u, lo, hi, (1.0 - u.z * u.z).max(0.0).sqrt()));
-        };
-        for &u in moving_normals.iter().chain(&fixed.normal_axes) {
-            push(u);
-        }
-        for &da in moving_edges {
-            for &db in &fixed.edge_directions {
-                let c = da.cross(db);
-                let len2 = c.length_squared();
-                if len2 > 1e-18 {
-                    push(c / len2.sqrt());
-                }
-            }
-        }
-        Self { axes, witness: 0 }
-    }
-
-    /// Scans the axes `witness + k` (cyclically) for `k` in `range`, raising `scan.best` to `gap_u - weight |u_xy|`;
-    /// stops at the first axis that makes it pass the rule's threshold (remembered as the next witness) and returns
-    /// whether it did. O(axes x moving vertices).
-    fn scan(
-        &mut self,
-        moving: &mut MovedComponent,
-        rule: &Rule,
-        range: std::ops::Range<usize>,
-        best: &mut f64,
-    ) -> bool {
-        let n = self.axes.len();
-        // the first axes are the moving component's own normals, in order
-        let own = moving.own.len();
-        for k in range {
-            let i = if self.witness + k >= n { self.witness + k - n } else { self.witness + k };
-            let (u, b_lo, b_hi, horizontal) = self.axes[i];
-            let (a_lo, a_hi) = if i < own { moving.own(i, u) } else { project(&moving.vertices, u) };
-            let gap = (b_lo - a_hi).max(a_lo - b_hi);
-            let value = if rule.weight == 0.0 { gap } else { gap - rule.weight * horizontal };
-            *best = best.max(value);
-            if rule.decided(*best) {
-                self.witness = i;
-                return true;
-            }
-        }
-        false
-    }
-}
-
 /// The stopping rule of a scan: the per-axis value is `gap - weight |u_xy|`; a running maximum past `stop` decides
 /// the pair as not violating.
 #[derive(Debug, Clone, Copy)]
@@ -252,8 +185,10 @@ impl Rule {
     }
 }
 
-/// The scan of a pair seen for the first time, on the fly (no allocation): the normal axes (`normals = true`) or
-/// the edge cross products, in the order and with the arithmetic of [`PairAxes`].
+/// The separating-axis scan of a pair, on the fly (no allocation): the normal axes (`normals = true`: the moving
+/// component's, then the stack component's) or the unit cross products of their edge directions longer than `1e-9`,
+/// in the order and with the arithmetic of `stackplan_cspace::interference::sat_gap` and [`horizontal_slack`], so
+/// every per-axis value is bit-identical to theirs.
 fn scan_direct(
     moving_normals: &[DVec3],
     moving_edges: &[DVec3],
@@ -299,18 +234,16 @@ fn scan_direct(
     false
 }
 
-/// The separating-axis data of the pairs tested so far, by (orientation index, moving component, stack component):
-/// for each pair "never tested", "tested once" (its axes are computed on the fly) or its [`PairAxes`] (built on the
-/// second test, so pairs tested once cost no allocation). A dense index per (orientation, moving component) over the
-/// stack components (4 bytes a pair, allocated when the pair's row is first touched) into one arena of axes: the
-/// narrow phase looks up every pair that passes the boxes, so this replaces a hash map whose probes dominated it.
+/// The lists of a finished [`CandidateQueue`] ([`CandidateQueue::recycle`]), emptied, for the next one: no allocation
+/// per detection once warm.
+///
+/// (Up to the 14th session the scratch also kept each (orientation, moving, stack component) pair's separating axes
+/// with the stack component's projections, built on the pair's second test. Measured in the 15th: the pairs are
+/// tested a few times each, so building the axes cost more than re-deriving them on the fly saved; the Channel
+/// search ran 5.6 % fewer instructions and the Triangle one 9 % fewer without them, and a 15-part Complex plan held
+/// 376 MB of them.)
 #[derive(Debug, Clone, Default)]
-pub struct AxesCache {
-    /// `[orientation][moving][fixed]`: 0 never tested, 1 tested once, `k + 2` = `axes[k]`.
-    index: Vec<Vec<Vec<u32>>>,
-    axes: Vec<PairAxes>,
-    /// The lists of a finished [`CandidateQueue`] ([`CandidateQueue::recycle`]), emptied, for the next one (no
-    /// allocation per detection once warm).
+pub struct DetectScratch {
     spare: QueueLists,
 }
 
@@ -323,33 +256,13 @@ struct QueueLists {
     exact: Vec<Candidate>,
 }
 
-const UNSEEN: u32 = 0;
-const SEEN: u32 = 1;
-
-impl AxesCache {
-    /// Forgets every pair.
-    pub fn clear(&mut self) {
-        self.index.clear();
-        self.axes.clear();
-    }
-
-    /// The cached axes of a pair, if it has them.
-    fn axes_mut(&mut self, orientation: usize, moving: usize, fixed: usize) -> Option<&mut PairAxes> {
-        let slot = *self.index.get(orientation)?.get(moving)?.get(fixed)?;
-        if slot >= 2 { self.axes.get_mut((slot - 2) as usize) } else { None }
-    }
-}
-
 /// A pair whose normal axes did not decide it: the running maximum so far (an upper bound of its violation follows
-/// from it) and whether its scan runs on the fly or on cached axes.
+/// from it).
 #[derive(Debug, Clone, Copy)]
 struct OpenPair {
     moving: usize,
     fixed: usize,
     best: f64,
-    direct: bool,
-    /// Axes scanned so far (cached path).
-    scanned: usize,
 }
 
 /// The violating pairs of an orientation at `p`, produced lazily in the order of [`candidates`] (largest violation
@@ -379,8 +292,8 @@ fn precedes(a: (f64, usize, usize), b: (f64, usize, usize)) -> bool {
 }
 
 impl CandidateQueue {
-    /// Broad phase and the normal-axis scans (see the type's documentation). `cache` keeps the position-free part
-    /// of each pair's separating-axis test between calls (keyed by `orientation.index`).
+    /// Broad phase and the normal-axis scans (see the type's documentation). The queue's lists come from `scratch`
+    /// ([`CandidateQueue::recycle`] gives them back).
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         scene: &StackScene,
@@ -390,7 +303,7 @@ impl CandidateQueue {
         clearance: f64,
         horizontal_clearance: bool,
         tol: f64,
-        cache: &mut AxesCache,
+        scratch: &mut DetectScratch,
         counts: &mut DetectCounts,
     ) -> Self {
         let horizontal = horizontal_clearance && clearance > 0.0;
@@ -399,7 +312,7 @@ impl CandidateQueue {
         } else {
             Rule { weight: 0.0, stop: tol.max(clearance), inclusive: false }
         };
-        let QueueLists { mut moved, mut near, open, exact } = std::mem::take(&mut cache.spare);
+        let QueueLists { mut moved, mut near, open, exact } = std::mem::take(&mut scratch.spare);
         for m in &mut moved {
             m.vertices.clear();
             m.own.clear();
@@ -439,21 +352,6 @@ impl CandidateQueue {
                 Some(s) => (&s.axes[mi].0, &s.axes[mi].1),
                 None => (&placed.normal_axes, &placed.edge_directions),
             };
-            let AxesCache { index, axes: arena, .. } = &mut *cache;
-            let row = {
-                if index.len() <= orientation.index {
-                    index.resize_with(orientation.index + 1, Vec::new);
-                }
-                let rows = &mut index[orientation.index];
-                if rows.len() <= mi {
-                    rows.resize_with(mi + 1, Vec::new);
-                }
-                let row = &mut rows[mi];
-                if row.len() < scene.components.len() {
-                    row.resize(scene.components.len(), UNSEEN);
-                }
-                row
-            };
             for &fi in &near {
                 let fixed = &scene.components[fi];
                 if !boxes_overlap(&moved_box, &fixed.placed.aabb, margin) {
@@ -475,34 +373,21 @@ impl CandidateQueue {
                     moving.own.resize(normals.len(), (f64::NAN, f64::NAN));
                 }
                 let mut best = f64::NEG_INFINITY;
-                // first test of the pair: on the fly; second: build and keep its axes; later: reuse them
-                let slot = &mut row[fi];
-                let (decided, direct, scanned) = if *slot == UNSEEN {
-                    *slot = SEEN;
-                    (scan_direct(normals, edges, &fixed.placed, moving, &rule, true, &mut best), true, 0)
-                } else {
-                    if *slot == SEEN {
-                        *slot = arena.len() as u32 + 2;
-                        arena.push(PairAxes::new(normals, edges, &fixed.placed));
-                    }
-                    let axes = &mut arena[(*slot - 2) as usize];
-                    let k = (normals.len() + fixed.placed.normal_axes.len()).min(axes.axes.len());
-                    (axes.scan(moving, &rule, 0..k, &mut best), false, k)
-                };
+                let decided = scan_direct(normals, edges, &fixed.placed, moving, &rule, true, &mut best);
                 if !decided {
-                    queue.open.push(OpenPair { moving: mi, fixed: fi, best, direct, scanned });
+                    queue.open.push(OpenPair { moving: mi, fixed: fi, best });
                 }
             }
         }
-        cache.spare.near = near;
+        scratch.spare.near = near;
         queue
     }
 
-    /// Gives the queue's lists back to `cache` for the next detection (optional: a queue simply dropped costs only
+    /// Gives the queue's lists back to `scratch` for the next detection (optional: a queue simply dropped costs only
     /// the allocations of the next one).
-    pub fn recycle(self, cache: &mut AxesCache) {
-        let near = std::mem::take(&mut cache.spare.near);
-        cache.spare = QueueLists { moved: self.moved, near, open: self.open, exact: self.exact };
+    pub fn recycle(self, scratch: &mut DetectScratch) {
+        let near = std::mem::take(&mut scratch.spare.near);
+        scratch.spare = QueueLists { moved: self.moved, near, open: self.open, exact: self.exact };
     }
 
     /// Upper bound of an open pair's violation: from the running maximum, plus (with a clearance, where
@@ -524,7 +409,6 @@ impl CandidateQueue {
         scene: &StackScene,
         orientation: &Orientation,
         sweep: Option<&SweepAxes>,
-        cache: &mut AxesCache,
     ) -> Option<Candidate> {
         loop {
             let best_exact = (0..self.exact.len()).reduce(|a, b| {
@@ -549,7 +433,7 @@ impl CandidateQueue {
                 }
             };
             let open = self.open.swap_remove(refine);
-            if let Some(c) = self.finish(open, scene, orientation, sweep, cache) {
+            if let Some(c) = self.finish(open, scene, orientation, sweep) {
                 self.exact.push(c);
             }
         }
@@ -562,28 +446,16 @@ impl CandidateQueue {
         scene: &StackScene,
         orientation: &Orientation,
         sweep: Option<&SweepAxes>,
-        cache: &mut AxesCache,
     ) -> Option<Candidate> {
         let (mi, fi) = (open.moving, open.fixed);
         let placed = &orientation.components[mi];
         let fixed = &scene.components[fi];
         let moving = &mut self.moved[mi];
-        let decided = if open.direct {
-            let (normals, edges) = match sweep {
-                Some(s) => (&s.axes[mi].0, &s.axes[mi].1),
-                None => (&placed.normal_axes, &placed.edge_directions),
-            };
-            scan_direct(normals, edges, &fixed.placed, moving, &self.rule, false, &mut open.best)
-        } else {
-            match cache.axes_mut(orientation.index, mi, fi) {
-                Some(axes) => {
-                    let n = axes.axes.len();
-                    axes.scan(moving, &self.rule, open.scanned..n, &mut open.best)
-                }
-                // the entry was built when the pair was opened: cannot happen
-                None => false,
-            }
+        let (normals, edges) = match sweep {
+            Some(s) => (&s.axes[mi].0, &s.axes[mi].1),
+            None => (&placed.normal_axes, &placed.edge_directions),
         };
+        let decided = scan_direct(normals, edges, &fixed.placed, moving, &self.rule, false, &mut open.best);
         let tol = self.tol;
         let clearance = self.clearance;
         if self.horizontal {
@@ -627,16 +499,16 @@ pub fn candidates(
     clearance: f64,
     horizontal_clearance: bool,
     tol: f64,
-    cache: &mut AxesCache,
+    scratch: &mut DetectScratch,
     counts: &mut DetectCounts,
 ) -> Vec<Candidate> {
     let mut queue =
-        CandidateQueue::new(scene, orientation, sweep, p, clearance, horizontal_clearance, tol, cache, counts);
+        CandidateQueue::new(scene, orientation, sweep, p, clearance, horizontal_clearance, tol, scratch, counts);
     let mut out = Vec::new();
-    while let Some(c) = queue.next(scene, orientation, sweep, cache) {
+    while let Some(c) = queue.next(scene, orientation, sweep) {
         out.push(c);
     }
-    queue.recycle(cache);
+    queue.recycle(scratch);
     out
 }
 
@@ -753,7 +625,7 @@ mod tests {
         out
     }
 
-    /// The lazy queue (first and repeated tests of each pair, i.e. on-the-fly and cached axes) gives exactly the
+    /// The lazy queue (first and repeated tests of each pair, with the scratch lists recycled) gives exactly the
     /// reference's pairs, order and violations (bit for bit), with and without clearance, horizontal clearance and
     /// sweeps, at positions from far apart to deeply overlapping.
     #[test]
@@ -775,7 +647,7 @@ mod tests {
         for (clearance, horizontal, insertion) in
             [(0.0, false, false), (3.0, false, false), (3.0, true, false), (3.0, true, true), (0.0, false, true)]
         {
-            let mut cache = AxesCache::default();
+            let mut scratch = DetectScratch::default();
             for ti in 0..6 {
                 let theta = ti as f64 * 0.7;
                 let cost = Cost::Target { target: DVec3::ZERO };
@@ -794,7 +666,7 @@ mod tests {
                             clearance,
                             horizontal,
                             tol,
-                            &mut cache,
+                            &mut scratch,
                             &mut counts,
                         );
                         assert_eq!(got, expected, "p {p}, theta {theta}, clearance {clearance}, {horizontal}");

@@ -46,7 +46,7 @@
 //! narrow phase on overlapping boxes) and at most one obstacle construction. Root QPs run in parallel (rayon); the
 //! loop itself is sequential, so the result does not depend on the thread count.
 
-use crate::detect::{AxesCache, CandidateQueue, DetectCounts, StackScene, SweepAxes};
+use crate::detect::{CandidateQueue, DetectCounts, DetectScratch, StackScene, SweepAxes};
 use crate::interval_obstacles::{IntervalObstacles, ObstacleRoute};
 use crate::obstacles::DerivedObstacle;
 use crate::orientation::{Orientation, SeparableQuadratic};
@@ -507,7 +507,7 @@ struct Search<'r, 'a> {
     /// Per orientation, the (moving, stack component) pairs whose derived obstacle an earlier search of the plan
     /// built (indexed once per search; taken when the orientation is first expanded).
     shared_pairs: Vec<Vec<(usize, usize)>>,
-    axes: AxesCache,
+    detect_scratch: DetectScratch,
     intervals: IntervalObstacles,
     stats: PlacementStats,
 }
@@ -527,17 +527,17 @@ pub fn place_with_cache(
 }
 
 /// What successive searches into a growing stack share beyond the [`ObstacleCache`]: the derived obstacles (insertion
-/// and clearance applied) and the separating-axis data of each (orientation, pair), both keyed by orientation index,
-/// and the constant-topology structures the obstacles are extrapolated from ([`IntervalObstacles`]). They are reused
+/// and clearance applied) of each (orientation, pair), keyed by orientation index, the constant-topology structures
+/// the obstacles are extrapolated from ([`IntervalObstacles`]) and the detection's scratch lists. They are reused
 /// only while the searches have the same orientations (bit-identical rotations), the same clearance, insertion,
 /// horizontal-clearance and extrapolation settings, and the previous search's stack components are the first
-/// components of the new stack, bit for bit (parts appended, never moved); otherwise they are cleared. The first two
-/// are pure functions of those inputs; an extrapolated obstacle depends (in its last bits) on which angle its
+/// components of the new stack, bit for bit (parts appended, never moved); otherwise they are cleared. The derived
+/// obstacles are pure functions of those inputs; an extrapolated obstacle depends (in its last bits) on which angle its
 /// structure was built at, so a plan's results depend on its search history, deterministically.
 #[derive(Debug, Default)]
 pub struct SearchCaches {
     signature: Option<CacheSignature>,
-    axes: AxesCache,
+    detect_scratch: DetectScratch,
     derived: HashMap<(usize, usize, usize), Arc<DerivedObstacle>>,
     intervals: IntervalObstacles,
     /// Whether searches continue the open frontier of an earlier search ([`SearchCaches::carrying_frontiers`]).
@@ -629,7 +629,6 @@ impl SearchCaches {
                 && old.stack.iter().zip(&next.stack).all(|(a, b)| a == b)
         });
         if !keep {
-            self.axes.clear();
             self.derived.clear();
             self.intervals.clear();
             self.table = ObstacleTable::default();
@@ -733,7 +732,7 @@ fn prepare<'r, 'a>(
         obstacle_ids: table.ids,
         by_orientation: table.by_orientation,
         shared_pairs,
-        axes: std::mem::take(&mut caches.axes),
+        detect_scratch: std::mem::take(&mut caches.detect_scratch),
         derived: std::mem::take(&mut caches.derived),
         intervals: std::mem::take(&mut caches.intervals),
         stats,
@@ -970,7 +969,7 @@ fn ms(since: Instant) -> f64 {
 impl Search<'_, '_> {
     /// Moves the shared caches' contents back into `caches`.
     fn give_back(&mut self, caches: &mut SearchCaches) {
-        caches.axes = std::mem::take(&mut self.axes);
+        caches.detect_scratch = std::mem::take(&mut self.detect_scratch);
         caches.derived = std::mem::take(&mut self.derived);
         caches.intervals = std::mem::take(&mut self.intervals);
     }
@@ -1253,7 +1252,7 @@ impl Search<'_, '_> {
                     clearance,
                     self.request.horizontal_clearance,
                     tol,
-                    &mut self.axes,
+                    &mut self.detect_scratch,
                     &mut counts,
                 );
                 self.stats.interference_tests += 1;
@@ -1267,7 +1266,6 @@ impl Search<'_, '_> {
                         &self.scene,
                         &self.orientations[node.orientation],
                         self.sweeps[node.orientation].as_ref(),
-                        &mut self.axes,
                     );
                     self.stats.time_interference_ms += ms(t_det);
                     let Some(c) = next else { break };
@@ -1280,7 +1278,7 @@ impl Search<'_, '_> {
                         break;
                     }
                 }
-                queue.recycle(&mut self.axes);
+                queue.recycle(&mut self.detect_scratch);
             }
             let Some(id) = cutting else {
                 // free: a placement, unless it repeats one already found (cells share boundaries)

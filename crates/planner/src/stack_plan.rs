@@ -383,6 +383,18 @@ pub fn plan_stack_with_progress(
                 let candidate = settled(part, &rests, candidate, &scene, &cache, tol, &request.cost)?;
                 let verdict = accept(&mut growing, part, &candidate.0, &mut stats)?;
                 stats.seconds_checks += started.elapsed().as_secs_f64();
+                tracing::trace!(
+                    index,
+                    stage,
+                    tested,
+                    cost = candidate.0.cost,
+                    theta_deg = candidate.0.theta_deg,
+                    resting_pose = candidate.0.resting_pose,
+                    position = ?candidate.0.position,
+                    nodes = search.stats().nodes_expanded,
+                    verdict = ?verdict,
+                    "candidate tested"
+                );
                 match verdict {
                     Ok(grasp_radius) => {
                         accepted.push((stage, candidate, tested, grasp_radius));
