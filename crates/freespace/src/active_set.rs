@@ -80,7 +80,7 @@ pub(crate) fn dot4(a: &V4, b: &V4) -> f64 {
 
 /// `a . b` over the first `K` lanes, summed in the order of [`dot4`] (which is `dot_first::<4>`).
 #[inline]
-fn dot_first<const K: usize>(a: &V4, b: &V4) -> f64 {
+pub(crate) fn dot_first<const K: usize>(a: &V4, b: &V4) -> f64 {
     let mut s = a[0] * b[0];
     for i in 1..K {
         s += a[i] * b[i];

@@ -25,7 +25,7 @@
 //!
 //! Redundancy removal costs one LP per inequality (O(m) iterations of O(m) each); membership is O(m).
 
-use crate::active_set::{ActiveSetError, MAX_N, Outcome, Problem, Seek, V4, dot4};
+use crate::active_set::{ActiveSetError, MAX_N, Outcome, Problem, Seek, V4, dot_first, dot4};
 use geom::{Containment, Tolerance};
 use serde::{Deserialize, Serialize};
 use stackplan_geom as geom;
@@ -683,11 +683,13 @@ fn phase_one_rows<const D: usize>(
     length_scale: f64,
 ) -> Result<Option<V4>, CellError> {
     let mut point = to_v4(start);
-    let satisfied_at = |j: usize, p: &V4| dot4(&rows[j], p) <= offsets[j];
+    // the level over the D used lanes (the others are zeros: only the sign of a zero level can differ from the full
+    // `dot4`, and `<=` does not see it)
+    let satisfied_at = |j: usize, p: &V4| dot_first::<D>(&rows[j], p) <= offsets[j];
     // (a copy of the start point and zipped slices: no bounds checks, and the point stays in registers although
     // the mask's byte stores could alias it)
     let p0 = point;
-    mask.extend(rows.iter().zip(offsets).map(|(row, &b)| dot4(row, &p0) <= b));
+    mask.extend(rows.iter().zip(offsets).map(|(row, &b)| dot_first::<D>(row, &p0) <= b));
     for j in 0..rows.len() {
         if mask[j] {
             continue;
