@@ -4,8 +4,9 @@
 //!   of `gauss_map_obstacle` (the obstacle with its planes, edges, provenance and kinds, or the failure) on 100
 //!   polytopes x 4 400 pairs x 86 rotations and writes one line per case to `FILE`: run it before and after a change,
 //!   then `cmp` the two files;
-//! * `... --example obstacle_identity -- profile box|prism|general [CALLS]` builds and drops `CALLS` (default 10 000)
-//!   obstacles of the benchmark's box or prism pair in `build_and_drop`, for `valgrind --tool=callgrind
+//! * `... --example obstacle_identity -- profile box|prism|general|random [CALLS]` builds and drops `CALLS` (default
+//!   10 000) obstacles of the benchmark's box or prism pair (`general`: the boxes under a general rotation, `random`:
+//!   two hulls of 20 and 24 points) in `build_and_drop`, for `valgrind --tool=callgrind
 //!   --toggle-collect='*build_and_drop*'` or `perf stat -e task-clock`.
 
 #![allow(clippy::print_stdout, clippy::print_stderr)] // a command-line tool reports its counts
@@ -170,6 +171,21 @@ fn profile(case: &str, n: usize) {
             DMat3::from_rotation_z(0.3),
         ),
         "prism" => (prism(1.0), prism(0.7), DMat3::from_rotation_z(0.3)),
+        "random" => {
+            // hulls of 20 and 24 points on ellipsoids (more than 64 obstacle vertices: the star-sort edge table)
+            let cloud = |n: usize, seed: f64| {
+                let pts: Vec<DVec3> = (0..n)
+                    .map(|k| {
+                        let t = k as f64 * 2.399 + seed;
+                        let z = 1.0 - 2.0 * (k as f64 + 0.5) / n as f64;
+                        let r = (1.0 - z * z).sqrt();
+                        DVec3::new(r * t.cos() * 3.0, r * t.sin() * 2.0, z)
+                    })
+                    .collect();
+                convex_hull(&pts).expect("hull").polytope
+            };
+            (cloud(20, 0.3), cloud(24, 0.7), DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7))
+        }
         _ => (
             common::cuboid(DVec3::ZERO, DVec3::new(100.0, 50.0, 2.0)),
             common::cuboid(DVec3::ZERO, DVec3::new(80.0, 60.0, 2.0)),
@@ -191,7 +207,9 @@ fn main() {
             profile(case, args.get(3).and_then(|s| s.parse().ok()).unwrap_or(10_000));
         }
         _ => {
-            eprintln!("usage: obstacle_identity dump FILE | obstacle_identity profile box|prism|general [CALLS]");
+            eprintln!(
+                "usage: obstacle_identity dump FILE | obstacle_identity profile box|prism|general|random [CALLS]"
+            );
             std::process::exit(2);
         }
     }

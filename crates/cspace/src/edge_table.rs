@@ -76,6 +76,7 @@ fn build_stars(nv: usize, faces: &[Face], scratch: &mut EdgeScratch) -> Option<(
     out.clear();
     out.resize(total, (0, 0));
     face_of.clear();
+    face_of.resize(total, 0);
     let mut h = 0u32;
     for (f, face) in faces.iter().enumerate() {
         let Some((&first, rest)) = face.vertices.split_first() else { continue };
@@ -87,7 +88,7 @@ fn build_stars(nv: usize, faces: &[Face], scratch: &mut EdgeScratch) -> Option<(
             let slot = &mut start[a + 1];
             out[*slot as usize] = (b as u32, h);
             *slot += 1;
-            face_of.push(f as u32);
+            face_of[h as usize] = f as u32;
             h += 1;
             a = b;
         }
