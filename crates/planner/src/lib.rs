@@ -10,6 +10,7 @@
 //! * [`detect`]: interference pairs at a configuration (broad phase + exact narrow phase, insertion sweeps);
 //! * [`interval_obstacles`]: obstacles constructed at interval starts and extrapolated inside ([A] IV-B);
 //! * [`obstacles`]: the pair obstacles cut out (plain, insertion, clearance) with face provenance;
+//! * [`dary_heap`]: the 4-ary heap of the search's open nodes;
 //! * [`qp`]: the QP on a free-space cell with its active constraints;
 //! * [`search`]: the best-first search and its statistics ([A] Tables I-II);
 //! * [`settle`]: the vertical drop of a part released above its supports (clearance on inclined faces);
@@ -18,6 +19,7 @@
 //! * [`stack_plan`]: the stacking planner for n identical parts ([A] II-B): placement, then stability, grasp and
 //!   insertion checks, in the seed's two stages.
 
+pub mod dary_heap;
 pub mod detect;
 pub mod interval_obstacles;
 pub mod obstacles;

@@ -46,6 +46,7 @@
 //! narrow phase on overlapping boxes) and at most one obstacle construction. Root QPs run in parallel (rayon); the
 //! loop itself is sequential, so the result does not depend on the thread count.
 
+use crate::dary_heap::DaryHeap;
 use crate::detect::{CandidateQueue, DetectCounts, DetectScratch, StackScene, SweepAxes};
 use crate::interval_obstacles::{IntervalObstacles, ObstacleRoute};
 use crate::obstacles::DerivedObstacle;
@@ -60,7 +61,7 @@ use stackplan_cspace::ObstacleCache;
 use stackplan_freespace::cell::{Cell, Halfspace, Tag};
 use stackplan_geom::{Pose, Tolerance};
 use std::cmp::Ordering;
-use std::collections::{BinaryHeap, HashMap};
+use std::collections::HashMap;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -331,17 +332,17 @@ impl PartialOrd for HeapKey {
     }
 }
 impl Ord for HeapKey {
-    /// Reversed so that `BinaryHeap` pops the cheapest (then lowest orientation, then lowest id).
+    /// Reversed so that the max-heap pops the cheapest (then lowest orientation, then lowest id).
     fn cmp(&self, other: &Self) -> Ordering {
         other.cost.total_cmp(&self.cost).then(other.orientation.cmp(&self.orientation)).then(other.id.cmp(&self.id))
     }
 }
 
-/// The open nodes: a binary heap of small keys (cost, orientation, id) over a slab of the solved nodes (whose
+/// The open nodes: a 4-ary heap ([`DaryHeap`]) of small keys (cost, orientation, id) over a slab of the solved nodes (whose
 /// cells, optima and paths would otherwise be moved at every sift) and the families of pending children (one entry
 /// each, see [`Family`]). Pops in the order (cost, orientation, id).
 struct NodeHeap<const D: usize> {
-    keys: BinaryHeap<HeapKey>,
+    keys: DaryHeap<HeapKey>,
     slab: Vec<Option<Node<D>>>,
     free: Vec<u32>,
     families: Vec<Family<D>>,
@@ -351,7 +352,7 @@ struct NodeHeap<const D: usize> {
 
 impl<const D: usize> Default for NodeHeap<D> {
     fn default() -> Self {
-        Self { keys: BinaryHeap::new(), slab: Vec::new(), free: Vec::new(), families: Vec::new(), children: Vec::new() }
+        Self { keys: DaryHeap::new(), slab: Vec::new(), free: Vec::new(), families: Vec::new(), children: Vec::new() }
     }
 }
 
