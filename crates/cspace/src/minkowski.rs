@@ -551,7 +551,10 @@ fn overlay(
         #[cfg(test)]
         z_prism::TAKEN.with(|c| c.set(c.get() + 1));
         z_prism::face_specs(am, bn, &prism.a, &prism.b, neg_ra, bv, merged_with_a, merged_with_b, faces)?;
-        let buffers = AssemblyBuffers { index_of, cycle, planar, merged_with_b, neg_ra, edges };
+        // the merged pole faces need no faces across their edges when no side face of -RA is merged (`z_prism.rs`)
+        let pole_faces_alone = by_class && z_prism::no_side_merged(&prism.a_classes, merged_with_b);
+        let plain = if pole_faces_alone { Some(prism.b_classes.as_slice()) } else { None };
+        let buffers = AssemblyBuffers { index_of, cycle, planar, merged_with_b, neg_ra, edges, plain };
         return assemble(moving, fixed, rotation, ra, faces, buffers);
     }
 
@@ -663,7 +666,7 @@ fn overlay(
             }
         }
     }
-    let buffers = AssemblyBuffers { index_of, cycle, planar, merged_with_b, neg_ra, edges };
+    let buffers = AssemblyBuffers { index_of, cycle, planar, merged_with_b, neg_ra, edges, plain: None };
     assemble(moving, fixed, rotation, ra, faces, buffers)
 }
 
@@ -818,6 +821,9 @@ struct AssemblyBuffers<'a> {
     neg_ra: &'a [DVec3],
     /// The edge table's buffers.
     edges: &'a mut EdgeScratch,
+    /// `Some(classes of B's faces)` when the merged faces of two poles (`z_prism.rs`) need no faces across their
+    /// edges: the test that reads them cannot succeed (see `z_prism::no_side_merged`).
+    plain: Option<&'a [u8]>,
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -829,7 +835,8 @@ fn assemble(
     specs: &[FaceSpec],
     buffers: AssemblyBuffers<'_>,
 ) -> Result<Obstacle, OverlayFailure> {
-    let AssemblyBuffers { index_of, cycle, planar: scratch, merged_with_b, neg_ra, edges: edge_scratch } = buffers;
+    let AssemblyBuffers { index_of, cycle, planar: scratch, merged_with_b, neg_ra, edges: edge_scratch, plain } =
+        buffers;
     let bv = fixed.vertices();
     let nb = bv.len();
     index_of.clear();
@@ -874,7 +881,10 @@ fn assemble(
             }
             (fixed_feature, moving_feature) => {
                 let n = spec.normal;
-                let both_faces = matches!((fixed_feature, moving_feature), (Feature::Face(_), Feature::Face(_)));
+                let both_faces = match (fixed_feature, moving_feature) {
+                    (Feature::Face(g), Feature::Face(_)) => !plain.is_some_and(|c| z_prism::is_pole(c[g])),
+                    _ => false,
+                };
                 let r = scratch.b.build(fixed, fixed_feature, false, bv, n, None, both_faces);
                 scratch.a.build(moving, moving_feature, true, neg_ra, n, Some(r), both_faces);
                 planar_merge(merged_with_b, n, both_faces, scratch, cycle);

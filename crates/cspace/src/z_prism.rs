@@ -151,6 +151,22 @@ pub(crate) fn parallel_faces(
     true
 }
 
+/// Whether the class is a pole's.
+#[inline]
+pub(crate) fn is_pole(class: u8) -> bool {
+    class == POLE
+}
+
+/// Whether no side face of `-RA` is merged with a face of `B`. Then, after [`parallel_faces`] (which merges only
+/// normals of one class), the merged face of two poles needs no faces across its edges: the merge
+/// (`minkowski::planar_merge`) reads them only in the test "the faces across both edges are merged", and every edge of
+/// a pole face of a z-prism lies between the pole and a side face (no edge joins two poles), so the face of `-RA`
+/// across it is a side face, merged with nothing: the test fails whatever the face of `B` across is, exactly as when
+/// the merge is told that its polygons are not both faces.
+pub(crate) fn no_side_merged(a_classes: &[u8], merged_with_b: &[Option<usize>]) -> bool {
+    a_classes.iter().zip(merged_with_b).all(|(&c, m)| c == POLE || m.is_none())
+}
+
 /// The support feature of the other summand for the face normal `u` that is merged with none of its faces: an edge
 /// whose (vertical) arc holds `u` strictly inside, else the vertex `argmax(points, u)`; as the general route decides.
 #[inline]
