@@ -60,7 +60,6 @@ use serde::{Deserialize, Serialize};
 use stackplan_cspace::ObstacleCache;
 use stackplan_freespace::cell::{Cell, Halfspace, Tag};
 use stackplan_geom::{Pose, Tolerance};
-use std::cmp::Ordering;
 use std::collections::HashMap;
 use std::sync::Arc;
 use std::time::Instant;
@@ -309,34 +308,40 @@ fn quantised_cost(cost: f64) -> f64 {
 
 /// The key of a node in the heap: its cost (rounded, [`quantised_cost`]), orientation and id (the total order of
 /// the search), and its slot in [`NodeHeap`]'s slab, or (with [`FAMILY`] set) its family's index.
-#[derive(Debug, Clone, Copy)]
+///
+/// The order is encoded in two integers so that a comparison is two integer compares (a heap walk makes up to four
+/// per level): `rank_cost` is the rounded cost's bits mapped monotonically to `u64` (the order of `f64::total_cmp`),
+/// `rank_tie` is `orientation << 40 | id`, both complemented so that the max-heap pops the cheapest, then the lowest
+/// orientation, then the lowest id. Ids stay below `2^40` (the node budget is far smaller) and orientations below
+/// `2^24` (checked when the search is prepared).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 struct HeapKey {
-    cost: f64,
-    orientation: u32,
+    rank_cost: u64,
+    rank_tie: u64,
     slot: u32,
-    id: u64,
+}
+
+/// Bits of [`HeapKey::rank_tie`] that hold the id.
+const ID_BITS: u32 = 40;
+
+impl HeapKey {
+    fn new(cost: f64, orientation: usize, id: u64, slot: u32) -> Self {
+        debug_assert!(id < 1 << ID_BITS && orientation < 1 << (64 - ID_BITS));
+        let bits = quantised_cost(cost).to_bits();
+        // negative: all bits flipped; positive: the sign bit set (`total_cmp`'s order as unsigned integers)
+        let ordered = if bits >> 63 == 1 { !bits } else { bits | 1 << 63 };
+        Self { rank_cost: !ordered, rank_tie: !((orientation as u64) << ID_BITS | id), slot }
+    }
+
+    /// The rounded cost.
+    fn cost(&self) -> f64 {
+        let ordered = !self.rank_cost;
+        f64::from_bits(if ordered >> 63 == 1 { ordered & !(1 << 63) } else { !ordered })
+    }
 }
 
 /// The bit of [`HeapKey::slot`] that marks a family's entry.
 const FAMILY: u32 = 1 << 31;
-
-impl PartialEq for HeapKey {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
-}
-impl Eq for HeapKey {}
-impl PartialOrd for HeapKey {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for HeapKey {
-    /// Reversed so that the max-heap pops the cheapest (then lowest orientation, then lowest id).
-    fn cmp(&self, other: &Self) -> Ordering {
-        other.cost.total_cmp(&self.cost).then(other.orientation.cmp(&self.orientation)).then(other.id.cmp(&self.id))
-    }
-}
 
 /// The open nodes: a 4-ary heap ([`DaryHeap`]) of small keys (cost, orientation, id) over a slab of the solved nodes (whose
 /// cells, optima and paths would otherwise be moved at every sift) and the families of pending children (one entry
@@ -358,8 +363,7 @@ impl<const D: usize> Default for NodeHeap<D> {
 
 impl<const D: usize> NodeHeap<D> {
     fn push(&mut self, node: Node<D>) {
-        let key =
-            HeapKey { cost: quantised_cost(node.cost), orientation: node.orientation as u32, slot: 0, id: node.id };
+        let (cost, orientation, id) = (node.cost, node.orientation, node.id);
         let slot = match self.free.pop() {
             Some(slot) => {
                 self.slab[slot as usize] = Some(node);
@@ -370,7 +374,7 @@ impl<const D: usize> NodeHeap<D> {
                 (self.slab.len() - 1) as u32
             }
         };
-        self.keys.push(HeapKey { slot, ..key });
+        self.keys.push(HeapKey::new(cost, orientation, id, slot));
     }
 
     /// Pushes a family with the pending children `children` (`(key, id, face)`; drained; none: nothing to push).
@@ -386,29 +390,27 @@ impl<const D: usize> NodeHeap<D> {
         let &(cost, id, _) = children.last().unwrap_or(&(f64::INFINITY, 0, 0));
         self.children.append(children);
         let index = self.families.len() as u32;
-        self.keys.push(HeapKey {
-            cost: quantised_cost(cost),
-            orientation: family.orientation as u32,
-            slot: index | FAMILY,
-            id,
-        });
+        self.keys.push(HeapKey::new(cost, family.orientation, id, index | FAMILY));
         self.families.push(family);
     }
 
     fn pop(&mut self) -> Option<Popped<D>> {
-        let key = self.keys.pop()?;
-        if key.slot & FAMILY != 0 {
-            let index = key.slot & !FAMILY;
+        let top = *self.keys.peek()?;
+        if top.slot & FAMILY != 0 {
+            let index = top.slot & !FAMILY;
             let family = &mut self.families[index as usize];
             family.left = family.left.checked_sub(1)?;
             let (_, id, face) = self.children[family.first + family.left as usize];
             if family.left > 0 {
+                // the family's next child: its key is not less than the popped one's, so it replaces the top
                 let (cost, next, _) = self.children[family.first + family.left as usize - 1];
-                let orientation = family.orientation as u32;
-                self.keys.push(HeapKey { cost: quantised_cost(cost), orientation, slot: key.slot, id: next });
+                self.keys.replace_top(HeapKey::new(cost, family.orientation, next, top.slot));
+            } else {
+                self.keys.pop();
             }
             return Some(Popped::Pending { family: index, id, face });
         }
+        let key = self.keys.pop()?;
         self.free.push(key.slot);
         self.slab[key.slot as usize].take().map(Popped::Solved)
     }
@@ -419,7 +421,7 @@ impl<const D: usize> NodeHeap<D> {
 
     /// The cheapest key's (rounded) cost: a lower bound of every cost the heap still holds.
     fn peek_cost(&self) -> Option<f64> {
-        self.keys.peek().map(|key| key.cost)
+        self.keys.peek().map(HeapKey::cost)
     }
 
     fn is_empty(&self) -> bool {
@@ -678,6 +680,14 @@ fn prepare<'r, 'a>(
         for (ti, &theta) in request.thetas.iter().enumerate().take(count) {
             orientations.push((rest, ti, theta, *r));
         }
+    }
+    // the heap key packs the orientation index in 24 bits (`HeapKey`)
+    if orientations.len() >= 1 << (64 - ID_BITS) {
+        return Err(PlacementError::BadOption(format!(
+            "{} orientations (resting poses x theta values) are more than the search handles ({})",
+            orientations.len(),
+            (1u64 << (64 - ID_BITS)) - 1
+        )));
     }
     let orientations: Vec<Orientation> = orientations
         .into_par_iter()
@@ -1568,6 +1578,43 @@ mod tests {
         for v in values {
             let q = quantised_cost(v);
             assert!((q - v).abs() <= v.abs() * 2f64.powi(-40), "{v} -> {q}");
+        }
+    }
+
+    /// The integer-encoded heap key orders as (rounded cost by `total_cmp`, orientation, id) reversed (the max-heap
+    /// pops the cheapest), and gives the rounded cost back.
+    #[test]
+    fn heap_key_orders_as_cost_orientation_id() {
+        let costs = [
+            f64::NEG_INFINITY,
+            -1e300,
+            -2.5,
+            -0.0,
+            0.0,
+            1e-300,
+            0.75,
+            1.0,
+            1.0000000000000002,
+            8560.25,
+            8560.25 * (1.0 + 1e-9),
+            1e300,
+            f64::INFINITY,
+        ];
+        let mut keys = Vec::new();
+        for (a, &cost) in costs.iter().enumerate() {
+            for orientation in [0usize, 1, 359, (1 << 24) - 1] {
+                for id in [0u64, 1, 77, (1 << 40) - 1] {
+                    keys.push(((cost, orientation, id), HeapKey::new(cost, orientation, id, a as u32)));
+                }
+            }
+        }
+        for (x, kx) in &keys {
+            assert_eq!(kx.cost().to_bits(), quantised_cost(x.0).to_bits(), "{x:?}");
+            for (y, ky) in &keys {
+                let expected =
+                    quantised_cost(y.0).total_cmp(&quantised_cost(x.0)).then(y.1.cmp(&x.1)).then(y.2.cmp(&x.2));
+                assert_eq!((kx.rank_cost, kx.rank_tie).cmp(&(ky.rank_cost, ky.rank_tie)), expected, "{x:?} vs {y:?}");
+            }
         }
     }
 }
