@@ -704,8 +704,9 @@ impl Problem<'_> {
         let m = self.rows.len();
         let bland_after = 4 * m + 20;
         let limit = 40 * (m + 5);
-        let flat_tol = 1e-10 * self.gradient_scale();
-        let mult_tol = MULT_TOL * self.gradient_scale();
+        let gradient_scale = self.gradient_scale();
+        let flat_tol = 1e-10 * gradient_scale;
+        let mult_tol = MULT_TOL * gradient_scale;
         let g = self.g;
         let mut p = start;
         let mut w = WorkSet::default();
