@@ -465,6 +465,7 @@ pub fn plan_stack_with_progress(
         check_stack(&world, &CheckOptions { margin_directions: 8, prefix_stability: true, ..check_options })
             .map_err(|e| PlanError::Check(e.to_string()))?;
     stats.seconds_checks += started.elapsed().as_secs_f64();
+    tracing::debug!(ms = started.elapsed().as_secs_f64() * 1e3, "final stack check (with margins)");
     for (p, c) in planned.iter_mut().zip(&final_check.parts) {
         p.stability_margin = c.margin;
     }
