@@ -245,6 +245,14 @@ mod tests {
         convex_hull(&pts).expect("prism").polytope
     }
 
+    /// A box with corners scaled by `s` and unit face normals (the planes of a box of ordinary size).
+    fn scaled(s: f64) -> ConvexPolytope {
+        let unit = ConvexPolytope::cuboid(DVec3::new(-1.0, 0.0, -1.0), DVec3::new(2.0, 1.0, 3.0)).expect("box");
+        let vertices = unit.vertices().iter().map(|v| *v * s).collect();
+        let planes = unit.planes().map(|p| stackplan_geom::Plane { normal: p.normal, offset: p.offset * s }).collect();
+        unit.with_geometry(vertices, planes).expect("same topology")
+    }
+
     #[test]
     fn z_prism_route_equals_the_general_overlay() {
         // boxes, the bench's hexagons, regular and irregular outlines (some sharing edge directions), extruded along
@@ -259,6 +267,9 @@ mod tests {
             prism(&[(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 2.0)], -0.5, 0.25, 2),
             prism(&[(0.0, 0.0), (1.5, 0.5), (0.5, 1.5)], 0.0, 0.75, 2),
             prism(&[(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 2.0)], -0.5, 0.25, 0),
+            // squared lengths that overflow and underflow (circles of zero length, or refused)
+            scaled(1e160),
+            scaled(1e-170),
         ];
         for (n, turn) in [(5, 0.1), (8, 0.0), (7, 1.3)] {
             let outline: Vec<(f64, f64)> = (0..n)
@@ -281,7 +292,8 @@ mod tests {
         rotations.push(DMat3::from_cols(DVec3::Y, -DVec3::X, DVec3::Z));
         rotations.push(DMat3::from_cols(-DVec3::X, -DVec3::Y, DVec3::Z));
         rotations.push(DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7));
-        // the z-prisms among them (not the x-extruded one; not the 7-gon, whose top normal has a rounded x of 3e-17)
+        // the z-prisms among them (not the x-extruded one; not the 7-gon, whose top normal has a rounded x of 3e-17;
+        // not the tiny box, whose vertical edges' squared lengths underflow)
         let z_prisms = shapes
             .iter()
             .filter(|s| {
@@ -289,7 +301,7 @@ mod tests {
                 super::vertical_arcs(s, s.vertices(), &n, &mut Vec::new(), &mut Vec::new())
             })
             .count();
-        assert_eq!(z_prisms, 8);
+        assert_eq!(z_prisms, 9);
         let taken_before = super::TAKEN.with(std::cell::Cell::get);
         let (mut cases, mut merged) = (0, 0);
         for a in &shapes {
