@@ -26,7 +26,7 @@
 //! product, the only term computed here), a pole that is not merged with a face of the other summand is supported by a
 //! vertex, and the face list is the general route's steps 1 and 2 with step 3 empty: the same `FaceSpec`s in the same
 //! order, handed to the same assembly, so the obstacle is bit for bit the general route's (checked by
-//! `examples/obstacle_identity.rs dump` and by the unit test in `minkowski.rs` on pairs of prisms at many angles).
+//! `examples/obstacle_identity.rs dump` and by the unit test below on pairs of prisms at many angles).
 //! What is saved: both sign tables (`EA FB + EB FA` products), the arc-crossing pass, the circles of the horizontal
 //! arcs and most of the support tests' arithmetic.
 //!
