@@ -153,8 +153,8 @@ pub struct Cell<const D: usize> {
     tolerance: Tolerance,
     shape: CellShape<D>,
     /// Whether every normal is a fixed point of [`unit_halfspace`] (its computed length is exactly 1.0), so that
-    /// normalising the inequalities again is the identity ([`Cell::extended`] then copies them). `false` only makes
-    /// `extended` normalise them again.
+    /// normalising the inequalities again is the identity ([`Cell::extended`] then copies them). A function of the
+    /// inequalities (so the derived equality of cells is the one of their lists).
     unit: bool,
 }
 
@@ -550,8 +550,8 @@ impl<const D: usize> Cell<D> {
         let hs: Vec<Halfspace<D>> =
             self.halfspaces.iter().zip(&mask).filter(|(_, keep)| **keep).map(|(h, _)| *h).collect();
         let lists = pack(&hs);
-        // a subset of fixed points is fixed
-        Ok(Self { halfspaces: hs, lists, tolerance: self.tolerance, shape: self.shape, unit: self.unit })
+        let unit = hs.iter().all(|h| length(&h.normal) == 1.0);
+        Ok(Self { halfspaces: hs, lists, tolerance: self.tolerance, shape: self.shape, unit })
     }
 
     /// Maximum of `direction . p` over the cell with a maximiser (lowest z, y, x among maximisers); `None` if empty.
@@ -938,6 +938,7 @@ mod tests {
             };
             assert!(matches!(child.shape, CellShape::Known { .. }), "case {case}");
             assert_eq!(bits(&child), bits(&fresh), "case {case}");
+            assert_eq!(child.unit, child.halfspaces().iter().all(|h| length(&h.normal) == 1.0));
             copied += usize::from(parent.unit);
             children += 1;
         }
