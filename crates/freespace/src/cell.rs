@@ -443,12 +443,11 @@ impl<const D: usize> Cell<D> {
         }
     }
 
-    /// This cell (non-empty, so every normal is non-zero) with extra inequalities added that are normalised
-    /// already: the rows `extra_rows` with the offsets and tags of `extra` (as
-    /// [`Cell::phase_one_in`] leaves them in its scratch: `unit_halfspace` of each extra inequality, zero normals
-    /// that hold dropped). The result is `Cell::new` of all the inequalities (provisionally [`CellShape::Known`] at
-    /// the origin), bit for bit: the extra inequalities went through the same normalisation, and this cell's are
-    /// normalised again as `Cell::new` would.
+    /// This cell (non-empty) with extra inequalities added that are normalised already: the rows `extra_rows` with
+    /// the offsets and tags of `extra` (as [`Cell::phase_one_in`] leaves them in its scratch: `unit_halfspace` of
+    /// each extra inequality, zero normals that hold dropped). The result is `Cell::new` of all the inequalities
+    /// (provisionally [`CellShape::Known`] at the origin, or [`CellShape::Empty`]), bit for bit: the extra
+    /// inequalities went through the same normalisation, and this cell's are normalised again as `Cell::new` would.
     ///
     /// When every inequality of this cell is a fixed point of the normalisation (`unit`), normalising them again is
     /// the identity, so they are copied (`extend_from_slice` of the inequalities, the rows and the offsets: O(m)
@@ -457,11 +456,13 @@ impl<const D: usize> Cell<D> {
     fn extended(&self, extra_rows: &[V4], extra: &[(f64, Tag)]) -> Result<Self, CellError> {
         let mut halfspaces = Vec::with_capacity(self.halfspaces.len() + extra.len());
         let mut unit = true;
+        let mut trivially_empty = false;
         if self.unit {
             // every inequality is a fixed point of `unit_halfspace`: normalising them again is the identity
             halfspaces.extend_from_slice(&self.halfspaces);
         } else {
-            push_normalised(&mut halfspaces, &mut unit, &self.halfspaces, 0, self.tolerance)?;
+            // (empty only if a normal vanished: an overflowing length made it zero)
+            trivially_empty = push_normalised(&mut halfspaces, &mut unit, &self.halfspaces, 0, self.tolerance)?;
         }
         let m0 = halfspaces.len();
         for (row, &(offset, tag)) in extra_rows.iter().zip(extra) {
@@ -486,7 +487,7 @@ impl<const D: usize> Cell<D> {
         } else {
             pack(&halfspaces)
         };
-        let shape = CellShape::Known { point: [0.0; D] };
+        let shape = if trivially_empty { CellShape::Empty } else { CellShape::Known { point: [0.0; D] } };
         Ok(Self { halfspaces, lists, tolerance: self.tolerance, shape, unit })
     }
 
