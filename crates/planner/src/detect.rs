@@ -271,9 +271,10 @@ struct OpenPair {
 /// Every pair that passes the boxes is scanned on its normal axes at once (most non-violating pairs are decided
 /// there); the others stay *open* with an upper bound of their violation from the running maximum (a maximum over
 /// fewer axes is smaller, and the distance that `classify_pair` takes from GJK is at least the separating-axis
-/// gap, up to GJK's accuracy, for which the bound keeps a margin). [`CandidateQueue::next`] returns a pair only when its exact violation is at least every open bound (ties
-/// by the same index order), finishing open scans on demand: the sequence is the one of sorting the exact
-/// violations, but the pairs after the one the search cuts with are never scanned to the end.
+/// gap, up to GJK's accuracy, for which the bound keeps a margin). [`CandidateQueue::next`] returns a pair only when
+/// its exact violation is at least every open bound (ties by the same index order), finishing open scans on demand:
+/// the sequence is the one of sorting the exact violations, but the pairs after the one the search cuts with are
+/// never scanned to the end.
 #[derive(Debug)]
 pub struct CandidateQueue {
     p: DVec3,

@@ -343,9 +343,9 @@ impl HeapKey {
 /// The bit of [`HeapKey::slot`] that marks a family's entry.
 const FAMILY: u32 = 1 << 31;
 
-/// The open nodes: a 4-ary heap ([`DaryHeap`]) of small keys (cost, orientation, id) over a slab of the solved nodes (whose
-/// cells, optima and paths would otherwise be moved at every sift) and the families of pending children (one entry
-/// each, see [`Family`]). Pops in the order (cost, orientation, id).
+/// The open nodes: a 4-ary heap ([`DaryHeap`]) of small keys (cost, orientation, id) over a slab of the solved nodes
+/// (whose cells, optima and paths would otherwise be moved at every sift) and the families of pending children (one
+/// entry each, see [`Family`]). Pops in the order (cost, orientation, id).
 struct NodeHeap<const D: usize> {
     keys: DaryHeap<HeapKey>,
     slab: Vec<Option<Node<D>>>,
@@ -380,14 +380,13 @@ impl<const D: usize> NodeHeap<D> {
     /// Pushes a family with the pending children `children` (`(key, id, face)`; drained; none: nothing to push).
     /// `family.first` and `family.left` are set here.
     fn push_family(&mut self, mut family: Family<D>, children: &mut Vec<(f64, u64, u32)>) {
-        if children.is_empty() {
-            return;
-        }
         // descending in (rounded key, id): the cheapest last
         children.sort_unstable_by(|a, b| quantised_cost(b.0).total_cmp(&quantised_cost(a.0)).then(b.1.cmp(&a.1)));
         family.first = self.children.len();
         family.left = children.len() as u32;
-        let &(cost, id, _) = children.last().unwrap_or(&(f64::INFINITY, 0, 0));
+        let Some(&(cost, id, _)) = children.last() else {
+            return;
+        };
         self.children.append(children);
         let index = self.families.len() as u32;
         self.keys.push(HeapKey::new(cost, family.orientation, id, index | FAMILY));
@@ -810,25 +809,28 @@ impl std::fmt::Debug for States {
 /// The shared caches are held until the search is dropped (then handed back, as [`place_with_caches`] does).
 ///
 /// ```
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// use glam::DVec3;
 /// use stackplan_cspace::ObstacleCache;
 /// use stackplan_geom::{ConvexPolytope, Part, PartOrigin, Pose};
 /// use stackplan_planner::{FloorVolume, PlacementRequest, PlacementSearch, SearchCaches, StackPart, uniform_thetas};
 ///
-/// let block = ConvexPolytope::cuboid(DVec3::ZERO, DVec3::new(40.0, 20.0, 10.0)).unwrap();
-/// let part = Part::from_components("block", vec![block], 1.0, PartOrigin::ConvexPieces).unwrap();
+/// let block = ConvexPolytope::cuboid(DVec3::ZERO, DVec3::new(40.0, 20.0, 10.0))?;
+/// let part = Part::from_components("block", vec![block], 1.0, PartOrigin::ConvexPieces)?;
 /// let stack = vec![StackPart { part: &part, pose: Pose::IDENTITY }];
 /// let mut request = PlacementRequest::new(&part, stack, FloorVolume::rectangle(-50.0, -50.0, 90.0, 70.0, 100.0));
 /// request.thetas = uniform_thetas(8);
 /// let (cache, mut caches) = (ObstacleCache::new(), SearchCaches::new());
-/// let mut search = PlacementSearch::new(&request, &cache, &mut caches).unwrap();
-/// let first = search.next_placements(2).unwrap(); // the 2 best
-/// let more = search.next_placements(3).unwrap(); // the next 3: places 3..5 of a search with k = 5
-/// assert!(first.placements.last().unwrap().cost <= more.placements[0].cost);
+/// let mut search = PlacementSearch::new(&request, &cache, &mut caches)?;
+/// let first = search.next_placements(2)?; // the 2 best
+/// let more = search.next_placements(3)?; // the next 3: places 3..5 of a search with k = 5
+/// assert!(first.placements[first.placements.len() - 1].cost <= more.placements[0].cost);
 /// drop(search); // hands the caches back
 /// request.k = 5;
-/// let once = stackplan_planner::place_with_caches(&request, &ObstacleCache::new(), &mut SearchCaches::new()).unwrap();
+/// let once = stackplan_planner::place_with_caches(&request, &ObstacleCache::new(), &mut SearchCaches::new())?;
 /// assert_eq!([first.placements, more.placements].concat(), once.placements);
+/// # Ok(())
+/// # }
 /// ```
 pub struct PlacementSearch<'r, 'a, 'c> {
     search: Search<'r, 'a>,

@@ -427,7 +427,13 @@ pub fn plan_stack_with_progress(
         // stage 1 (compact) wins unless stage 2 is strictly cheaper: ties and near-ties keep the stack compact
         let best = accepted.iter().min_by(|a, b| {
             let (ca, cb) = (a.1.0.cost, b.1.0.cost);
-            if cheaper(ca, cb) || cheaper(cb, ca) { ca.total_cmp(&cb) } else { a.0.cmp(&b.0) }
+            if cheaper(ca, cb) {
+                std::cmp::Ordering::Less
+            } else if cheaper(cb, ca) {
+                std::cmp::Ordering::Greater
+            } else {
+                a.0.cmp(&b.0)
+            }
         });
         if let Some((stage, (candidate, release_drop), rejected, grasp_radius)) = best.cloned() {
             let pose = candidate.pose();
@@ -484,13 +490,13 @@ pub fn plan_stack_with_progress(
     })
 }
 
-/// The xy bounding rectangle of the placed parts.
 /// Whether cost `a` beats cost `b` outright: cheaper by more than a near-tie (`1e-9` relative), which keeps the
 /// earlier (more compact) stage's part.
 fn cheaper(a: f64, b: f64) -> bool {
     b - a > 1e-9 * (1.0 + a.abs().max(b.abs()))
 }
 
+/// The xy bounding rectangle of the placed parts.
 fn footprint(part: &Part, placed: &[Pose]) -> (DVec2, DVec2) {
     let mut lo = DVec2::splat(f64::INFINITY);
     let mut hi = DVec2::splat(f64::NEG_INFINITY);
