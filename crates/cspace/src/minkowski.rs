@@ -468,6 +468,25 @@ thread_local! {
     static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
 }
 
+#[cfg(test)]
+thread_local! {
+    /// Tests: take the one-by-one crossing test even for at most 64 B arcs.
+    static ONE_BY_ONE_CROSSINGS: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// Tests: take the general overlay even for a z-prism pair (`z_prism.rs`).
+    pub(crate) static GENERAL_ROUTE_ONLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Whether the test switch `$switch` (a thread-local above) is on; always `false` outside the tests.
+macro_rules! test_switch {
+    ($switch:ident) => {{
+        #[cfg(test)]
+        let on = $switch.with(std::cell::Cell::get);
+        #[cfg(not(test))]
+        let on = false;
+        on
+    }};
+}
+
 /// The Gauss-map route alone, without the hull fallback (for tests and benchmarks).
 pub fn gauss_map_obstacle(
     moving: &ConvexPolytope,
@@ -524,7 +543,7 @@ fn overlay(
     let (fa, fb) = (am.len(), bn.len());
 
     // two z-prisms turned about z (sheet metal): the same faces without sign tables or crossings (`z_prism.rs`)
-    let z_prisms = !general_route_only()
+    let z_prisms = !test_switch!(GENERAL_ROUTE_ONLY)
         && z_prism::vertical_arcs(moving, neg_ra, am, &mut prism.a_classes, &mut prism.a)
         && z_prism::vertical_arcs(fixed, bv, bn, &mut prism.b_classes, &mut prism.b);
 
@@ -613,7 +632,7 @@ fn overlay(
     // `to_mask[g]` the B arcs starting / ending at B's face g, the arcs from a face on the positive side to one on the
     // negative side are `(OR of from_mask over positive g) & (OR of to_mask over negative g)`, and vice versa; the
     // same pairs as the one-by-one test (the same signs), visited in the same order.
-    let small = b_arcs.len() <= 64 && !one_by_one_crossings();
+    let small = b_arcs.len() <= 64 && !test_switch!(ONE_BY_ONE_CROSSINGS);
     if small {
         from_mask.clear();
         from_mask.resize(fb, 0);
@@ -668,40 +687,6 @@ fn overlay(
     }
     let buffers = AssemblyBuffers { index_of, cycle, planar, merged_with_b, neg_ra, edges, plain: None };
     assemble(moving, fixed, rotation, ra, faces, buffers)
-}
-
-#[cfg(test)]
-thread_local! {
-    /// Tests: take the one-by-one crossing test even for at most 64 B arcs.
-    static ONE_BY_ONE_CROSSINGS: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-}
-
-#[cfg(test)]
-fn one_by_one_crossings() -> bool {
-    ONE_BY_ONE_CROSSINGS.with(std::cell::Cell::get)
-}
-
-#[cfg(not(test))]
-#[inline]
-fn one_by_one_crossings() -> bool {
-    false
-}
-
-#[cfg(test)]
-thread_local! {
-    /// Tests: take the general overlay even for a z-prism pair (`z_prism.rs`).
-    pub(crate) static GENERAL_ROUTE_ONLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-}
-
-#[cfg(test)]
-fn general_route_only() -> bool {
-    GENERAL_ROUTE_ONLY.with(std::cell::Cell::get)
-}
-
-#[cfg(not(test))]
-#[inline]
-fn general_route_only() -> bool {
-    false
 }
 
 pub(crate) struct FaceSpec {
