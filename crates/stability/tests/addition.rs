@@ -9,9 +9,7 @@
 
 mod common;
 
-use common::{
-    at, box_layers, box_part, build, fixture_columns, fixture_parts, placements, planned_channels, same_margin,
-};
+use common::{at, box_layers, box_part, build, for_each_fixture_column, placements, planned_channels, same_margin};
 use glam::DVec3;
 use proptest::prelude::*;
 use stackplan_stability::check::{CheckOptions, PartCheck, check_stack};
@@ -85,17 +83,12 @@ fn compare_additions(stack: &[PlacedPart<'_>], options: &CheckOptions, weight: f
 #[test]
 fn added_parts_report_like_the_whole_check_on_fixture_columns() {
     let mut compared = 0;
-    for (file, part) in &fixture_parts() {
-        for pose in 0..2 {
-            for (dx, dy) in [(0.0, 0.0), (7.0, -3.0), (40.0, 0.0)] {
-                let stack = fixture_columns(part, pose, dx, dy);
-                for (mu, directions, clearance) in [(0.4, 8, 0.0), (0.8, 0, 5.0)] {
-                    let what = format!("{} pose {pose} shift ({dx}, {dy}) mu {mu}", file.display());
-                    compared += compare_additions(&stack, &options(mu, directions, clearance), part.mass.mass, &what);
-                }
-            }
+    for_each_fixture_column(&[(0.0, 0.0), (7.0, -3.0), (40.0, 0.0)], |label, part, stack| {
+        for (mu, directions, clearance) in [(0.4, 8, 0.0), (0.8, 0, 5.0)] {
+            let what = format!("{label} mu {mu}");
+            compared += compare_additions(stack, &options(mu, directions, clearance), part.mass.mass, &what);
         }
-    }
+    });
     assert!(compared >= 100, "only {compared} additions compared");
 }
 
@@ -134,7 +127,7 @@ fn added_parts_report_like_the_whole_check_on_brick_walls() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: std::env::var("PROPTEST_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(16), ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: common::cases(16), ..ProptestConfig::default() })]
 
     /// Random box columns (two or three, placed layer by layer) with an optional plank bridging them on top.
     #[test]

@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::{at, box_layers, box_part, build, fixture_columns, fixture_parts, placements, planned_channels};
+use common::{at, box_layers, box_part, build, for_each_fixture_column, placements, planned_channels};
 use glam::{DMat3, DVec3};
 use proptest::prelude::*;
 use stackplan_stability::check::{CheckOptions, PartCheck, check_stack};
@@ -78,17 +78,11 @@ fn compare_candidates(stack: &[PlacedPart<'_>], options: &CheckOptions, what: &s
 #[test]
 fn candidates_fail_and_pass_like_the_added_part_report_on_fixture_columns() {
     let mut compared = 0;
-    for (file, part) in &fixture_parts() {
-        for pose in 0..2 {
-            for (dx, dy) in [(0.0, 0.0), (7.0, -3.0), (40.0, 0.0)] {
-                let stack = fixture_columns(part, pose, dx, dy);
-                for (mu, cup) in [(0.4, 5.0), (0.8, 10.0), (0.5, 400.0)] {
-                    let what = format!("{} pose {pose} shift ({dx}, {dy}) mu {mu} cup {cup}", file.display());
-                    compared += compare_candidates(&stack, &options(mu, cup), &what);
-                }
-            }
+    for_each_fixture_column(&[(0.0, 0.0), (7.0, -3.0), (40.0, 0.0)], |label, _, stack| {
+        for (mu, cup) in [(0.4, 5.0), (0.8, 10.0), (0.5, 400.0)] {
+            compared += compare_candidates(stack, &options(mu, cup), &format!("{label} mu {mu} cup {cup}"));
         }
-    }
+    });
     assert!(compared >= 150, "only {compared} candidates compared");
 }
 
@@ -166,7 +160,7 @@ fn options_a_growing_stack_cannot_honour_are_errors() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: std::env::var("PROPTEST_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(16), ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: common::cases(16), ..ProptestConfig::default() })]
 
     /// Random box columns (two or three, placed layer by layer) with an optional plank bridging them on top.
     #[test]

@@ -280,7 +280,7 @@ fn column_margin(boxes: &[(DVec3, DVec3)]) -> f64 {
 const KNIFE_EDGE: f64 = 0.005;
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: std::env::var("PROPTEST_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(16), ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: common::cases(16), ..ProptestConfig::default() })]
 
     /// Random columns of 2-4 boxes with random offsets: the check agrees with the analytic criterion; every column it
     /// calls unstable moves in the simulation, every column it calls stable stays put unless it stands on a knife edge

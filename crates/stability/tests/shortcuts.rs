@@ -21,9 +21,7 @@
 
 mod common;
 
-use common::{
-    at, box_layers, box_part, build, fixture_columns, fixture_parts, placements, planned_channels, same_margin,
-};
+use common::{at, box_layers, box_part, build, for_each_fixture_column, placements, planned_channels, same_margin};
 use glam::DVec3;
 use proptest::prelude::*;
 use stackplan_stability::check::{CheckOptions, StackCheck, check_stack, check_stack_reference};
@@ -76,19 +74,13 @@ fn assert_checks_equivalent(fast: &StackCheck, plain: &StackCheck, weight: f64, 
 
 #[test]
 fn shortcuts_match_the_plain_socps_on_fixture_columns() {
-    for (file, part) in &fixture_parts() {
-        for pose in 0..2 {
-            for (dx, dy) in [(0.0, 0.0), (7.0, -3.0)] {
-                let stack = fixture_columns(part, pose, dx, dy);
-                let mut options = options();
-                options.mu = 0.4;
-                let fast = check_stack(&stack, &options).expect("check");
-                let plain = check_stack_reference(&stack, &options).expect("check");
-                let what = format!("{} pose {pose} shift ({dx}, {dy})", file.display());
-                assert_checks_equivalent(&fast, &plain, part.mass.mass, &what);
-            }
-        }
-    }
+    for_each_fixture_column(&[(0.0, 0.0), (7.0, -3.0)], |label, part, stack| {
+        let mut options = options();
+        options.mu = 0.4;
+        let fast = check_stack(stack, &options).expect("check");
+        let plain = check_stack_reference(stack, &options).expect("check");
+        assert_checks_equivalent(&fast, &plain, part.mass.mass, label);
+    });
 }
 
 /// The planner's 15-part Channel stack (flipped channels straddling a flange of the one below: flat supports at two
@@ -106,7 +98,7 @@ fn shortcuts_match_the_plain_socps_on_the_planned_channel_stack() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: std::env::var("PROPTEST_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(16), ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: common::cases(16), ..ProptestConfig::default() })]
 
     #[test]
     fn groups_decide_like_direct_solves(

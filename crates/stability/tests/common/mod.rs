@@ -8,6 +8,24 @@ use stackplan_stability::contacts::analyse_contacts;
 use stackplan_stability::resting_poses::resting_poses;
 use stackplan_stability::world::{stack_tolerance, world_stack};
 
+/// Number of proptest cases: `PROPTEST_CASES` if set, else `default`.
+pub fn cases(default: u32) -> u32 {
+    std::env::var("PROPTEST_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(default)
+}
+
+/// Runs `f(label, part, stack)` on the fixture columns of every fixture part ([`fixture_parts`]) in its two lowest
+/// resting poses, for each shift `(dx, dy)` of `shifts` ([`fixture_columns`]).
+pub fn for_each_fixture_column(shifts: &[(f64, f64)], mut f: impl FnMut(&str, &Part, &[PlacedPart<'_>])) {
+    for (file, part) in &fixture_parts() {
+        for pose in 0..2 {
+            for &(dx, dy) in shifts {
+                let stack = fixture_columns(part, pose, dx, dy);
+                f(&format!("{} pose {pose} shift ({dx}, {dy})", file.display()), part, &stack);
+            }
+        }
+    }
+}
+
 /// The box `[lo, hi]`.
 pub fn cuboid(lo: DVec3, hi: DVec3) -> ConvexPolytope {
     ConvexPolytope::cuboid(lo, hi).expect("box")
@@ -67,8 +85,6 @@ pub fn nesting_height(placed: PlacedPart<'_>, dx: f64, dy: f64, upper: f64) -> f
     hi
 }
 
-/// Two columns of three copies of `part` in resting pose `pose`, each copy shifted by `(dx, dy)` from the one below
-/// and lowered onto it.
 /// Every fixture part (`fixtures/parts/*.json`, sorted by file name) with its file, as the library reads it.
 pub fn fixture_parts() -> Vec<(std::path::PathBuf, Part)> {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/parts");
@@ -86,6 +102,8 @@ pub fn fixture_parts() -> Vec<(std::path::PathBuf, Part)> {
     parts
 }
 
+/// Two columns of three copies of `part` in resting pose `pose`, each copy shifted by `(dx, dy)` from the one below
+/// and lowered onto it.
 pub fn fixture_columns(part: &Part, pose: usize, dx: f64, dy: f64) -> Vec<PlacedPart<'_>> {
     let poses = resting_poses(part).expect("poses");
     let pose = &poses[pose.min(poses.len() - 1)];
