@@ -474,6 +474,8 @@ thread_local! {
     static ONE_BY_ONE_CROSSINGS: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
     /// Tests: take the general overlay even for a z-prism pair (`z_prism.rs`).
     pub(crate) static GENERAL_ROUTE_ONLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// Tests: assemble a tame z-prism pair by the polygon merges too (`z_prism::derived_cycles`).
+    pub(crate) static NO_DERIVED_CYCLES: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
 /// Whether the test switch `$switch` (a thread-local above) is on; always `false` outside the tests.
@@ -543,9 +545,10 @@ fn overlay(
     let (fa, fb) = (am.len(), bn.len());
 
     // two z-prisms turned about z (sheet metal): the same faces without sign tables or crossings (`z_prism.rs`)
+    let mut tame = true;
     let z_prisms = !test_switch!(GENERAL_ROUTE_ONLY)
-        && z_prism::vertical_arcs(moving, neg_ra, am, &mut prism.a_classes, &mut prism.a)
-        && z_prism::vertical_arcs(fixed, bv, bn, &mut prism.b_classes, &mut prism.b);
+        && z_prism::vertical_arcs(moving, neg_ra, am, &mut prism.a_classes, &mut prism.a, &mut tame)
+        && z_prism::vertical_arcs(fixed, bv, bn, &mut prism.b_classes, &mut prism.b, &mut tame);
 
     // parallel faces: merged_with_b[f] = Some(g) when -R n_f == n_g within half the tolerance.
     merged_with_b.clear();
@@ -569,11 +572,23 @@ fn overlay(
     if z_prisms {
         #[cfg(test)]
         z_prism::TAKEN.with(|c| c.set(c.get() + 1));
-        z_prism::face_specs(am, bn, &prism.a, &prism.b, neg_ra, bv, merged_with_a, merged_with_b, faces)?;
+        let mut margin = f64::INFINITY;
+        z_prism::face_specs(am, bn, &prism.a, &prism.b, neg_ra, bv, merged_with_a, merged_with_b, faces, &mut margin)?;
+        // a tame pair: every cycle without the polygon merges (`z_prism::derived_cycles`)
+        let derived = tame
+            && by_class
+            && margin > z_prism::MARGIN
+            && !test_switch!(NO_DERIVED_CYCLES)
+            && z_prism::derived_cycles(moving, fixed, neg_ra, am, bn, faces, prism);
+        #[cfg(test)]
+        if derived {
+            z_prism::DERIVED.with(|c| c.set(c.get() + 1));
+        }
         // the merged pole faces need no faces across their edges when no side face of -RA is merged (`z_prism.rs`)
         let pole_faces_alone = by_class && z_prism::no_side_merged(&prism.a_classes, merged_with_b);
         let plain = if pole_faces_alone { Some(prism.b_classes.as_slice()) } else { None };
-        let buffers = AssemblyBuffers { index_of, cycle, planar, merged_with_b, neg_ra, edges, plain };
+        let cycles = if derived { Some((prism.cycles.as_slice(), prism.starts.as_slice())) } else { None };
+        let buffers = AssemblyBuffers { index_of, cycle, planar, merged_with_b, neg_ra, edges, plain, cycles };
         return assemble(moving, fixed, rotation, ra, faces, buffers);
     }
 
@@ -685,7 +700,7 @@ fn overlay(
             }
         }
     }
-    let buffers = AssemblyBuffers { index_of, cycle, planar, merged_with_b, neg_ra, edges, plain: None };
+    let buffers = AssemblyBuffers { index_of, cycle, planar, merged_with_b, neg_ra, edges, plain: None, cycles: None };
     assemble(moving, fixed, rotation, ra, faces, buffers)
 }
 
@@ -809,6 +824,9 @@ struct AssemblyBuffers<'a> {
     /// `Some(classes of B's faces)` when the merged faces of two poles (`z_prism.rs`) need no faces across their
     /// edges: the test that reads them cannot succeed (see `z_prism::no_side_merged`).
     plain: Option<&'a [u8]>,
+    /// `Some((cycles, starts))`: the vertex-pair cycle of face `s` is `cycles[starts[s]..starts[s + 1]]`, derived
+    /// without the polygon merges (`z_prism::derived_cycles`).
+    cycles: Option<(&'a [[usize; 2]], &'a [usize])>,
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -820,8 +838,16 @@ fn assemble(
     specs: &[FaceSpec],
     buffers: AssemblyBuffers<'_>,
 ) -> Result<Obstacle, OverlayFailure> {
-    let AssemblyBuffers { index_of, cycle, planar: scratch, merged_with_b, neg_ra, edges: edge_scratch, plain } =
-        buffers;
+    let AssemblyBuffers {
+        index_of,
+        cycle,
+        planar: scratch,
+        merged_with_b,
+        neg_ra,
+        edges: edge_scratch,
+        plain,
+        cycles: derived,
+    } = buffers;
     let bv = fixed.vertices();
     let nb = bv.len();
     index_of.clear();
@@ -831,56 +857,20 @@ fn assemble(
     let mut faces: Vec<Face> = Vec::with_capacity(specs.len());
     let mut kinds: Vec<FaceKind> = Vec::with_capacity(specs.len());
     edge_scratch.clear();
-    for spec in specs {
+    for (s, spec) in specs.iter().enumerate() {
         cycle.clear();
-        match (spec.fixed, spec.moving) {
-            (Feature::Face(g), Feature::Vertex(i)) => {
-                cycle.extend(fixed.faces()[g].vertices.iter().map(|&j| [i, j]));
-            }
-            (Feature::Vertex(j), Feature::Face(f)) => {
-                cycle.extend(moving.faces()[f].vertices.iter().rev().map(|&i| [i, j]));
-            }
-            (Feature::Edge(eb), Feature::Edge(ea)) => {
-                let [j0, j1] = fixed.edges()[eb].vertices;
-                let [i0, i1] = moving.edges()[ea].vertices;
-                // p00 -> p01 runs along B's edge, p01 -> p11 along -RA's edge
-                let d_b = bv[j1] - bv[j0];
-                let d_a = ra[i0] - ra[i1];
-                if d_b.cross(d_a).dot(spec.normal) > 0.0 {
-                    cycle.extend([[i0, j0], [i0, j1], [i1, j1], [i1, j0]]);
-                } else {
-                    cycle.extend([[i0, j0], [i1, j0], [i1, j1], [i0, j1]]);
-                }
-            }
-            (Feature::Face(g), Feature::Edge(ea)) => {
-                let corners = &fixed.faces()[g].vertices;
-                let [i0, i1] = moving.edges()[ea].vertices;
-                face_plus_segment::<true>(corners, bv, [i0, i1], neg_ra, spec.normal, &mut scratch.classes, cycle);
-            }
-            (Feature::Edge(eb), Feature::Face(f)) => {
-                let corners = &mut scratch.a.corners;
-                corners.clear();
-                corners.extend(moving.faces()[f].vertices.iter().rev());
-                let [j0, j1] = fixed.edges()[eb].vertices;
-                face_plus_segment::<false>(corners, neg_ra, [j0, j1], bv, spec.normal, &mut scratch.classes, cycle);
-            }
-            (fixed_feature, moving_feature) => {
-                let n = spec.normal;
-                let both_faces = match (fixed_feature, moving_feature) {
-                    (Feature::Face(g), Feature::Face(_)) => !plain.is_some_and(|c| z_prism::is_pole(c[g])),
-                    _ => false,
-                };
-                let r = scratch.b.build(fixed, fixed_feature, false, bv, n, None, both_faces);
-                scratch.a.build(moving, moving_feature, true, neg_ra, n, Some(r), both_faces);
-                planar_merge(merged_with_b, n, both_faces, scratch, cycle);
-            }
-        }
-        if cycle.len() < 3 {
+        let corners: &[[usize; 2]] = if let Some((cycles, starts)) = derived {
+            &cycles[starts[s]..starts[s + 1]]
+        } else {
+            face_cycle(moving, fixed, ra, neg_ra, spec, merged_with_b, plain, scratch, cycle);
+            cycle
+        };
+        if corners.len() < 3 {
             return Err(OverlayFailure::FlatFace);
         }
-        let mut face = Vec::with_capacity(cycle.len());
+        let mut face = Vec::with_capacity(corners.len());
         let mut offset = f64::NEG_INFINITY;
-        for &[i, j] in cycle.iter() {
+        for &[i, j] in corners {
             let slot = &mut index_of[i * nb + j];
             if *slot == u32::MAX {
                 *slot = vertices.len() as u32;
@@ -909,6 +899,64 @@ fn assemble(
         return Err(OverlayFailure::Euler);
     }
     Ok(Obstacle { polytope, vertex_pairs, face_kinds: kinds, rotation, route: Route::GaussMap })
+}
+
+/// The vertex-pair cycle of the face `spec` into `cycle` (cleared by the caller), from its generating features.
+#[allow(clippy::too_many_arguments)]
+fn face_cycle(
+    moving: &ConvexPolytope,
+    fixed: &ConvexPolytope,
+    ra: &[DVec3],
+    neg_ra: &[DVec3],
+    spec: &FaceSpec,
+    merged_with_b: &[Option<usize>],
+    plain: Option<&[u8]>,
+    scratch: &mut PlanarScratch,
+    cycle: &mut Vec<[usize; 2]>,
+) {
+    let bv = fixed.vertices();
+    match (spec.fixed, spec.moving) {
+        (Feature::Face(g), Feature::Vertex(i)) => {
+            cycle.extend(fixed.faces()[g].vertices.iter().map(|&j| [i, j]));
+        }
+        (Feature::Vertex(j), Feature::Face(f)) => {
+            cycle.extend(moving.faces()[f].vertices.iter().rev().map(|&i| [i, j]));
+        }
+        (Feature::Edge(eb), Feature::Edge(ea)) => {
+            let [j0, j1] = fixed.edges()[eb].vertices;
+            let [i0, i1] = moving.edges()[ea].vertices;
+            // p00 -> p01 runs along B's edge, p01 -> p11 along -RA's edge
+            let d_b = bv[j1] - bv[j0];
+            let d_a = ra[i0] - ra[i1];
+            if d_b.cross(d_a).dot(spec.normal) > 0.0 {
+                cycle.extend([[i0, j0], [i0, j1], [i1, j1], [i1, j0]]);
+            } else {
+                cycle.extend([[i0, j0], [i1, j0], [i1, j1], [i0, j1]]);
+            }
+        }
+        (Feature::Face(g), Feature::Edge(ea)) => {
+            let corners = &fixed.faces()[g].vertices;
+            let [i0, i1] = moving.edges()[ea].vertices;
+            face_plus_segment::<true>(corners, bv, [i0, i1], neg_ra, spec.normal, &mut scratch.classes, cycle);
+        }
+        (Feature::Edge(eb), Feature::Face(f)) => {
+            let corners = &mut scratch.a.corners;
+            corners.clear();
+            corners.extend(moving.faces()[f].vertices.iter().rev());
+            let [j0, j1] = fixed.edges()[eb].vertices;
+            face_plus_segment::<false>(corners, neg_ra, [j0, j1], bv, spec.normal, &mut scratch.classes, cycle);
+        }
+        (fixed_feature, moving_feature) => {
+            let n = spec.normal;
+            let both_faces = match (fixed_feature, moving_feature) {
+                (Feature::Face(g), Feature::Face(_)) => !plain.is_some_and(|c| z_prism::is_pole(c[g])),
+                _ => false,
+            };
+            let r = scratch.b.build(fixed, fixed_feature, false, bv, n, None, both_faces);
+            scratch.a.build(moving, moving_feature, true, neg_ra, n, Some(r), both_faces);
+            planar_merge(merged_with_b, n, both_faces, scratch, cycle);
+        }
+    }
 }
 
 /// `(ANGULAR_TOLERANCE / 2)^2`: the squared sine below which two edge directions are parallel, and the squared
