@@ -56,6 +56,9 @@ pub(crate) struct Scratch {
     /// [`derived_cycles`]: the faces' vertex-pair cycles, face `s` at `cycles[starts[s]..starts[s + 1]]`.
     pub(crate) cycles: Vec<[usize; 2]>,
     pub(crate) starts: Vec<usize>,
+    /// [`derived_cycles`]: the pole (`BOTTOM`, `TOP`) of every vertex of `-RA` and of `B`.
+    pub(crate) a_levels: Vec<u8>,
+    pub(crate) b_levels: Vec<u8>,
     /// The kind of every face normal of `-RA` and of `B`: 0 side, 1 pole.
     pub(crate) a_classes: Vec<u8>,
     pub(crate) b_classes: Vec<u8>,
@@ -66,6 +69,11 @@ pub(crate) struct Scratch {
 
 const SIDE: u8 = 0;
 const POLE: u8 = 1;
+
+/// The levels of [`derived_cycles`]: a vertex on the bottom or the top pole (the index of that end of a vertical
+/// edge in `[bottom, top]`).
+const BOTTOM: u8 = 0;
+const TOP: u8 = 1;
 
 /// The squared lengths of the edges [`derived_cycles`] accepts (far from under- and overflow of the tolerance tests
 /// of `minkowski::face_plus_segment` and `minkowski::planar_merge`, which multiply two squared lengths by
@@ -290,10 +298,10 @@ pub(crate) fn derived_cycles(
     specs: &[FaceSpec],
     scratch: &mut Scratch,
 ) -> bool {
-    let Scratch { next, cycles, starts, a_classes, b_classes, .. } = scratch;
+    let Scratch { next, cycles, starts, a_classes, b_classes, a_levels, b_levels, .. } = scratch;
     let bv = fixed.vertices();
     let (na, nb) = (neg_ra.len(), bv.len());
-    // the two poles of each summand: (top face, bottom face) and their heights
+    // the two poles of each summand: (top face, bottom face)
     let poles = |normals: &[DVec3], classes: &[u8]| {
         let (mut top, mut bottom, mut count) = (usize::MAX, usize::MAX, 0);
         for (f, (n, &c)) in normals.iter().zip(classes).enumerate() {
@@ -307,34 +315,35 @@ pub(crate) fn derived_cycles(
     let (Some((a_top, a_bottom)), Some((b_top, b_bottom))) = (poles(am, a_classes), poles(bn, b_classes)) else {
         return false;
     };
-    let height = |p: &ConvexPolytope, points: &[DVec3], f: usize| p.faces()[f].vertices.first().map(|&v| points[v].z);
-    let (Some(za_hi), Some(za_lo), Some(zb_hi), Some(zb_lo)) = (
-        height(moving, neg_ra, a_top),
-        height(moving, neg_ra, a_bottom),
-        height(fixed, bv, b_top),
-        height(fixed, bv, b_bottom),
-    ) else {
-        return false;
+    // every vertex's pole (TOP, BOTTOM; else `false`)
+    let levels = |p: &ConvexPolytope, points: &[DVec3], top: usize, bottom: usize, out: &mut Vec<u8>| {
+        let (Some(&t), Some(&b)) = (p.faces()[top].vertices.first(), p.faces()[bottom].vertices.first()) else {
+            return false;
+        };
+        let (hi, lo) = (points[t].z, points[b].z);
+        out.clear();
+        for v in points {
+            out.push(if v.z == hi {
+                TOP
+            } else if v.z == lo {
+                BOTTOM
+            } else {
+                return false;
+            });
+        }
+        hi > lo
     };
-    if !(za_hi > za_lo && zb_hi > zb_lo) || na.checked_mul(nb).is_none_or(|n| n >= u32::MAX as usize) {
+    if !(levels(moving, neg_ra, a_top, a_bottom, a_levels) && levels(fixed, bv, b_top, b_bottom, b_levels))
+        || na >= 1 << 16
+        || nb >= 1 << 16
+    {
         return false;
     }
-    // whether a vertex is on the top pole (`None`: on neither)
-    let level = |z: f64, hi: f64, lo: f64| {
-        if z == hi {
-            Some(true)
-        } else if z == lo {
-            Some(false)
-        } else {
-            None
-        }
-    };
-    let top_a = |i: usize| level(neg_ra[i].z, za_hi, za_lo);
-    let top_b = |j: usize| level(bv[j].z, zb_hi, zb_lo);
-    // the two ends of a vertical edge as (top, bottom)
-    let ends = |[v0, v1]: [usize; 2], top: &dyn Fn(usize) -> Option<bool>| match (top(v0), top(v1)) {
-        (Some(true), Some(false)) => Some((v0, v1)),
-        (Some(false), Some(true)) => Some((v1, v0)),
+    let (a_levels, b_levels) = (&a_levels[..], &b_levels[..]);
+    // the two ends of a vertical edge as [bottom, top] (indexed by the level)
+    let ends = |[v0, v1]: [usize; 2], levels: &[u8]| match (levels[v0], levels[v1]) {
+        (BOTTOM, TOP) => Some([v0, v1]),
+        (TOP, BOTTOM) => Some([v1, v0]),
         _ => None,
     };
     next.clear();
@@ -346,30 +355,30 @@ pub(crate) fn derived_cycles(
     let mut pole_count = 0;
     for spec in specs {
         starts.push(cycles.len());
-        let quad = match (spec.fixed, spec.moving) {
+        // the corners' levels
+        let mut quad = [0u8; 4];
+        match (spec.fixed, spec.moving) {
             (Feature::Face(g), Feature::Edge(ea)) => {
                 let corners = &fixed.faces()[g].vertices;
-                let Some((i_top, i_bottom)) = ends(moving.edges()[ea].vertices, &top_a) else { return false };
+                let Some(i) = ends(moving.edges()[ea].vertices, a_levels) else { return false };
                 if corners.len() != 4 {
                     return false;
                 }
-                for &j in corners {
-                    let Some(top) = top_b(j) else { return false };
-                    cycles.push([if top { i_top } else { i_bottom }, j]);
+                for (&j, level) in corners.iter().zip(&mut quad) {
+                    *level = b_levels[j];
+                    cycles.push([i[usize::from(*level)], j]);
                 }
-                true
             }
             (Feature::Edge(eb), Feature::Face(f)) => {
                 let corners = &moving.faces()[f].vertices;
-                let Some((j_top, j_bottom)) = ends(fixed.edges()[eb].vertices, &top_b) else { return false };
+                let Some(j) = ends(fixed.edges()[eb].vertices, b_levels) else { return false };
                 if corners.len() != 4 {
                     return false;
                 }
-                for &i in corners.iter().rev() {
-                    let Some(top) = top_a(i) else { return false };
-                    cycles.push([i, if top { j_top } else { j_bottom }]);
+                for (&i, level) in corners.iter().rev().zip(&mut quad) {
+                    *level = a_levels[i];
+                    cycles.push([i, j[usize::from(*level)]]);
                 }
-                true
             }
             (Feature::Face(g), Feature::Face(f)) if g == b_top || g == b_bottom => {
                 if pole_count == 2 || (g == b_top) != (f == a_top) {
@@ -379,23 +388,22 @@ pub(crate) fn derived_cycles(
                 pole_faces[pole_count] = (cycles.len(), g, size);
                 pole_count += 1;
                 cycles.resize(cycles.len() + size, [0, 0]);
-                false
+                continue;
             }
             _ => return false,
-        };
-        if quad {
-            // the quadrilateral's pole edges (two corners on the same pole; a corner's `i` and `j` are on the same
-            // one by construction), reversed, into `next`
-            let c = &cycles[cycles.len() - 4..];
-            for k in 0..4 {
-                let ([i0, j0], [i1, j1]) = (c[k], c[(k + 1) % 4]);
-                if top_b(j0) == top_b(j1) {
-                    let slot = &mut next[i1 * nb + j1];
-                    if *slot != u32::MAX {
-                        return false;
-                    }
-                    *slot = (i0 * nb + j0) as u32;
+        }
+        // the quadrilateral's pole edges (two corners on the same pole; a corner's `i` and `j` are on the same one by
+        // construction), reversed, into `next` (as `i << 16 | j`)
+        let c = &cycles[cycles.len() - 4..];
+        for k in 0..4 {
+            let l = if k == 3 { 0 } else { k + 1 };
+            if quad[k] == quad[l] {
+                let ([i0, j0], [i1, j1]) = (c[k], c[l]);
+                let slot = &mut next[i1 * nb + j1];
+                if *slot != u32::MAX {
+                    return false;
                 }
+                *slot = ((i0 << 16) | j0) as u32;
             }
         }
     }
@@ -411,24 +419,25 @@ pub(crate) fn derived_cycles(
         let Some(&FaceSpec { fixed: Feature::Face(h), moving: Feature::Edge(ea), .. }) = specs.get(across) else {
             return false;
         };
-        let Some((i_top, i_bottom)) = ends(moving.edges()[ea].vertices, &top_a) else { return false };
+        let Some(i) = ends(moving.edges()[ea].vertices, a_levels) else { return false };
         if h != across || corners.len() < 2 {
             return false;
         }
-        let i = if g == b_top { i_top } else { i_bottom };
-        let start = (i * nb + corners[0]) as u32;
-        let mut key = start;
+        let i = i[usize::from(g == b_top)];
+        let start = [i, corners[0]];
+        let mut corner = start;
         for k in 0..size {
-            if k > 0 && key == start {
+            if k > 0 && corner == start {
                 return false;
             }
-            let key_usize = key as usize;
-            cycles[position + k] = [key_usize / nb, key_usize % nb];
-            key = next[key_usize];
-            if key == u32::MAX {
+            cycles[position + k] = corner;
+            let packed = next[corner[0] * nb + corner[1]];
+            if packed == u32::MAX {
                 return false;
             }
+            corner = [(packed >> 16) as usize, (packed & 0xFFFF) as usize];
         }
+        let key = corner;
         // closed, and leaving the start along B's edge 0
         if key != start || cycles[position + 1] != [i, corners[1]] {
             return false;
