@@ -545,10 +545,9 @@ fn overlay(
     let (fa, fb) = (am.len(), bn.len());
 
     // two z-prisms turned about z (sheet metal): the same faces without sign tables or crossings (`z_prism.rs`)
-    let mut tame = true;
     let z_prisms = !test_switch!(GENERAL_ROUTE_ONLY)
-        && z_prism::vertical_arcs(moving, neg_ra, am, &mut prism.a_classes, &mut prism.a, &mut tame)
-        && z_prism::vertical_arcs(fixed, bv, bn, &mut prism.b_classes, &mut prism.b, &mut tame);
+        && z_prism::vertical_arcs(moving, neg_ra, am, &mut prism.a_classes, &mut prism.a)
+        && z_prism::vertical_arcs(fixed, bv, bn, &mut prism.b_classes, &mut prism.b);
 
     // parallel faces: merged_with_b[f] = Some(g) when -R n_f == n_g within half the tolerance.
     merged_with_b.clear();
@@ -575,8 +574,7 @@ fn overlay(
         let mut margin = f64::INFINITY;
         z_prism::face_specs(am, bn, &prism.a, &prism.b, neg_ra, bv, merged_with_a, merged_with_b, faces, &mut margin)?;
         // a tame pair: every cycle without the polygon merges (`z_prism::derived_cycles`)
-        let derived = tame
-            && by_class
+        let derived = by_class
             && margin > z_prism::MARGIN
             && !test_switch!(NO_DERIVED_CYCLES)
             && z_prism::derived_cycles(moving, fixed, neg_ra, am, bn, faces, prism);

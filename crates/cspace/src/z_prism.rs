@@ -98,7 +98,6 @@ pub(crate) fn vertical_arcs(
     normals: &[DVec3],
     classes: &mut Vec<u8>,
     out: &mut Vec<VerticalArc>,
-    tame: &mut bool,
 ) -> bool {
     classes.clear();
     for n in normals {
@@ -123,12 +122,10 @@ pub(crate) fn vertical_arcs(
                 // `s = 1 / sqrt((0 * 0 + 0 * 0) + dz * dz)`, whose x and y are `±0` exactly when `s` is finite (else
                 // NaN: refused); then `cz` is finite or NaN, and `w * cz` is the general route's test value up to
                 // exact zeros
-                let dz2 = d.z * d.z;
-                let s = dz2.sqrt().recip();
+                let s = (d.z * d.z).sqrt().recip();
                 if !s.is_finite() {
                     return false;
                 }
-                *tame &= (TAME_LO..=TAME_HI).contains(&dz2);
                 let (n0, n1) = (normals[f0], normals[f1]);
                 // its orientation: `(n0 x n1) . d` is `(±0 + ±0) + w * cz` (glam's operand order), `>= 0` exactly when
                 // `w * cz >= 0` (a zero of either sign passes, NaN fails)
@@ -141,11 +138,6 @@ pub(crate) fn vertical_arcs(
                 if d.z != 0.0 {
                     return false;
                 }
-                // [`derived_cycles`]'s premises: a length far from under- and overflow, a unit side normal, the edge
-                // orthogonal to it within 1e-12 rad
-                let n = normals[if classes[f0] == SIDE { f0 } else { f1 }];
-                let (len2, nn, dot) = (d.x * d.x + d.y * d.y, n.x * n.x + n.y * n.y, n.x * d.x + n.y * d.y);
-                *tame &= (TAME_LO..=TAME_HI).contains(&len2) && (nn - 1.0).abs() <= 1e-9 && dot * dot <= 1e-24 * len2;
             }
             _ => return false,
         }
@@ -322,16 +314,13 @@ pub(crate) fn derived_cycles(
         };
         let (hi, lo) = (points[t].z, points[b].z);
         out.clear();
-        for v in points {
-            out.push(if v.z == hi {
-                TOP
-            } else if v.z == lo {
-                BOTTOM
-            } else {
-                return false;
-            });
+        out.resize(points.len(), BOTTOM);
+        let mut on_poles = hi > lo;
+        for (level, v) in out.iter_mut().zip(points) {
+            *level = u8::from(v.z == hi);
+            on_poles &= (v.z == hi) | (v.z == lo);
         }
-        hi > lo
+        on_poles
     };
     if !(levels(moving, neg_ra, a_top, a_bottom, a_levels) && levels(fixed, bv, b_top, b_bottom, b_levels))
         || na >= 1 << 16
@@ -340,6 +329,24 @@ pub(crate) fn derived_cycles(
         return false;
     }
     let (a_levels, b_levels) = (&a_levels[..], &b_levels[..]);
+    // tame: the vertical edges (all of length `hi - lo`, exactly) and, per side face, its horizontal edges (the two
+    // have the same `x`, `y`) far from under- and overflow, a unit normal, the edges orthogonal to it within 1e-12 rad
+    let tame_height = |levels: &[u8], points: &[DVec3]| {
+        let (Some(t), Some(b)) = (levels.iter().position(|&l| l == TOP), levels.iter().position(|&l| l == BOTTOM))
+        else {
+            return false;
+        };
+        let dz = points[t].z - points[b].z;
+        (TAME_LO..=TAME_HI).contains(&(dz * dz))
+    };
+    if !(tame_height(a_levels, neg_ra) && tame_height(b_levels, bv)) {
+        return false;
+    }
+    let tame_side = |n: DVec3, p: DVec3, q: DVec3| {
+        let d = q - p;
+        let (len2, nn, dot) = (d.x * d.x + d.y * d.y, n.x * n.x + n.y * n.y, n.x * d.x + n.y * d.y);
+        (TAME_LO..=TAME_HI).contains(&len2) && (nn - 1.0).abs() <= 1e-9 && dot * dot <= 1e-24 * len2
+    };
     // the two ends of a vertical edge as [bottom, top] (indexed by the level)
     let ends = |[v0, v1]: [usize; 2], levels: &[u8]| match (levels[v0], levels[v1]) {
         (BOTTOM, TOP) => Some([v0, v1]),
@@ -348,13 +355,26 @@ pub(crate) fn derived_cycles(
     };
     next.clear();
     next.resize(na * nb, u32::MAX);
+    // the cycles' total length when every side face is a quadrilateral (checked below)
+    let size = |p: &ConvexPolytope, f: usize| p.faces()[f].vertices.len();
+    let total = 4 * specs.len().saturating_sub(2)
+        + size(fixed, b_top)
+        + size(moving, a_top)
+        + size(fixed, b_bottom)
+        + size(moving, a_bottom);
     cycles.clear();
+    cycles.resize(total, [0, 0]);
     starts.clear();
+    starts.resize(specs.len() + 1, 0);
     // the pole faces: (position in `cycles`, face of B, corners)
     let mut pole_faces = [(0, 0, 0); 2];
     let mut pole_count = 0;
-    for spec in specs {
-        starts.push(cycles.len());
+    let mut w = 0;
+    for (s, spec) in specs.iter().enumerate() {
+        starts[s] = w;
+        if w + 4 > total {
+            return false;
+        }
         // the corners' levels
         let mut quad = [0u8; 4];
         match (spec.fixed, spec.moving) {
@@ -364,9 +384,13 @@ pub(crate) fn derived_cycles(
                 if corners.len() != 4 {
                     return false;
                 }
-                for (&j, level) in corners.iter().zip(&mut quad) {
+                for ((&j, level), corner) in corners.iter().zip(&mut quad).zip(&mut cycles[w..w + 4]) {
                     *level = b_levels[j];
-                    cycles.push([i[usize::from(*level)], j]);
+                    *corner = [i[usize::from(*level)], j];
+                }
+                let k = if quad[0] == quad[1] { 0 } else { 1 };
+                if !tame_side(bn[g], bv[corners[k]], bv[corners[k + 1]]) {
+                    return false;
                 }
             }
             (Feature::Edge(eb), Feature::Face(f)) => {
@@ -375,26 +399,34 @@ pub(crate) fn derived_cycles(
                 if corners.len() != 4 {
                     return false;
                 }
-                for (&i, level) in corners.iter().rev().zip(&mut quad) {
+                for ((&i, level), corner) in corners.iter().rev().zip(&mut quad).zip(&mut cycles[w..w + 4]) {
                     *level = a_levels[i];
-                    cycles.push([i, j[usize::from(*level)]]);
+                    *corner = [i, j[usize::from(*level)]];
+                }
+                let k = if quad[0] == quad[1] { 0 } else { 1 };
+                if !tame_side(am[f], neg_ra[corners[k]], neg_ra[corners[k + 1]]) {
+                    return false;
                 }
             }
             (Feature::Face(g), Feature::Face(f)) if g == b_top || g == b_bottom => {
                 if pole_count == 2 || (g == b_top) != (f == a_top) {
                     return false;
                 }
-                let size = fixed.faces()[g].vertices.len() + moving.faces()[f].vertices.len();
-                pole_faces[pole_count] = (cycles.len(), g, size);
+                let size = size(fixed, g) + size(moving, f);
+                if w + size > total {
+                    return false;
+                }
+                pole_faces[pole_count] = (w, g, size);
                 pole_count += 1;
-                cycles.resize(cycles.len() + size, [0, 0]);
+                w += size;
                 continue;
             }
             _ => return false,
         }
         // the quadrilateral's pole edges (two corners on the same pole; a corner's `i` and `j` are on the same one by
         // construction), reversed, into `next` (as `i << 16 | j`)
-        let c = &cycles[cycles.len() - 4..];
+        let c = &cycles[w..w + 4];
+        w += 4;
         for k in 0..4 {
             let l = if k == 3 { 0 } else { k + 1 };
             if quad[k] == quad[l] {
@@ -407,8 +439,8 @@ pub(crate) fn derived_cycles(
             }
         }
     }
-    starts.push(cycles.len());
-    if pole_count != 2 {
+    starts[specs.len()] = w;
+    if pole_count != 2 || w != total {
         return false;
     }
     for &(position, g, size) in &pole_faces {
@@ -456,7 +488,7 @@ thread_local! {
 
 #[cfg(test)]
 mod tests {
-    use crate::minkowski::{GENERAL_ROUTE_ONLY, gauss_map_obstacle};
+    use crate::minkowski::{GENERAL_ROUTE_ONLY, NO_DERIVED_CYCLES, gauss_map_obstacle};
     use glam::{DMat3, DVec3};
     use stackplan_geom::{ConvexPolytope, convex_hull};
 
@@ -522,7 +554,7 @@ mod tests {
             .iter()
             .filter(|s| {
                 let n: Vec<DVec3> = s.faces().iter().map(|f| f.plane.normal).collect();
-                super::vertical_arcs(s, s.vertices(), &n, &mut Vec::new(), &mut Vec::new(), &mut true)
+                super::vertical_arcs(s, s.vertices(), &n, &mut Vec::new(), &mut Vec::new())
             })
             .count();
         assert_eq!(z_prisms, 9);
@@ -533,9 +565,14 @@ mod tests {
             for b in &shapes {
                 for &r in &rotations {
                     let fast = format!("{:?}", gauss_map_obstacle(a, r, b));
+                    // the z-prism route with the general polygon merges (no derived cycles), and the general route
+                    NO_DERIVED_CYCLES.with(|c| c.set(true));
+                    let merged_cycles = format!("{:?}", gauss_map_obstacle(a, r, b));
+                    NO_DERIVED_CYCLES.with(|c| c.set(false));
                     GENERAL_ROUTE_ONLY.with(|c| c.set(true));
                     let general = gauss_map_obstacle(a, r, b);
                     GENERAL_ROUTE_ONLY.with(|c| c.set(false));
+                    assert_eq!(fast, merged_cycles, "{a:?} {r:?} {b:?}");
                     assert_eq!(fast, format!("{general:?}"), "{a:?} {r:?} {b:?}");
                     cases += 1;
                     if let Ok(o) = general {
@@ -544,7 +581,8 @@ mod tests {
                 }
             }
         }
-        let taken = super::TAKEN.with(std::cell::Cell::get) - taken_before;
+        // (each z-prism case ran the z-prism route twice, once with the derived cycles switched off)
+        let taken = (super::TAKEN.with(std::cell::Cell::get) - taken_before) / 2;
         let derived = super::DERIVED.with(std::cell::Cell::get) - derived_before;
         // the tame pairs (most pairs at generic angles; not the quarter turns, not within 1e-6 of one, not the huge
         // box) assembled without the polygon merges, bit for bit as the general route
