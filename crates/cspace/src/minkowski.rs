@@ -855,34 +855,42 @@ fn assemble(
     let mut faces: Vec<Face> = Vec::with_capacity(specs.len());
     let mut kinds: Vec<FaceKind> = Vec::with_capacity(specs.len());
     edge_scratch.clear();
-    for (s, spec) in specs.iter().enumerate() {
-        cycle.clear();
-        let corners: &[[usize; 2]] = if let Some((cycles, starts)) = derived {
-            &cycles[starts[s]..starts[s + 1]]
-        } else {
-            face_cycle(moving, fixed, ra, neg_ra, spec, merged_with_b, plain, scratch, cycle);
-            cycle
-        };
-        if corners.len() < 3 {
-            return Err(OverlayFailure::FlatFace);
-        }
-        let mut face = Vec::with_capacity(corners.len());
-        let mut offset = f64::NEG_INFINITY;
-        for &[i, j] in corners {
-            let slot = &mut index_of[i * nb + j];
-            if *slot == u32::MAX {
-                *slot = vertices.len() as u32;
-                vertices.push(bv[j] - ra[i]);
-                vertex_pairs.push([i, j]);
-                edge_scratch.vertex();
+    // one face from its vertex-pair cycle: number its new vertices, its offset, its vertex list
+    macro_rules! add_face {
+        ($spec:expr, $corners:expr) => {{
+            let (spec, corners): (&FaceSpec, &[[usize; 2]]) = ($spec, $corners);
+            if corners.len() < 3 {
+                return Err(OverlayFailure::FlatFace);
             }
-            let v = *slot as usize;
-            edge_scratch.corner(v);
-            offset = offset.max(spec.normal.dot(vertices[v]));
-            face.push(v);
+            let mut face = Vec::with_capacity(corners.len());
+            let mut offset = f64::NEG_INFINITY;
+            for &[i, j] in corners {
+                let slot = &mut index_of[i * nb + j];
+                if *slot == u32::MAX {
+                    *slot = vertices.len() as u32;
+                    vertices.push(bv[j] - ra[i]);
+                    vertex_pairs.push([i, j]);
+                    edge_scratch.vertex();
+                }
+                let v = *slot as usize;
+                edge_scratch.corner(v);
+                offset = offset.max(spec.normal.dot(vertices[v]));
+                face.push(v);
+            }
+            faces.push(Face { vertices: face, plane: Plane { normal: spec.normal, offset } });
+            kinds.push(FaceKind::from_features(spec.fixed, spec.moving).unwrap_or(FaceKind::Unclassified));
+        }};
+    }
+    if let Some((cycles, starts)) = derived {
+        for (spec, range) in specs.iter().zip(starts.windows(2)) {
+            add_face!(spec, &cycles[range[0]..range[1]]);
         }
-        faces.push(Face { vertices: face, plane: Plane { normal: spec.normal, offset } });
-        kinds.push(FaceKind::from_features(spec.fixed, spec.moving).unwrap_or(FaceKind::Unclassified));
+    } else {
+        for spec in specs {
+            cycle.clear();
+            face_cycle(moving, fixed, ra, neg_ra, spec, merged_with_b, plain, scratch, cycle);
+            add_face!(spec, cycle);
+        }
     }
     let (v, f) = (vertices.len(), faces.len());
     // every face has a positive area by construction (a translated face of `A` or `B`, a sum containing one, or a
