@@ -24,9 +24,11 @@
 //!   at [`MARGIN_CAP`]. Each direction is one SOCP `max alpha`. A margin of 0.1 means the stack tolerates a sideways
 //!   push of 10 % of its weight from every sampled direction (between samples the true minimum can be lower).
 //!
-//! Fast pre-check: when every contact of a single movable part is a horizontal support from below (normal +z) and the
-//! c.g. projects outside the convex hull of the contact points by more than the tolerance, the part is unstable
-//! without a solve. The pre-check never declares stability, and never applies to inclined supports.
+//! Fast pre-check: when every contact of a single movable part is a horizontal support from below (normal +z) in one
+//! horizontal plane (within the tolerance) and the c.g. projects outside the convex hull of the contact points by
+//! more than the tolerance, the part is unstable without a solve. The pre-check never declares stability, and never
+//! applies to inclined supports nor to supports at several heights (friction can then form a couple between them and
+//! hold a c.g. outside their hull; the tipping certificate of `instability` accounts for that couple).
 //!
 //! The model is the usual "forces at patch vertices" discretisation: exact for the normal-force distribution over a
 //! flat convex patch; it ignores torsional friction inside a patch, so it is slightly conservative. Feasibility means
@@ -48,6 +50,12 @@
 //! * verdicts only (`EquilibriumOptions::verdict_only`): a support-tree edge whose c.g. lies over the support
 //!   polygon of its contacts that admit a vertical push is stable without a solve (`hull_certificate`), and a group
 //!   without a tree by nonnegative vertical forces at those contacts (`tree::vertical_certificate`, `vertical_qp`);
+//! * instability (`instability`, every mode but the plain one): before a group's or a non-flat edge's SOCP, a
+//!   virtual-work certificate (a set of parts tipping about a horizontal axis with every contact force doing
+//!   non-negative work and gravity positive work) proves it unstable without a solve; the certificates of the SOCPs
+//!   that end `PrimalInfeasible` are verified and remembered in the `SolveCache` for the next problems (a planner's
+//!   next candidates often fail by the same mechanism); verdict-only group SOCPs run without the solver's iterative
+//!   refinement;
 //! * margins (`margin`): coplanar points with the same cone reduced to their hull's vertices; a triangle certificate
 //!   (three SOCPs) for problems that resist the current smallest margin in every direction (nested, locked parts);
 //! * a memo (`SolveCache`) of identical rigid-body problems across the calls of one stack check.
@@ -71,6 +79,7 @@ use serde::{Deserialize, Serialize};
 
 mod cache;
 mod hull_certificate;
+mod instability;
 mod margin;
 mod tree;
 mod vertical_qp;
@@ -343,24 +352,35 @@ fn group_equilibrium(
     cache: &SolveCache,
 ) -> Result<(Verdict, Vec<DVec3>), EquilibriumError> {
     let (mu, plain) = (options.mu, options.equilibrium_by_socp_only);
-    let socp =
-        |bodies: &[Rigid], movers: &[usize], own: &[&Point]| -> Result<(Verdict, Vec<DVec3>), EquilibriumError> {
-            let problem = Problem::new(bodies, movers, own, mu);
-            let (status, x) = problem.solve(None)?;
-            let verdict = verdict_of(status);
-            if !verdict.is_stable() {
-                return Ok((verdict, Vec::new()));
+    // one SOCP; for a group (`group_solve`, not a support-tree edge): without the solver's iterative refinement when
+    // only the verdict is wanted, and a verified certificate of infeasibility is remembered (`instability::Mechanism`)
+    let socp = |bodies: &[Rigid],
+                movers: &[usize],
+                own: &[&Point],
+                group_solve: bool|
+     -> Result<(Verdict, Vec<DVec3>), EquilibriumError> {
+        let problem = Problem::new(bodies, movers, own, mu);
+        let (status, x, dual) = problem.solve_verdict(!(group_solve && options.verdict_only))?;
+        tracing::debug!(?status, parts = movers.len(), points = own.len(), "equilibrium SOCP");
+        let verdict = verdict_of(status);
+        if status == SolverStatus::PrimalInfeasible && group_solve && !plain {
+            let mechanism = instability::Mechanism::from_dual(bodies, movers, problem.length_scale, &dual);
+            if mechanism.proves(bodies, movers, own, mu) {
+                cache.remember(mechanism);
             }
-            let forces = own
-                .iter()
-                .enumerate()
-                .map(|(k, pt)| {
-                    (pt.frame[0] * x[3 * k] + pt.frame[1] * x[3 * k + 1] + pt.frame[2] * x[3 * k + 2])
-                        * problem.force_scale
-                })
-                .collect();
-            Ok((verdict, forces))
-        };
+        }
+        if !verdict.is_stable() {
+            return Ok((verdict, Vec::new()));
+        }
+        let forces = own
+            .iter()
+            .enumerate()
+            .map(|(k, pt)| {
+                (pt.frame[0] * x[3 * k] + pt.frame[1] * x[3 * k + 1] + pt.frame[2] * x[3 * k + 2]) * problem.force_scale
+            })
+            .collect();
+        Ok((verdict, forces))
+    };
     let edges = if plain { None } else { tree::support_tree(bodies, points, group) };
     let Some(edges) = edges else {
         let own = group.points(points);
@@ -376,7 +396,13 @@ fn group_equilibrium(
         {
             return Ok((Verdict::Stable, forces));
         }
-        return socp(bodies, &group.movers, &own);
+        if !plain
+            && (instability::group_unstable(bodies, points, group, mu)
+                || cache.any_mechanism(|m| m.proves(bodies, &group.movers, &own, mu)))
+        {
+            return Ok((Verdict::Unstable, Vec::new()));
+        }
+        return socp(bodies, &group.movers, &own, true);
     };
     let position: std::collections::HashMap<usize, usize> =
         group.point_indices.iter().enumerate().map(|(local, &k)| (k, local)).collect();
@@ -393,7 +419,8 @@ fn group_equilibrium(
             None => cache.equilibrium(cache::key(&[mu], &edge.union, &own), || {
                 match tree::flat_minimum_norm(&edge.union, &own) {
                     Some(f) => Ok((Verdict::Stable, f)),
-                    None => socp(&[edge.union], &[0], &own.iter().collect::<Vec<_>>()),
+                    None if instability::body_unstable(&edge.union, &own, mu) => Ok((Verdict::Unstable, Vec::new())),
+                    None => socp(&[edge.union], &[0], &own.iter().collect::<Vec<_>>(), false),
                 }
             })?,
         };
@@ -607,6 +634,12 @@ fn precheck(parts: &[WorldPart], movers: &[usize], points: &[&Point]) -> Option<
     if !mine.iter().all(|p| horizontal_support(p)) {
         return None;
     }
+    // supports at several heights: friction can form a couple between them (supports at (0, 0) and (1, h) hold a
+    // c.g. up to (1 + mu h) / 2 when mu h > 1), so the hull test is exact only for coplanar ones
+    let (lo, hi) = mine.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.p.z), hi.max(p.p.z)));
+    if hi - lo > tol {
+        return None;
+    }
     let hull = convex_hull_2d(&mine.iter().map(|p| DVec2::new(p.p.x, p.p.y)).collect::<Vec<_>>(), tol);
     let c = parts[*i].center_of_gravity;
     let c2 = DVec2::new(c.x, c.y);
@@ -629,6 +662,8 @@ struct Problem {
     mover_rows: Vec<(usize, f64)>,
     mu: f64,
     force_scale: f64,
+    /// The length unit of the moment rows (the movers' box diagonal, at least 1).
+    length_scale: f64,
 }
 
 impl Problem {
@@ -673,11 +708,22 @@ impl Problem {
                 add(a, -1.0);
             }
         }
-        Self { n_points: points.len(), rows, rhs, mover_rows, mu, force_scale }
+        Self { n_points: points.len(), rows, rhs, mover_rows, mu, force_scale, length_scale }
+    }
+
+    /// Solves the equilibrium problem (no load), with the solver's iterative refinement when `refine`. Returns the
+    /// status, the primal solution (forces in the local frames) and the dual variables of the equality rows (after a
+    /// `PrimalInfeasible`, the solver's certificate: see `instability::Mechanism::from_dual`).
+    fn solve_verdict(&self, refine: bool) -> Result<(SolverStatus, Vec<f64>, Vec<f64>), EquilibriumError> {
+        let mut solver = self.solver_with(None, MARGIN_CAP, refine)?;
+        solver.solve();
+        let dual = solver.solution.z.iter().take(self.rhs.len()).copied().collect();
+        Ok((solver.solution.status, solver.solution.x.clone(), dual))
     }
 
     /// Solves the equilibrium problem (`load = None`) or the margin problem `max alpha` for load direction `d`.
     /// Returns the status and the primal solution (forces in the local frames, then alpha when present).
+    #[cfg(test)]
     fn solve(&self, load: Option<DVec3>) -> Result<(SolverStatus, Vec<f64>), EquilibriumError> {
         let mut solver = self.solver(load, MARGIN_CAP)?;
         solver.solve();
@@ -707,6 +753,11 @@ impl Problem {
 
     /// A clarabel solver for the equilibrium problem (`load = None`) or the margin problem for direction `d`.
     fn solver(&self, load: Option<DVec3>, cap: f64) -> Result<DefaultSolver<f64>, EquilibriumError> {
+        self.solver_with(load, cap, true)
+    }
+
+    /// [`Problem::solver`] with the solver's iterative refinement on or off.
+    fn solver_with(&self, load: Option<DVec3>, cap: f64, refine: bool) -> Result<DefaultSolver<f64>, EquilibriumError> {
         let nf = 3 * self.n_points;
         let n = nf + usize::from(load.is_some());
         let (a, (b, cones)) = self.constraints(load, cap);
@@ -723,6 +774,7 @@ impl Problem {
         };
         let settings = DefaultSettingsBuilder::default()
             .verbose(false)
+            .iterative_refinement_enable(refine)
             .build()
             .map_err(|e| EquilibriumError::Solver(format!("{e:?}")))?;
         DefaultSolver::new(&p, &q, &a, &b, &cones, settings).map_err(|e| EquilibriumError::Solver(format!("{e:?}")))

@@ -16,7 +16,8 @@
 //!   fixture part (`fixtures/parts/*.json`) in its two lowest resting poses, nested (parts lowered onto the one
 //!   below until they touch, straight and shifted sideways), on the planned Channel stack (flat supports at two
 //!   heights) and on staggered brick walls (cyclic support graphs, side contacts between neighbours, overhanging
-//!   rows: the vertical certificate of the prefix verdicts): identical verdicts of every kind, margins within 1e-6
+//!   rows: the vertical certificate of the prefix verdicts): identical verdicts of every kind (except `Unstable`
+//!   by a certificate of instability where the plain SOCP ends `Unknown`, see `same_verdict`), margins within 1e-6
 //!   relative, the same minimum-norm forces (see `assert_equivalent`).
 
 mod common;
@@ -40,9 +41,15 @@ fn options() -> CheckOptions {
 /// within 1e-6 relative, every force within `1e-3 * weight` (the minimum-norm forces are unique, but a duality gap
 /// of 1e-8 relative bounds the distance of a solver's forces to them only by about `sqrt(1e-8)` of their norm).
 fn assert_equivalent(fast: &Equilibrium, plain: &Equilibrium, weight: f64, what: &str) {
-    assert_eq!(fast.verdict, plain.verdict, "{what}: verdict");
+    assert!(same_verdict(&fast.verdict, &plain.verdict), "{what}: verdict {:?} vs {:?}", fast.verdict, plain.verdict);
     assert!(same_margin(fast.margin, plain.margin), "{what}: margin {:?} vs {:?}", fast.margin, plain.margin);
     assert_same_forces(&fast.forces, &plain.forces, weight, what);
+}
+
+/// The same verdict, or `Unstable` where the plain SOCP ends unsure (`Unknown`, e.g. `AlmostPrimalInfeasible`): a
+/// certificate of instability (`equilibrium::instability`) decides what the solver could not.
+fn same_verdict(fast: &Verdict, plain: &Verdict) -> bool {
+    fast == plain || (*fast == Verdict::Unstable && matches!(plain, Verdict::Unknown(_)))
 }
 
 fn assert_same_forces(fast: &[ContactForce], plain: &[ContactForce], weight: f64, what: &str) {
@@ -62,9 +69,16 @@ fn assert_checks_equivalent(fast: &StackCheck, plain: &StackCheck, weight: f64, 
     assert_eq!(fast.parts.len(), plain.parts.len());
     for (f, p) in fast.parts.iter().zip(&plain.parts) {
         let part = format!("{what}, part {}", f.index);
+        assert!(same_verdict(&f.stable, &p.stable), "{part}: stable {:?} vs {:?}", f.stable, p.stable);
+        assert!(
+            same_verdict(&f.stack_stable, &p.stack_stable),
+            "{part}: stack stable {:?} vs {:?}",
+            f.stack_stable,
+            p.stack_stable
+        );
         assert_eq!(
-            (&f.stable, &f.stack_stable, f.graspable, f.insertable, f.removable, f.ok),
-            (&p.stable, &p.stack_stable, p.graspable, p.insertable, p.removable, p.ok),
+            (f.graspable, f.insertable, f.removable, f.ok),
+            (p.graspable, p.insertable, p.removable, p.ok),
             "{part}: verdicts"
         );
         assert!(same_margin(f.margin, p.margin), "{part}: margin {:?} vs {:?}", f.margin, p.margin);

@@ -9,6 +9,7 @@
 //! would (the patch labels of the points are not part of the key: they do not enter the solve). Cost: O(K) per
 //! lookup; the memo lives as long as the check.
 
+use super::instability::Mechanism;
 use super::{Point, Rigid, Verdict};
 use glam::DVec3;
 use std::collections::HashMap;
@@ -22,7 +23,12 @@ type EquilibriumAnswer = (Verdict, Vec<DVec3>);
 pub struct SolveCache {
     equilibria: Mutex<HashMap<Vec<u64>, EquilibriumAnswer>>,
     margins: Mutex<HashMap<Vec<u64>, Vec<Option<f64>>>>,
+    /// Verified certificates of instability of earlier solves, the most recent first (at most [`MECHANISMS`]).
+    mechanisms: Mutex<Vec<Mechanism>>,
 }
+
+/// How many certificates of instability the memo keeps.
+pub(super) const MECHANISMS: usize = 8;
 
 /// The exact key of a rigid-body problem: `extra` values, the body, then every point.
 pub(super) fn key(extra: &[f64], body: &Rigid, points: &[Point]) -> Vec<u64> {
@@ -56,6 +62,27 @@ impl SolveCache {
         solve: impl FnOnce() -> Result<(Verdict, Vec<DVec3>), super::EquilibriumError>,
     ) -> Result<(Verdict, Vec<DVec3>), super::EquilibriumError> {
         memo(&self.equilibria, key, solve)
+    }
+
+    /// Keeps a verified certificate of instability for later problems (dropping the oldest beyond [`MECHANISMS`]).
+    pub(super) fn remember(&self, mechanism: Mechanism) {
+        if let Ok(mut list) = self.mechanisms.lock() {
+            list.insert(0, mechanism);
+            list.truncate(MECHANISMS);
+        }
+    }
+
+    /// Whether `proves` holds for a remembered certificate (the first that does moves to the front).
+    pub(super) fn any_mechanism(&self, proves: impl Fn(&Mechanism) -> bool) -> bool {
+        let Ok(mut list) = self.mechanisms.lock() else { return false };
+        match list.iter().position(proves) {
+            Some(k) => {
+                let hit = list.remove(k);
+                list.insert(0, hit);
+                true
+            }
+            None => false,
+        }
     }
 
     pub(super) fn margin(
