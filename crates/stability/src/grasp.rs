@@ -116,7 +116,7 @@ impl Region {
     /// Whether `p` lies in the region (closed pieces, open obstacles, with the tolerance).
     pub fn contains(&self, p: DVec2) -> bool {
         self.pieces.iter().any(|poly| polygon_contains(poly, p, self.tol))
-            && !self.obstacles.iter().any(|o| crate::polygon2d::signed_boundary_distance(p, o) > self.tol)
+            && !self.obstacles.iter().any(|o| crate::polygon2d::inside_by(p, o, self.tol))
     }
 
     /// `d(p)`: distance to the boundary when inside, 0 outside. A region without boundary has no area (a bounded

@@ -120,6 +120,18 @@ pub fn signed_boundary_distance(p: DVec2, poly: &[DVec2]) -> f64 {
     -dist
 }
 
+/// Whether `p` lies inside the convex counter-clockwise polygon `poly` by more than `margin`: the same answer as
+/// `signed_boundary_distance(p, poly) > margin` for `margin >= 0`, without the distances to the edges of an outside
+/// point (it stops at the first edge line that `p` is not beyond by more than `margin`). O(n).
+pub fn inside_by(p: DVec2, poly: &[DVec2], margin: f64) -> bool {
+    let n = poly.len();
+    (0..n).all(|k| {
+        let (a, b) = (poly[k], poly[(k + 1) % n]);
+        let len = (b - a).length();
+        len == 0.0 || cross(a, b, p) / len > margin
+    })
+}
+
 /// Whether `p` lies in the closed convex polygon `poly` (counter-clockwise, >= 3 vertices) enlarged by `tol`.
 pub fn contains(poly: &[DVec2], p: DVec2, tol: f64) -> bool {
     signed_boundary_distance(p, poly) >= -tol
@@ -336,6 +348,15 @@ mod tests {
     fn boundary_distance() {
         let sq = convex_hull_2d(&[v(0.0, 0.0), v(4.0, 0.0), v(4.0, 2.0), v(0.0, 2.0)], 1e-12);
         assert!((signed_boundary_distance(v(2.0, 1.0), &sq) - 1.0).abs() < 1e-12);
+        // inside_by answers signed_boundary_distance(p) > margin
+        for x in [-1.0, 0.0, 0.5, 1.0, 2.0, 3.5, 4.0, 6.0] {
+            for y in [-1.0, 0.0, 0.5, 1.0, 2.0, 3.0, 5.0] {
+                for margin in [0.0, 0.5, 1.0] {
+                    let p = v(x, y);
+                    assert_eq!(inside_by(p, &sq, margin), signed_boundary_distance(p, &sq) > margin, "{p} {margin}");
+                }
+            }
+        }
         assert!((signed_boundary_distance(v(7.0, 6.0), &sq) + 5.0).abs() < 1e-12);
     }
 }
