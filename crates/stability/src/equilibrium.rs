@@ -352,8 +352,9 @@ fn group_equilibrium(
     cache: &SolveCache,
 ) -> Result<(Verdict, Vec<DVec3>), EquilibriumError> {
     let (mu, plain) = (options.mu, options.equilibrium_by_socp_only);
-    // one SOCP; for a group (`group_solve`, not a support-tree edge): without the solver's iterative refinement when
-    // only the verdict is wanted, and a verified certificate of infeasibility is remembered (`instability::Mechanism`)
+    // one SOCP, of a group (`group_solve`) or of a support-tree edge; a verified certificate of infeasibility is
+    // remembered (`instability::Mechanism`); a group's runs without the solver's iterative refinement when only the
+    // verdict is wanted (an edge's answer is memoised for every mode)
     let socp = |bodies: &[Rigid],
                 movers: &[usize],
                 own: &[&Point],
@@ -363,10 +364,10 @@ fn group_equilibrium(
         let (status, x, dual) = problem.solve_verdict(!(group_solve && options.verdict_only))?;
         tracing::debug!(?status, parts = movers.len(), points = own.len(), "equilibrium SOCP");
         let verdict = verdict_of(status);
-        if status == SolverStatus::PrimalInfeasible && group_solve && !plain {
+        if status == SolverStatus::PrimalInfeasible && !plain {
             let mechanism = instability::Mechanism::from_dual(bodies, movers, problem.length_scale, &dual);
             if mechanism.proves(bodies, movers, own, mu) {
-                cache.remember(mechanism);
+                cache.remember(!group_solve, mechanism);
             }
         }
         if !verdict.is_stable() {
@@ -398,7 +399,7 @@ fn group_equilibrium(
         }
         if !plain
             && (instability::group_unstable(bodies, points, group, mu)
-                || cache.any_mechanism(|m| m.proves(bodies, &group.movers, &own, mu)))
+                || cache.any_mechanism(false, |m| m.proves(bodies, &group.movers, &own, mu)))
         {
             return Ok((Verdict::Unstable, Vec::new()));
         }
@@ -417,10 +418,15 @@ fn group_equilibrium(
         let (v, on_subtree) = match certified {
             Some(f) => (Verdict::Stable, f),
             None => cache.equilibrium(cache::key(&[mu], &edge.union, &own), || {
+                let refs: Vec<&Point> = own.iter().collect();
                 match tree::flat_minimum_norm(&edge.union, &own) {
                     Some(f) => Ok((Verdict::Stable, f)),
-                    None if instability::body_unstable(&edge.union, &own, mu) => Ok((Verdict::Unstable, Vec::new())),
-                    None => socp(&[edge.union], &[0], &own.iter().collect::<Vec<_>>(), false),
+                    None if instability::body_unstable(&edge.union, &own, mu)
+                        || cache.any_mechanism(true, |m| m.proves(&[edge.union], &[0], &refs, mu)) =>
+                    {
+                        Ok((Verdict::Unstable, Vec::new()))
+                    }
+                    None => socp(&[edge.union], &[0], &refs, false),
                 }
             })?,
         };

@@ -23,8 +23,9 @@ type EquilibriumAnswer = (Verdict, Vec<DVec3>);
 pub struct SolveCache {
     equilibria: Mutex<HashMap<Vec<u64>, EquilibriumAnswer>>,
     margins: Mutex<HashMap<Vec<u64>, Vec<Option<f64>>>>,
-    /// Verified certificates of instability of earlier solves, the most recent first (at most [`MECHANISMS`]).
-    mechanisms: Mutex<Vec<Mechanism>>,
+    /// Verified certificates of instability of earlier solves, the most recent first (at most [`MECHANISMS`] each):
+    /// of groups (twists of parts), and of support-tree edges (the twist of the edge's rigid union).
+    mechanisms: Mutex<[Vec<Mechanism>; 2]>,
 }
 
 /// How many certificates of instability the memo keeps.
@@ -64,17 +65,21 @@ impl SolveCache {
         memo(&self.equilibria, key, solve)
     }
 
-    /// Keeps a verified certificate of instability for later problems (dropping the oldest beyond [`MECHANISMS`]).
-    pub(super) fn remember(&self, mechanism: Mechanism) {
-        if let Ok(mut list) = self.mechanisms.lock() {
+    /// Keeps a verified certificate of instability of a group (`edge` false) or of a support-tree edge (`edge` true)
+    /// for later problems (dropping the oldest beyond [`MECHANISMS`]).
+    pub(super) fn remember(&self, edge: bool, mechanism: Mechanism) {
+        if let Ok(mut lists) = self.mechanisms.lock() {
+            let list = &mut lists[usize::from(edge)];
             list.insert(0, mechanism);
             list.truncate(MECHANISMS);
         }
     }
 
-    /// Whether `proves` holds for a remembered certificate (the first that does moves to the front).
-    pub(super) fn any_mechanism(&self, proves: impl Fn(&Mechanism) -> bool) -> bool {
-        let Ok(mut list) = self.mechanisms.lock() else { return false };
+    /// Whether `proves` holds for a remembered certificate of a group (`edge` false) or of an edge (`edge` true); the
+    /// first that does moves to the front.
+    pub(super) fn any_mechanism(&self, edge: bool, proves: impl Fn(&Mechanism) -> bool) -> bool {
+        let Ok(mut lists) = self.mechanisms.lock() else { return false };
+        let list = &mut lists[usize::from(edge)];
         match list.iter().position(proves) {
             Some(k) => {
                 let hit = list.remove(k);

@@ -40,7 +40,8 @@
 //! that ends `PrimalInfeasible` returns one (the dual variables of its equality rows); it is verified by the test
 //! above (slack [`CONE_SLACK`] of the largest speed, gravity's power at least [`GRAVITY_POWER`] of the weight times
 //! that speed: an equilibrium would need contact forces of about 1e5 times the weight) and kept in the
-//! [`super::SolveCache`]; the next groups are tested against the kept ones before their SOCP. A planner's candidates
+//! [`super::SolveCache`] (those of groups, and those of support-tree edges: one twist of the edge's rigid union);
+//! the next groups (edges) are tested against the kept ones before their SOCP. A planner's candidates
 //! for one part often fail by the same mechanism (the part tips the parts it rests on), which the upward-closed sets
 //! miss when a part resting on a tipping set is held elsewhere (it must move differently). The verdict a remembered
 //! mechanism gives is the SOCP's verdict whenever the SOCP would decide with these margins, so it does not depend on
