@@ -30,8 +30,21 @@
 //! What is saved: both sign tables (`EA FB + EB FA` products), the arc-crossing pass, the circles of the horizontal
 //! arcs and most of the support tests' arithmetic.
 //!
-//! Complexity: O(E + F) to recognise the pair, O(FA FB) for the parallel faces (as in the general route) and
-//! O(FB EA_v + FA EB_v) for the support searches over the `EA_v`, `EB_v` vertical arcs.
+//! **Derived cycles** (session 16): for a *tame* pair ([`derived_cycles`]: two poles per summand, merged pairwise, no
+//! side face merged, every side face a quadrilateral, edge lengths far from under- and overflow, unit side normals
+//! orthogonal to their horizontal edges, every side normal at least [`MARGIN`] inside the arc holding it) the obstacle
+//! is the extrusion `(b (+) (-R a)) x [b_lo - a_hi, b_hi - a_lo]` of the 2-D Minkowski sum of the cross-sections, and
+//! every decision the general assembly takes for it (`face_plus_segment`, `planar_merge`) is the geometric one with
+//! a wide margin. The face cycles are then read off the features: a side face of one summand plus a vertical edge of
+//! the other is its quadrilateral with the top corners translated by the edge's top end and the bottom ones by its
+//! bottom end; a pole of the obstacle is the chain of the side faces' edges on that pole, started where the merge
+//! starts. Same cycles, same order, same assembly (numbering, offsets, edge table): bit for bit the general route's.
+//! Pairs that are not tame (quarter turns and rotations within 1e-6 rad of one, where side faces merge; a side face
+//! supported by a vertex; huge or tiny coordinates) keep the polygon merges.
+//!
+//! Complexity: O(E + F) to recognise the pair, O(FA FB) for the parallel faces (as in the general route),
+//! O(FB EA_v + FA EB_v) for the support searches over the `EA_v`, `EB_v` vertical arcs, and O(V + output) for the
+//! derived cycles.
 
 use glam::DVec3;
 use stackplan_geom::polytope::ConvexPolytope;
