@@ -50,12 +50,12 @@
 //! * verdicts only (`EquilibriumOptions::verdict_only`): a support-tree edge whose c.g. lies over the support
 //!   polygon of its contacts that admit a vertical push is stable without a solve (`hull_certificate`), and a group
 //!   without a tree by nonnegative vertical forces at those contacts (`tree::vertical_certificate`, `vertical_qp`);
-//! * instability (`instability`, every mode but the plain one): before a group's or a non-flat edge's SOCP, a
-//!   virtual-work certificate (a set of parts tipping about a horizontal axis with every contact force doing
-//!   non-negative work and gravity positive work) proves it unstable without a solve; the certificates of the SOCPs
-//!   that end `PrimalInfeasible` are verified and remembered in the `SolveCache` for the next problems (a planner's
-//!   next candidates often fail by the same mechanism); verdict-only group SOCPs run without the solver's iterative
-//!   refinement;
+//! * instability (`instability`, every mode but the plain one): before a group's vertical QP and SOCP or a non-flat
+//!   edge's SOCP, a virtual-work certificate (a set of parts tipping about a horizontal axis with every contact force
+//!   doing non-negative work and gravity positive work) proves it unstable without a solve; the certificates of the
+//!   SOCPs that end `PrimalInfeasible` are verified and remembered in the `SolveCache` for the next problems (a
+//!   planner's next candidates often fail by the same mechanism); verdict-only group SOCPs run without the solver's
+//!   iterative refinement;
 //! * margins (`margin`): coplanar points with the same cone reduced to their hull's vertices; a triangle certificate
 //!   (three SOCPs) for problems that resist the current smallest margin in every direction (nested, locked parts);
 //! * a memo (`SolveCache`) of identical rigid-body problems across the calls of one stack check.
@@ -391,17 +391,19 @@ fn group_equilibrium(
         {
             return Ok((Verdict::Stable, forces));
         }
-        if !plain
-            && options.verdict_only
-            && let Some(forces) = vertical_qp::vertical_qp_certificate(bodies, &group.movers, &own, mu)?
-        {
-            return Ok((Verdict::Stable, forces));
-        }
+        // the certificates of instability before the vertical QP: microseconds against an interior-point solve, and
+        // the two exclude each other
         if !plain
             && (instability::group_unstable(bodies, points, group, mu)
                 || cache.any_mechanism(false, |m| m.proves(bodies, &group.movers, &own, mu)))
         {
             return Ok((Verdict::Unstable, Vec::new()));
+        }
+        if !plain
+            && options.verdict_only
+            && let Some(forces) = vertical_qp::vertical_qp_certificate(bodies, &group.movers, &own, mu)?
+        {
+            return Ok((Verdict::Stable, forces));
         }
         return socp(bodies, &group.movers, &own, true);
     };

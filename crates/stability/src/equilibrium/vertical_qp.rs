@@ -84,6 +84,7 @@ pub(super) fn vertical_qp_certificate(
     let mut solver =
         DefaultSolver::new(&p, &q, &a, &b, &cones, settings).map_err(|e| EquilibriumError::Solver(format!("{e:?}")))?;
     solver.solve();
+    tracing::debug!(status = ?solver.solution.status, parts = movers.len(), points = points.len(), "vertical QP");
     if solver.solution.status != SolverStatus::Solved {
         tracing::trace!(status = ?solver.solution.status, parts = movers.len(), "no vertical certificate");
         return Ok(None);
