@@ -133,8 +133,26 @@ pub fn inside_by(p: DVec2, poly: &[DVec2], margin: f64) -> bool {
 }
 
 /// Whether `p` lies in the closed convex polygon `poly` (counter-clockwise, >= 3 vertices) enlarged by `tol`.
+///
+/// The same answer as `signed_boundary_distance(p, poly) >= -tol` with an early exit: a point beyond an edge line by
+/// more than `tol` is farther than `tol` from the polygon, and one behind every edge line is inside; only a point
+/// outside within `tol` of an edge line needs the distances to the edges. O(n).
 pub fn contains(poly: &[DVec2], p: DVec2, tol: f64) -> bool {
-    signed_boundary_distance(p, poly) >= -tol
+    let n = poly.len();
+    let mut inside = true;
+    for k in 0..n {
+        let (a, b) = (poly[k], poly[(k + 1) % n]);
+        let len = (b - a).length();
+        if len == 0.0 {
+            continue;
+        }
+        let d = cross(a, b, p) / len;
+        if d < -tol {
+            return false;
+        }
+        inside &= d >= 0.0;
+    }
+    inside || signed_boundary_distance(p, poly) >= -tol
 }
 
 /// Clips the convex set `subject` (a point, segment or polygon) by the half-plane left of `a -> b` (enlarged by tol).
@@ -348,6 +366,15 @@ mod tests {
     fn boundary_distance() {
         let sq = convex_hull_2d(&[v(0.0, 0.0), v(4.0, 0.0), v(4.0, 2.0), v(0.0, 2.0)], 1e-12);
         assert!((signed_boundary_distance(v(2.0, 1.0), &sq) - 1.0).abs() < 1e-12);
+        // contains answers signed_boundary_distance(p) >= -tol (near the corners too)
+        for x in [-1.0, -0.3, -0.1, 0.0, 0.05, 2.0, 3.95, 4.0, 4.1, 4.3, 6.0] {
+            for y in [-1.0, -0.3, -0.1, 0.0, 0.05, 1.0, 1.95, 2.0, 2.1, 2.3, 5.0] {
+                for tol in [0.0, 0.2, 0.5] {
+                    let p = v(x, y);
+                    assert_eq!(contains(&sq, p, tol), signed_boundary_distance(p, &sq) >= -tol, "{p} {tol}");
+                }
+            }
+        }
         // inside_by answers signed_boundary_distance(p) > margin
         for x in [-1.0, 0.0, 0.5, 1.0, 2.0, 3.5, 4.0, 6.0] {
             for y in [-1.0, 0.0, 0.5, 1.0, 2.0, 3.0, 5.0] {
