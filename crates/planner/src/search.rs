@@ -1196,11 +1196,12 @@ impl Search<'_, '_> {
                     // build and solve the child now; push it back with its true cost (>= its key)
                     let t_cells = Instant::now();
                     let f = &heap.families[family as usize];
-                    let (orientation, cell, applied, obstacle, start) =
-                        (f.orientation, Arc::clone(&f.cell), Arc::clone(&f.applied), f.obstacle, f.start);
-                    self.child_inequalities::<D>(obstacle, face, fixed_z, &mut buffers.extra);
-                    let solved = self.solve_child::<D>(orientation, &cell, &buffers.extra, &start, fixed_z)?;
+                    let orientation = f.orientation;
+                    self.child_inequalities::<D>(f.obstacle, face, fixed_z, &mut buffers.extra);
+                    let solved = self.solve_child::<D>(orientation, &f.cell, &buffers.extra, &f.start, fixed_z)?;
                     if let Some((cell, optimum)) = solved {
+                        // the path is shared by the family's children: one more reference for a non-empty one
+                        let applied = Arc::clone(&f.applied);
                         heap.push(Node {
                             cost: optimum.value,
                             orientation,
