@@ -86,6 +86,14 @@ mod vertical_qp;
 
 pub use cache::SolveCache;
 
+/// A contact point on part 0 from the floor with unit normal along `normal` (the certificates' unit tests).
+#[cfg(test)]
+fn test_point(p: DVec3, normal: DVec3) -> Point {
+    let n = normal.normalize();
+    let (t1, t2) = plane_basis(n);
+    Point { patch: 0, p, frame: [n, t1, t2], a: None, b: 0 }
+}
+
 /// Margin directions solved one after the other with one reused solver (see `Problem::solve_loads`).
 const DIRECTIONS_PER_SOLVER: usize = 4;
 

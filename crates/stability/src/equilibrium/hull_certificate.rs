@@ -77,16 +77,10 @@ pub(super) fn hull_certificate(body: &Rigid, points: &[Point], mu: f64) -> Optio
 
 #[cfg(test)]
 mod tests {
+    use super::super::test_point as point;
     use super::super::{Problem, verdict_of};
     use super::*;
-    use crate::contacts::plane_basis;
     use proptest::prelude::*;
-
-    fn point(p: DVec3, normal: DVec3) -> Point {
-        let n = normal.normalize();
-        let (t1, t2) = plane_basis(n);
-        Point { patch: 0, p, frame: [n, t1, t2], a: None, b: 0 }
-    }
 
     fn body(cg: DVec3) -> Rigid {
         Rigid { mass: 2.5, cg, aabb: (DVec3::new(-60.0, -60.0, 0.0), DVec3::new(60.0, 60.0, 40.0)) }

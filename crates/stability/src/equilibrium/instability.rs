@@ -318,19 +318,29 @@ impl Mechanism {
 
 #[cfg(test)]
 mod tests {
+    use super::super::test_point as point;
     use super::super::{Problem, verdict_of};
     use super::*;
-    use crate::contacts::plane_basis;
     use proptest::prelude::*;
-
-    fn point(p: DVec3, normal: DVec3) -> Point {
-        let n = normal.normalize();
-        let (t1, t2) = plane_basis(n);
-        Point { patch: 0, p, frame: [n, t1, t2], a: None, b: 0 }
-    }
 
     fn body(cg: DVec3) -> Rigid {
         Rigid { mass: 1.5, cg, aabb: (DVec3::new(-50.0, -50.0, 0.0), DVec3::new(50.0, 50.0, 60.0)) }
+    }
+
+    /// Contact points from a proptest's raw tuples: kinds 0 and 1 push straight up (kind 0 at height 0, so coplanar
+    /// supports half the time), kind 2 is inclined, kind 3 nearly horizontal (a side contact).
+    #[allow(clippy::type_complexity)]
+    fn random_points(raw: &[((f64, f64, f64), (usize, f64, f64))]) -> Vec<Point> {
+        raw.iter()
+            .map(|&((x, y, z), (kind, nx, ny))| {
+                let n = match kind {
+                    0 | 1 => DVec3::Z,
+                    2 => DVec3::new(0.4 * nx, 0.4 * ny, 1.0),
+                    _ => DVec3::new(nx, ny, 0.1 * nx * ny).try_normalize().unwrap_or(DVec3::X),
+                };
+                point(DVec3::new(x, y, if kind == 0 { 0.0 } else { z }), n)
+            })
+            .collect()
     }
 
     fn socp_verdict(b: &Rigid, points: &[Point], mu: f64) -> super::super::Verdict {
@@ -500,17 +510,7 @@ mod tests {
             second in (-60.0f64..60.0, -60.0f64..60.0, 10.0f64..50.0),
             mu in 0.0f64..1.5,
         ) {
-            let points: Vec<Point> = raw
-                .iter()
-                .map(|&((x, y, z), (kind, nx, ny))| {
-                    let n = match kind {
-                        0 | 1 => DVec3::Z,
-                        2 => DVec3::new(0.4 * nx, 0.4 * ny, 1.0),
-                        _ => DVec3::new(nx, ny, 0.1 * nx * ny).try_normalize().unwrap_or(DVec3::X),
-                    };
-                    point(DVec3::new(x, y, if kind == 0 { 0.0 } else { z }), n)
-                })
-                .collect();
+            let points = random_points(&raw);
             let refs: Vec<&Point> = points.iter().collect();
             let a = body(DVec3::new(first.0, first.1, first.2));
             let problem = Problem::new(&[a], &[0], &refs, mu);
@@ -532,19 +532,7 @@ mod tests {
             cg in (-45.0f64..45.0, -45.0f64..45.0, 10.0f64..50.0),
             mu in 0.0f64..1.5,
         ) {
-            let points: Vec<Point> = raw
-                .iter()
-                .map(|&((x, y, z), (kind, nx, ny))| {
-                    let n = match kind {
-                        0 | 1 => DVec3::Z,
-                        2 => DVec3::new(0.4 * nx, 0.4 * ny, 1.0),
-                        _ => DVec3::new(nx, ny, 0.1 * nx * ny).try_normalize().unwrap_or(DVec3::X),
-                    };
-                    // coplanar supports half the time
-                    let z = if kind == 0 { 0.0 } else { z };
-                    point(DVec3::new(x, y, z), n)
-                })
-                .collect();
+            let points = random_points(&raw);
             let b = body(DVec3::new(cg.0, cg.1, cg.2));
             if body_unstable(&b, &points, mu) {
                 prop_assert!(never_stable(&socp_verdict(&b, &points, mu)));
