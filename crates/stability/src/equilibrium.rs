@@ -428,16 +428,16 @@ fn group_equilibrium(
         let (v, on_subtree) = match certified {
             Some(f) => (Verdict::Stable, f),
             None => cache.equilibrium(cache::key(&[mu], &edge.union, &own), || {
-                let refs: Vec<&Point> = own.iter().collect();
-                match tree::flat_minimum_norm(&edge.union, &own) {
-                    Some(f) => Ok((Verdict::Stable, f)),
-                    None if instability::body_unstable(&edge.union, &own, mu)
-                        || cache.any_mechanism(true, |m| m.proves(&[edge.union], &[0], &refs, mu)) =>
-                    {
-                        Ok((Verdict::Unstable, Vec::new()))
-                    }
-                    None => socp(&[edge.union], &[0], &refs, false),
+                if let Some(f) = tree::flat_minimum_norm(&edge.union, &own) {
+                    return Ok((Verdict::Stable, f));
                 }
+                let refs: Vec<&Point> = own.iter().collect();
+                if instability::body_unstable(&edge.union, &own, mu)
+                    || cache.any_mechanism(true, |m| m.proves(&[edge.union], &[0], &refs, mu))
+                {
+                    return Ok((Verdict::Unstable, Vec::new()));
+                }
+                socp(&[edge.union], &[0], &refs, false)
             })?,
         };
         match v {
