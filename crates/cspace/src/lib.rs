@@ -15,6 +15,7 @@ mod edge_table;
 pub mod interference;
 pub mod minkowski;
 pub mod offset;
+mod prism_assembly;
 mod z_prism;
 
 pub use cache::{CacheStats, ObstacleCache};

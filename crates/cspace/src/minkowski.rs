@@ -65,7 +65,7 @@ use stackplan_geom::tolerance::{RELATIVE, Tolerance};
 use stackplan_geom::{HullError, convex_hull};
 
 use crate::edge_table::{self, EdgeScratch};
-use crate::z_prism;
+use crate::{prism_assembly, z_prism};
 
 /// Angular tolerance (radians) of the Gauss-map decisions: a face normal within this of an arc's circle lies on it;
 /// two face normals within half of it are the same direction.
@@ -464,6 +464,7 @@ struct Scratch {
     planar: PlanarScratch,
     edges: EdgeScratch,
     prism: z_prism::Scratch,
+    direct: prism_assembly::Scratch,
 }
 
 thread_local! {
@@ -478,6 +479,8 @@ thread_local! {
     pub(crate) static GENERAL_ROUTE_ONLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
     /// Tests: assemble a tame z-prism pair by the polygon merges too (`z_prism::derived_cycles`).
     pub(crate) static NO_DERIVED_CYCLES: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// Tests: assemble the derived cycles of a tame z-prism pair by the general assembly (`prism_assembly.rs`).
+    pub(crate) static NO_DIRECT_ASSEMBLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
 /// Whether the test switch `$switch` (a thread-local above) is on; always `false` outside the tests.
@@ -533,6 +536,7 @@ fn overlay(
         planar,
         edges,
         prism,
+        direct,
     } = scratch;
     ra.clear();
     ra.extend(moving.vertices().iter().map(|a| rotation * *a));
@@ -583,6 +587,18 @@ fn overlay(
         #[cfg(test)]
         if derived {
             z_prism::DERIVED.with(|c| c.set(c.get() + 1));
+        }
+        // their vertex numbering, offsets and edge table from the prism structure (`prism_assembly.rs`)
+        if derived && !test_switch!(NO_DIRECT_ASSEMBLY) {
+            let (cycles, starts) = (prism.cycles.as_slice(), prism.starts.as_slice());
+            let b_levels = prism.b_levels.as_slice();
+            if let Some(result) =
+                prism_assembly::assemble(fixed, rotation, ra, faces, cycles, starts, b_levels, index_of, direct)
+            {
+                #[cfg(test)]
+                z_prism::DIRECT.with(|c| c.set(c.get() + 1));
+                return result;
+            }
         }
         // the merged pole faces need no faces across their edges when no side face of -RA is merged (`z_prism.rs`)
         let pole_faces_alone = by_class && z_prism::no_side_merged(&prism.a_classes, merged_with_b);

@@ -497,11 +497,13 @@ thread_local! {
     pub(crate) static TAKEN: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
     /// Tests: how many of those were assembled from [`derived_cycles`].
     pub(crate) static DERIVED: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+    /// Tests: how many of those were assembled directly (`prism_assembly.rs`).
+    pub(crate) static DIRECT: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
 }
 
 #[cfg(test)]
 mod tests {
-    use crate::minkowski::{GENERAL_ROUTE_ONLY, NO_DERIVED_CYCLES, gauss_map_obstacle};
+    use crate::minkowski::{GENERAL_ROUTE_ONLY, NO_DERIVED_CYCLES, NO_DIRECT_ASSEMBLY, gauss_map_obstacle};
     use glam::{DMat3, DVec3};
     use stackplan_geom::{ConvexPolytope, convex_hull};
 
@@ -573,11 +575,17 @@ mod tests {
         assert_eq!(z_prisms, 9);
         let taken_before = super::TAKEN.with(std::cell::Cell::get);
         let derived_before = super::DERIVED.with(std::cell::Cell::get);
+        let direct_before = super::DIRECT.with(std::cell::Cell::get);
         let (mut cases, mut merged) = (0, 0);
         for a in &shapes {
             for b in &shapes {
                 for &r in &rotations {
                     let fast = format!("{:?}", gauss_map_obstacle(a, r, b));
+                    // the derived cycles through the general assembly (no direct assembly, `prism_assembly.rs`)
+                    NO_DIRECT_ASSEMBLY.with(|c| c.set(true));
+                    let assembled = format!("{:?}", gauss_map_obstacle(a, r, b));
+                    NO_DIRECT_ASSEMBLY.with(|c| c.set(false));
+                    assert_eq!(fast, assembled, "{a:?} {r:?} {b:?}");
                     // the z-prism route with the general polygon merges (no derived cycles), and the general route
                     NO_DERIVED_CYCLES.with(|c| c.set(true));
                     let merged_cycles = format!("{:?}", gauss_map_obstacle(a, r, b));
@@ -594,9 +602,13 @@ mod tests {
                 }
             }
         }
-        // (each z-prism case ran the z-prism route twice, once with the derived cycles switched off)
-        let taken = (super::TAKEN.with(std::cell::Cell::get) - taken_before) / 2;
-        let derived = super::DERIVED.with(std::cell::Cell::get) - derived_before;
+        // (each z-prism case ran the z-prism route three times: with everything, without the direct assembly, without
+        // the derived cycles; the first two derive the cycles of a tame pair)
+        let taken = (super::TAKEN.with(std::cell::Cell::get) - taken_before) / 3;
+        let derived = (super::DERIVED.with(std::cell::Cell::get) - derived_before) / 2;
+        let direct = super::DIRECT.with(std::cell::Cell::get) - direct_before;
+        // every tame pair assembled directly
+        assert_eq!(direct, derived, "{direct} of {derived} derived pairs assembled directly");
         // the tame pairs (most pairs at generic angles; not the quarter turns, not within 1e-6 of one, not the huge
         // box) assembled without the polygon merges, bit for bit as the general route
         assert!(derived * 2 > taken && derived < taken, "{derived} of {taken} derived");

@@ -1,0 +1,225 @@
+//! The direct assembly of the obstacle of a tame z-prism pair: vertex numbering, offsets and the edge table generated
+//! from the prism structure, without the general assembly's lookup-table pass.
+//!
+//! Paper: Ayyadevara et al. 2002 ([A]) App. B, eq. 12; the obstacle of two z-prisms turned about `z` is itself a
+//! z-prism, `C = (b (+) (-R a)) x [b_lo - a_hi, b_hi - a_lo]` for the cross-sections `a`, `b` (see `z_prism.rs`).
+//! For a *tame* pair `z_prism::derived_cycles` has read every face cycle off the features: `k` side faces (each a
+//! quadrilateral with two corners on each pole) and two pole faces, `2 k` vertices, `3 k` edges. Every vertex has
+//! exactly three edges, known by construction:
+//!
+//! * **along its pole**: `v -> next(v)` in the pole face, traversed back (`next(v) -> v`) by one side face;
+//! * **from its pole's predecessor**: `prev(v) -> v` likewise (the same kind of edge, seen from its other end);
+//! * **vertical**: `v -> partner(v)` in one side face, `partner(v) -> v` in the adjacent one.
+//!
+//! So one pass over the faces (in the general route's order, numbering the vertex pairs on first appearance and taking
+//! every face's offset as the general assembly does) files each half-edge under the vertex that names it: a pole
+//! face's half-edge under its source (`pole`), a side face's horizontal half-edge under its *target* (`twin`: its
+//! reverse is that vertex's pole half-edge), a side face's vertical half-edge under its source (`vertical`). Then one
+//! pass over the vertices in increasing order emits each vertex's edges to larger vertices (at most three, sorted):
+//! exactly geom's edge table (edges by (smaller, larger) vertex, the face traversing smaller -> larger first, every
+//! half-edge's edge), with no sort of half-edges and no search for twins.
+//!
+//! Checked on the way (else `None`, and the caller assembles as the general route does, with the same result): every
+//! slot filled exactly once, `next` a permutation, the horizontal side half-edge filed under `v` comes from `next(v)`,
+//! `partner` an involution, and the three neighbours of every vertex distinct from each other and from it. These
+//! imply that every undirected edge has exactly one half-edge each way and no other, i.e. that the table is the one
+//! geom builds (which debug builds check on every obstacle).
+//!
+//! Complexity: O(V + F + sum of the face lengths), no allocation besides the result's own.
+
+use glam::{DMat3, DVec3};
+use stackplan_geom::polytope::{ConvexPolytope, Edge, Face, Plane};
+
+use crate::minkowski::{FaceKind, FaceSpec, Feature, Obstacle, OverlayFailure, Route};
+
+/// A half-edge filed under a vertex: the vertex at its other end, its index (in the faces' corner order) and its face.
+#[derive(Clone, Copy)]
+struct Half {
+    other: u32,
+    index: u32,
+    face: u32,
+}
+
+const EMPTY: Half = Half { other: u32::MAX, index: u32::MAX, face: u32::MAX };
+
+/// Working buffers, kept per thread with the overlay's.
+#[derive(Default)]
+pub(crate) struct Scratch {
+    /// `stars[v]`: the half-edges filed under `v`: `[POLE]` is `v -> next(v)` of its pole face, `[TWIN]` is
+    /// `next(v) -> v` of a side face (`other` its source), `[VERTICAL]` is `v -> partner(v)` of a side face.
+    stars: Vec<[Half; 3]>,
+    /// `prev[next(v)] = v`.
+    prev: Vec<u32>,
+}
+
+const POLE: usize = 0;
+const TWIN: usize = 1;
+const VERTICAL: usize = 2;
+
+/// The obstacle vertex of the vertex pair `[i, j]`, numbered on first appearance exactly as the general assembly
+/// (`minkowski::assemble`) numbers them: `b[j] - ra[i]`.
+#[inline(always)]
+fn number(
+    [i, j]: [usize; 2],
+    index_of: &mut [u32],
+    nb: usize,
+    bv: &[DVec3],
+    ra: &[DVec3],
+    vertices: &mut Vec<DVec3>,
+    vertex_pairs: &mut Vec<[usize; 2]>,
+) -> usize {
+    let slot = &mut index_of[i * nb + j];
+    if *slot == u32::MAX {
+        *slot = vertices.len() as u32;
+        vertices.push(bv[j] - ra[i]);
+        vertex_pairs.push([i, j]);
+    }
+    *slot as usize
+}
+
+/// The obstacle of a tame z-prism pair from the face cycles of `z_prism::derived_cycles` (face `s` is the vertex-pair
+/// cycle `cycles[starts[s]..starts[s + 1]]` of `specs[s]`; `b_levels` the pole of every vertex of `B`): bit for bit
+/// the general assembly's result, or `None` when the cycles are not the structure described in the module
+/// documentation (then the caller runs the general assembly). `index_of` is the general assembly's numbering table.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn assemble(
+    fixed: &ConvexPolytope,
+    rotation: DMat3,
+    ra: &[DVec3],
+    specs: &[FaceSpec],
+    cycles: &[[usize; 2]],
+    starts: &[usize],
+    b_levels: &[u8],
+    index_of: &mut Vec<u32>,
+    scratch: &mut Scratch,
+) -> Option<Result<Obstacle, OverlayFailure>> {
+    let bv = fixed.vertices();
+    let nb = bv.len();
+    // `k` side faces and two poles: `2 k` vertices, `3 k` edges, `6 k` half-edges
+    let nv = 2 * specs.len().checked_sub(2)?;
+    let total = 3 * nv;
+    if starts.len() != specs.len() + 1 || starts[specs.len()] != total || cycles.len() < total {
+        return None;
+    }
+    index_of.clear();
+    index_of.resize(ra.len() * nb, u32::MAX);
+    let index_of = &mut index_of[..];
+    let Scratch { stars, prev } = scratch;
+    stars.clear();
+    stars.resize(nv, [EMPTY; 3]);
+    let stars = &mut stars[..];
+    let mut vertices: Vec<DVec3> = Vec::with_capacity(nv);
+    let mut vertex_pairs: Vec<[usize; 2]> = Vec::with_capacity(nv);
+    let mut faces: Vec<Face> = Vec::with_capacity(specs.len());
+    let mut kinds: Vec<FaceKind> = Vec::with_capacity(specs.len());
+    for (s, (spec, range)) in specs.iter().zip(starts.windows(2)).enumerate() {
+        let (start, end) = (range[0], range[1]);
+        let corners = cycles.get(start..end)?;
+        let face_index = s as u32;
+        let face: Vec<usize> = if let (Feature::Face(_), Feature::Face(_)) = (spec.fixed, spec.moving) {
+            // a pole face: every half-edge `a -> b` is filed under its source
+            let mut face = Vec::with_capacity(corners.len());
+            for &c in corners {
+                face.push(number(c, index_of, nb, bv, ra, &mut vertices, &mut vertex_pairs));
+            }
+            let &last = face.last()?;
+            let mut a = last;
+            for (k, &b) in face.iter().enumerate() {
+                let index = (start + if k == 0 { face.len() - 1 } else { k - 1 }) as u32;
+                let slot = &mut stars.get_mut(a)?[POLE];
+                if slot.other != u32::MAX {
+                    return None;
+                }
+                *slot = Half { other: b as u32, index, face: face_index };
+                a = b;
+            }
+            face
+        } else {
+            // a side face, a quadrilateral whose half-edges `k` and `k + 2` run along the poles, `k + 1` and `k + 3`
+            // between them (the labels need not be geometric: the checks below are combinatorial)
+            let &[c0, c1, c2, c3] = corners else { return None };
+            let mut v = [0; 4];
+            for (v, c) in v.iter_mut().zip([c0, c1, c2, c3]) {
+                *v = number(c, index_of, nb, bv, ra, &mut vertices, &mut vertex_pairs);
+            }
+            let k = usize::from(b_levels[c0[1]] != b_levels[c1[1]]);
+            for q in 0..4 {
+                let (a, b) = (v[q], v[(q + 1) & 3]);
+                let index = (start + q) as u32;
+                let (owner, kind, other) = if q & 1 == k { (b, TWIN, a) } else { (a, VERTICAL, b) };
+                let slot = &mut stars.get_mut(owner)?[kind];
+                if slot.other != u32::MAX {
+                    return None;
+                }
+                *slot = Half { other: other as u32, index, face: face_index };
+            }
+            v.to_vec()
+        };
+        if vertices.len() > nv || face.len() < 3 {
+            return None;
+        }
+        // the offset exactly as the general assembly: the largest `n . v`, corners in cycle order
+        let mut offset = f64::NEG_INFINITY;
+        for &v in &face {
+            offset = offset.max(spec.normal.dot(vertices[v]));
+        }
+        faces.push(Face { vertices: face, plane: Plane { normal: spec.normal, offset } });
+        kinds.push(FaceKind::from_features(spec.fixed, spec.moving).unwrap_or(FaceKind::Unclassified));
+    }
+    if vertices.len() != nv {
+        return None;
+    }
+    prev.clear();
+    prev.resize(nv, u32::MAX);
+    for (v, star) in stars.iter().enumerate() {
+        let slot = prev.get_mut(star[POLE].other as usize)?;
+        if *slot != u32::MAX {
+            return None;
+        }
+        *slot = v as u32;
+    }
+    let (stars, prev) = (&*stars, &prev[..]);
+    let mut edges: Vec<Edge> = Vec::with_capacity(total / 2);
+    let mut face_edges = vec![0usize; total];
+    for (lo, (&[p, t, d], &pp)) in stars.iter().zip(prev).enumerate() {
+        // `prev` is a permutation (`pole` filled for every vertex), so `pp` is a vertex
+        let (pn, vt, me) = (p.other, d.other, lo as u32);
+        let (Some(&[pp_pole, pp_twin, _]), Some(&[_, _, down])) = (stars.get(pp as usize), stars.get(vt as usize))
+        else {
+            return None;
+        };
+        if t.other != pn || pp_twin.other != me || down.other != me || pn == pp || pn == vt || pp == vt || pn == me {
+            return None;
+        }
+        // (larger vertex, forward half-edge, reverse half-edge); the side half-edge `lo -> pp` is filed under `pp`
+        let mut up = [(pn, p, t), (pp, pp_twin, pp_pole), (vt, d, down)];
+        if up[0].0 > up[1].0 {
+            up.swap(0, 1);
+        }
+        if up[1].0 > up[2].0 {
+            up.swap(1, 2);
+        }
+        if up[0].0 > up[1].0 {
+            up.swap(0, 1);
+        }
+        for (hi, forward, reverse) in up {
+            if hi > me {
+                let e = edges.len();
+                edges.push(Edge { vertices: [lo, hi as usize], faces: [forward.face as usize, reverse.face as usize] });
+                face_edges[forward.index as usize] = e;
+                face_edges[reverse.index as usize] = e;
+            }
+        }
+    }
+    let f = faces.len();
+    if nv + f != edges.len() + 2 {
+        return None;
+    }
+    let polytope = ConvexPolytope::from_faces_and_edges(vertices, faces, edges, face_edges);
+    Some(match polytope {
+        Ok(polytope) => {
+            Obstacle::from_parts(polytope, vertex_pairs, kinds, rotation, Route::GaussMap).ok_or(OverlayFailure::Euler)
+        }
+        Err(e) => Err(OverlayFailure::Assembly(e)),
+    })
+}
