@@ -479,6 +479,8 @@ thread_local! {
     pub(crate) static GENERAL_ROUTE_ONLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
     /// Tests: assemble a tame z-prism pair by the polygon merges too (`z_prism::derived_cycles`).
     pub(crate) static NO_DERIVED_CYCLES: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// Tests: find the parallel faces of a z-prism pair by `z_prism::parallel_faces` first (not the poles alone).
+    pub(crate) static NO_POLE_MERGES_FIRST: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
     /// Tests: assemble the derived cycles of a tame z-prism pair by the general assembly (`prism_assembly.rs`).
     pub(crate) static NO_DIRECT_ASSEMBLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
@@ -560,25 +562,54 @@ fn overlay(
     merged_with_b.resize(fa, None);
     merged_with_a.clear();
     merged_with_a.resize(fb, None);
-    let by_class =
-        z_prisms && z_prism::parallel_faces(am, bn, &prism.a_classes, &prism.b_classes, merged_with_a, merged_with_b);
-    if !by_class {
-        for (f, m) in am.iter().enumerate() {
-            for (g, n) in bn.iter().enumerate() {
-                if (*m - *n).length_squared() <= PARALLEL_SQ {
-                    merged_with_b[f] = Some(g);
-                    merged_with_a[g] = Some(f);
-                }
-            }
-        }
-    }
     faces.clear();
 
     if z_prisms {
         #[cfg(test)]
         z_prism::TAKEN.with(|c| c.set(c.get() + 1));
+        // a tame pair merges only its poles: take that for granted, and confirm it by the supports' margin (every side
+        // normal well inside an arc of the other summand is far from all its side normals, `z_prism::pole_merges`)
         let mut margin = f64::INFINITY;
-        z_prism::face_specs(am, bn, &prism.a, &prism.b, neg_ra, bv, merged_with_a, merged_with_b, faces, &mut margin)?;
+        let mut by_class = !test_switch!(NO_POLE_MERGES_FIRST)
+            && z_prism::pole_merges(am, bn, &prism.a_classes, &prism.b_classes, merged_with_a, merged_with_b)
+            && z_prism::face_specs(
+                am,
+                bn,
+                &prism.a,
+                &prism.b,
+                neg_ra,
+                bv,
+                merged_with_a,
+                merged_with_b,
+                faces,
+                &mut margin,
+            )
+            .is_ok()
+            && margin > z_prism::MARGIN;
+        if !by_class {
+            // else as the general route: all parallel pairs (within a class when the poles are far from the sides)
+            merged_with_b.fill(None);
+            merged_with_a.fill(None);
+            by_class =
+                z_prism::parallel_faces(am, bn, &prism.a_classes, &prism.b_classes, merged_with_a, merged_with_b);
+            if !by_class {
+                all_parallel_faces(am, bn, merged_with_a, merged_with_b);
+            }
+            faces.clear();
+            margin = f64::INFINITY;
+            z_prism::face_specs(
+                am,
+                bn,
+                &prism.a,
+                &prism.b,
+                neg_ra,
+                bv,
+                merged_with_a,
+                merged_with_b,
+                faces,
+                &mut margin,
+            )?;
+        }
         // a tame pair: every cycle without the polygon merges (`z_prism::derived_cycles`)
         let derived = by_class
             && margin > z_prism::MARGIN
@@ -608,6 +639,7 @@ fn overlay(
         return assemble(moving, fixed, rotation, ra, faces, buffers);
     }
 
+    all_parallel_faces(am, bn, merged_with_a, merged_with_b);
     arcs(moving, neg_ra, am, a_arcs);
     arcs(fixed, bv, bn, b_arcs);
     let (am, bn, a_arcs, b_arcs) = (&*am, &*bn, &*a_arcs, &*b_arcs);
@@ -718,6 +750,24 @@ fn overlay(
     }
     let buffers = AssemblyBuffers { index_of, cycle, planar, merged_with_b, neg_ra, edges, plain: None, cycles: None };
     assemble(moving, fixed, rotation, ra, faces, buffers)
+}
+
+/// The parallel faces of `-RA` (normals `am`) and `B` (normals `bn`): every pair whose unit normals are within half
+/// the angular tolerance, in (face of `-RA`, face of `B`) order, the last match kept.
+fn all_parallel_faces(
+    am: &[DVec3],
+    bn: &[DVec3],
+    merged_with_a: &mut [Option<usize>],
+    merged_with_b: &mut [Option<usize>],
+) {
+    for (f, m) in am.iter().enumerate() {
+        for (g, n) in bn.iter().enumerate() {
+            if (*m - *n).length_squared() <= PARALLEL_SQ {
+                merged_with_b[f] = Some(g);
+                merged_with_a[g] = Some(f);
+            }
+        }
+    }
 }
 
 pub(crate) struct FaceSpec {

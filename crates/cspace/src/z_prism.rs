@@ -188,6 +188,40 @@ pub(crate) fn parallel_faces(
     true
 }
 
+/// The parallel faces among the poles only, exactly as [`parallel_faces`] finds them (the same pairs in the same
+/// order) when no side normal of one summand is parallel to one of the other; `false` (nothing written) when some pole
+/// is not far from the sides (as [`parallel_faces`]). The caller confirms that no side normals are parallel by
+/// [`face_specs`] run on these merges: when every side normal of `B` lies strictly inside a vertical arc of `-RA` with
+/// both its support tests above [`MARGIN`] (the sines of its angles to the arc's two end normals, up to the circle's
+/// `|cz|`, 1 within rounding), it is at least about `MARGIN` away from the arc's ends, and the ends are the side
+/// normals of `-RA` angularly next to it (the arcs of a convex prism's vertical edges lie between angularly adjacent
+/// side normals), so farther still from all others: no pair of side normals is within `sqrt(PARALLEL_SQ)` (half the
+/// angular tolerance, 5e-10) of each other, and [`parallel_faces`] would merge the poles alone. O(FA + FB).
+pub(crate) fn pole_merges(
+    am: &[DVec3],
+    bn: &[DVec3],
+    a_classes: &[u8],
+    b_classes: &[u8],
+    merged_with_a: &mut [Option<usize>],
+    merged_with_b: &mut [Option<usize>],
+) -> bool {
+    let far = |normals: &[DVec3], classes: &[u8]| {
+        normals.iter().zip(classes).all(|(n, &c)| c != POLE || n.z * n.z > PARALLEL_SQ)
+    };
+    if !(far(am, a_classes) && far(bn, b_classes)) {
+        return false;
+    }
+    for ((f, m), _) in am.iter().enumerate().zip(a_classes).filter(|(_, c)| **c == POLE) {
+        for ((g, n), _) in bn.iter().enumerate().zip(b_classes).filter(|(_, c)| **c == POLE) {
+            if (*m - *n).length_squared() <= PARALLEL_SQ {
+                merged_with_b[f] = Some(g);
+                merged_with_a[g] = Some(f);
+            }
+        }
+    }
+    true
+}
+
 /// Whether the class is a pole's.
 #[inline]
 pub(crate) fn is_pole(class: u8) -> bool {
@@ -503,7 +537,9 @@ thread_local! {
 
 #[cfg(test)]
 mod tests {
-    use crate::minkowski::{GENERAL_ROUTE_ONLY, NO_DERIVED_CYCLES, NO_DIRECT_ASSEMBLY, gauss_map_obstacle};
+    use crate::minkowski::{
+        GENERAL_ROUTE_ONLY, NO_DERIVED_CYCLES, NO_DIRECT_ASSEMBLY, NO_POLE_MERGES_FIRST, gauss_map_obstacle,
+    };
     use glam::{DMat3, DVec3};
     use stackplan_geom::{ConvexPolytope, convex_hull};
 
@@ -586,6 +622,11 @@ mod tests {
                     let assembled = format!("{:?}", gauss_map_obstacle(a, r, b));
                     NO_DIRECT_ASSEMBLY.with(|c| c.set(false));
                     assert_eq!(fast, assembled, "{a:?} {r:?} {b:?}");
+                    // all parallel pairs first (not the poles alone, confirmed by the supports' margin)
+                    NO_POLE_MERGES_FIRST.with(|c| c.set(true));
+                    let all_pairs = format!("{:?}", gauss_map_obstacle(a, r, b));
+                    NO_POLE_MERGES_FIRST.with(|c| c.set(false));
+                    assert_eq!(fast, all_pairs, "{a:?} {r:?} {b:?}");
                     // the z-prism route with the general polygon merges (no derived cycles), and the general route
                     NO_DERIVED_CYCLES.with(|c| c.set(true));
                     let merged_cycles = format!("{:?}", gauss_map_obstacle(a, r, b));
@@ -602,11 +643,12 @@ mod tests {
                 }
             }
         }
-        // (each z-prism case ran the z-prism route three times: with everything, without the direct assembly, without
-        // the derived cycles; the first two derive the cycles of a tame pair)
-        let taken = (super::TAKEN.with(std::cell::Cell::get) - taken_before) / 3;
-        let derived = (super::DERIVED.with(std::cell::Cell::get) - derived_before) / 2;
-        let direct = super::DIRECT.with(std::cell::Cell::get) - direct_before;
+        // (each z-prism case ran the z-prism route four times: with everything, without the direct assembly, without
+        // the poles merged first, without the derived cycles; the first three derive the cycles of a tame pair and
+        // the first and the third assemble them directly)
+        let taken = (super::TAKEN.with(std::cell::Cell::get) - taken_before) / 4;
+        let derived = (super::DERIVED.with(std::cell::Cell::get) - derived_before) / 3;
+        let direct = (super::DIRECT.with(std::cell::Cell::get) - direct_before) / 2;
         // every tame pair assembled directly
         assert_eq!(direct, derived, "{direct} of {derived} derived pairs assembled directly");
         // the tame pairs (most pairs at generic angles; not the quarter turns, not within 1e-6 of one, not the huge
