@@ -101,13 +101,23 @@ pub(crate) fn assemble(
     if starts.len() != specs.len() + 1 || starts[specs.len()] != total || cycles.len() < total {
         return None;
     }
-    index_of.clear();
-    index_of.resize(ra.len() * nb, u32::MAX);
-    let index_of = &mut index_of[..];
+    // (the buffers only grow; the parts used are filled here)
+    let na_nb = ra.len() * nb;
+    if index_of.len() < na_nb {
+        index_of.resize(na_nb, u32::MAX);
+    }
+    let index_of = &mut index_of[..na_nb];
+    index_of.fill(u32::MAX);
     let Scratch { stars, prev } = scratch;
-    stars.clear();
-    stars.resize(nv, [EMPTY; 3]);
-    let stars = &mut stars[..];
+    if stars.len() < nv {
+        stars.resize(nv, [EMPTY; 3]);
+    }
+    if prev.len() < nv {
+        prev.resize(nv, u32::MAX);
+    }
+    let (stars, prev) = (&mut stars[..nv], &mut prev[..nv]);
+    stars.fill([EMPTY; 3]);
+    prev.fill(u32::MAX);
     let mut vertices: Vec<DVec3> = Vec::with_capacity(nv);
     let mut vertex_pairs: Vec<[usize; 2]> = Vec::with_capacity(nv);
     let mut faces: Vec<Face> = Vec::with_capacity(specs.len());
@@ -126,11 +136,12 @@ pub(crate) fn assemble(
             let mut a = last;
             for (k, &b) in face.iter().enumerate() {
                 let index = (start + if k == 0 { face.len() - 1 } else { k - 1 }) as u32;
-                let slot = &mut stars.get_mut(a)?[POLE];
-                if slot.other != u32::MAX {
+                let (slot, back) = (&mut stars.get_mut(a)?[POLE], prev.get_mut(b)?);
+                if slot.other != u32::MAX || *back != u32::MAX {
                     return None;
                 }
                 *slot = Half { other: b as u32, index, face: face_index };
+                *back = a as u32;
                 a = b;
             }
             face
@@ -169,18 +180,11 @@ pub(crate) fn assemble(
     if vertices.len() != nv {
         return None;
     }
-    prev.clear();
-    prev.resize(nv, u32::MAX);
-    for (v, star) in stars.iter().enumerate() {
-        let slot = prev.get_mut(star[POLE].other as usize)?;
-        if *slot != u32::MAX {
-            return None;
-        }
-        *slot = v as u32;
-    }
-    let (stars, prev) = (&*stars, &prev[..]);
+    let (stars, prev) = (&*stars, &*prev);
     let mut edges: Vec<Edge> = Vec::with_capacity(total / 2);
-    let mut face_edges = vec![0usize; total];
+    // (with room for the faces' starts, which geom keeps in the same buffer)
+    let mut face_edges = Vec::with_capacity(total + faces.len() + 1);
+    face_edges.resize(total, 0usize);
     for (lo, (&[p, t, d], &pp)) in stars.iter().zip(prev).enumerate() {
         // `prev` is a permutation (`pole` filled for every vertex), so `pp` is a vertex
         let (pn, vt, me) = (p.other, d.other, lo as u32);

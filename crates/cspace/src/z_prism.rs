@@ -400,8 +400,11 @@ pub(crate) fn derived_cycles(
         (TOP, BOTTOM) => Some([v1, v0]),
         _ => None,
     };
-    next.clear();
-    next.resize(na * nb, u32::MAX);
+    // (the buffers only grow: every entry used below is written first, or filled here)
+    if next.len() < na * nb {
+        next.resize(na * nb, u32::MAX);
+    }
+    next[..na * nb].fill(u32::MAX);
     // the cycles' total length when every side face is a quadrilateral (checked below)
     let size = |p: &ConvexPolytope, f: usize| p.faces()[f].vertices.len();
     let total = 4 * specs.len().saturating_sub(2)
@@ -409,10 +412,15 @@ pub(crate) fn derived_cycles(
         + size(moving, a_top)
         + size(fixed, b_bottom)
         + size(moving, a_bottom);
-    cycles.clear();
-    cycles.resize(total, [0, 0]);
-    starts.clear();
-    starts.resize(specs.len() + 1, 0);
+    // every cycle position and every start is written below before it is read (the cycles' garbage beyond `total`
+    // is never read: faces are read through `starts`)
+    if cycles.len() < total {
+        cycles.resize(total, [0, 0]);
+    }
+    if starts.len() != specs.len() + 1 {
+        starts.clear();
+        starts.resize(specs.len() + 1, 0);
+    }
     // the pole faces: (position in `cycles`, face of B, corners)
     let mut pole_faces = [(0, 0, 0); 2];
     let mut pole_count = 0;
@@ -478,7 +486,7 @@ pub(crate) fn derived_cycles(
             let l = if k == 3 { 0 } else { k + 1 };
             if quad[k] == quad[l] {
                 let ([i0, j0], [i1, j1]) = (c[k], c[l]);
-                let slot = &mut next[i1 * nb + j1];
+                let slot = &mut next[..na * nb][i1 * nb + j1];
                 if *slot != u32::MAX {
                     return false;
                 }
@@ -510,7 +518,7 @@ pub(crate) fn derived_cycles(
                 return false;
             }
             cycles[position + k] = corner;
-            let packed = next[corner[0] * nb + corner[1]];
+            let packed = next[..na * nb][corner[0] * nb + corner[1]];
             if packed == u32::MAX {
                 return false;
             }
