@@ -111,7 +111,9 @@ fn build_stars(nv: usize, faces: &[Face], scratch: &mut EdgeScratch) -> Option<(
     }
     // pass 3: the edges in (smaller, larger) vertex order
     let mut edges = Vec::with_capacity(total / 2);
-    let mut face_edges = vec![usize::MAX; total];
+    // (with room for the faces' starts, which geom keeps in the same buffer)
+    let mut face_edges = Vec::with_capacity(total + faces.len() + 1);
+    face_edges.resize(total, usize::MAX);
     for lo in 0..nv {
         for &(hi, forward) in &out[start[lo] as usize..start[lo + 1] as usize] {
             let hi = hi as usize;
@@ -168,7 +170,9 @@ fn build_small(nv: usize, faces: &[Face], scratch: &mut EdgeScratch) -> Option<(
         half(a, first, f as u32)?;
     }
     let mut edges = Vec::with_capacity(total / 2);
-    let mut face_edges = vec![0; total];
+    // (with room for the faces' starts, which geom keeps in the same buffer)
+    let mut face_edges = Vec::with_capacity(total + faces.len() + 1);
+    face_edges.resize(total, 0);
     for lo in 0..nv {
         let mut above = targets[lo] & (u64::MAX << lo);
         while above != 0 {

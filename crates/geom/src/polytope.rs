@@ -286,25 +286,20 @@ impl ConvexPolytope {
     /// Minkowski sums of `stackplan-cspace`. O(V + F); the vertices' finiteness and count are checked as in
     /// [`Self::new`]; the table itself is trusted, and checked against the one [`Self::new`] would build only in debug
     /// builds. When `face_edges` does not have one entry per half-edge, the table is built here (same checks as
-    /// [`Self::from_faces_with_area`]).
+    /// [`Self::from_faces_with_area`]). The faces' starts in `face_edges` are kept in its spare capacity when it has
+    /// room for one more entry than there are faces (else it grows once).
     pub fn from_faces_and_edges(
         vertices: Vec<DVec3>,
         faces: Vec<Face>,
         edges: Vec<Edge>,
         face_edges: Vec<usize>,
     ) -> Result<Self, PolytopeError> {
-        let mut starts = Vec::with_capacity(faces.len() + 1);
-        let mut total = 0;
-        starts.push(0);
-        for face in &faces {
-            total += face.vertices.len();
-            starts.push(total);
-        }
+        let total: usize = faces.iter().map(|face| face.vertices.len()).sum();
         if face_edges.len() != total {
             return Self::from_faces_with_area(vertices, faces);
         }
         check_vertices(&vertices)?;
-        let face_edges = FaceEdgeTable { edges: face_edges, starts };
+        let face_edges = FaceEdgeTable::new(face_edges, faces.iter().map(|face| face.vertices.len()));
         #[cfg(debug_assertions)]
         {
             let built = edge_table(vertices.len(), &faces, |f| f.vertices.as_slice());
@@ -529,21 +524,41 @@ impl ConvexPolytope {
     }
 }
 
-/// The edge indices of every face in one flat list: face `f`'s are `edges[starts[f]..starts[f + 1]]` (two allocations
-/// instead of one per face). Serialised and debug-printed exactly as the list of per-face lists it replaces.
+/// The edge indices of every face in one flat list, and where every face's start in it, in one buffer: face `f`'s
+/// edges are `data[starts[f]..starts[f + 1]]` with `starts = data[split..]` (one allocation instead of one per face, or
+/// two). Serialised and debug-printed exactly as the list of per-face lists it replaces.
 #[derive(Clone, PartialEq, Eq)]
 struct FaceEdgeTable {
-    edges: Vec<usize>,
-    starts: Vec<usize>,
+    data: Vec<usize>,
+    split: usize,
 }
 
 impl FaceEdgeTable {
+    /// The table of the half-edges' edges `edges` (face order) for faces of the given lengths (which must add up to
+    /// `edges.len()`); the starts go into `edges`' spare capacity when it has room.
+    fn new(mut edges: Vec<usize>, lengths: impl ExactSizeIterator<Item = usize>) -> Self {
+        let split = edges.len();
+        edges.reserve(lengths.len() + 1);
+        let mut start = 0;
+        edges.push(start);
+        for length in lengths {
+            start += length;
+            edges.push(start);
+        }
+        Self { data: edges, split }
+    }
+
+    fn starts(&self) -> &[usize] {
+        &self.data[self.split..]
+    }
+
     fn of(&self, f: usize) -> &[usize] {
-        &self.edges[self.starts[f]..self.starts[f + 1]]
+        let starts = self.starts();
+        &self.data[starts[f]..starts[f + 1]]
     }
 
     fn lists(&self) -> impl Iterator<Item = &[usize]> + '_ {
-        self.starts.windows(2).map(|w| &self.edges[w[0]..w[1]])
+        self.starts().windows(2).map(|w| &self.data[w[0]..w[1]])
     }
 }
 
@@ -562,14 +577,11 @@ impl Serialize for FaceEdgeTable {
 impl<'de> Deserialize<'de> for FaceEdgeTable {
     fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
         let lists = Vec::<Vec<usize>>::deserialize(deserializer)?;
-        let mut starts = Vec::with_capacity(lists.len() + 1);
-        starts.push(0);
-        let mut edges = Vec::with_capacity(lists.iter().map(Vec::len).sum());
-        for list in lists {
-            edges.extend_from_slice(&list);
-            starts.push(edges.len());
+        let mut edges = Vec::with_capacity(lists.iter().map(Vec::len).sum::<usize>() + lists.len() + 1);
+        for list in &lists {
+            edges.extend_from_slice(list);
         }
-        Ok(Self { edges, starts })
+        Ok(Self::new(edges, lists.iter().map(Vec::len)))
     }
 }
 
@@ -656,12 +668,9 @@ fn edge_table<F>(
         let (lo, hi) = ((key >> 33) as usize, ((key >> 1) & 0xFFFF_FFFF) as usize);
         if key & 1 == 1 { (hi, lo) } else { (lo, hi) }
     };
-    let mut starts = Vec::with_capacity(faces.len() + 1);
-    starts.push(0);
-    for face in faces {
-        starts.push(starts[starts.len() - 1] + cycle(face).len());
-    }
-    let mut face_edges = FaceEdgeTable { edges: vec![usize::MAX; total], starts };
+    let mut face_edges = Vec::with_capacity(total + faces.len() + 1);
+    face_edges.resize(total, usize::MAX);
+    let mut face_edges = FaceEdgeTable::new(face_edges, faces.iter().map(|face| cycle(face).len()));
     let mut edges = Vec::with_capacity(half.len() / 2);
     let mut i = 0;
     while i < half.len() {
@@ -677,8 +686,10 @@ fn edge_table<F>(
         }
         let e = edges.len();
         edges.push(Edge { vertices: [a, b], faces: [f as usize, g as usize] });
-        face_edges.edges[face_edges.starts[f as usize] + k as usize] = e;
-        face_edges.edges[face_edges.starts[g as usize] + j as usize] = e;
+        let (forward, backward) =
+            (face_edges.starts()[f as usize] + k as usize, face_edges.starts()[g as usize] + j as usize);
+        face_edges.data[forward] = e;
+        face_edges.data[backward] = e;
         i += 2;
     }
     Ok((edges, face_edges))
