@@ -257,7 +257,7 @@ fn png_distinct_colours(png: &[u8]) -> usize {
     colours.len()
 }
 
-/// Triangle parts with the default 5 mm clearance nest ([A] Fig. 19): each is released above the inclined walls of
+/// Triangle parts with the default 5 mm clearance nest (\[A\] Fig. 19): each is released above the inclined walls of
 /// the one below and drops onto them; `check` then measures the clearance where the robot lets go, against the parts
 /// placed before, and passes. Without the drops (a plain stack file of the resting positions) the nested parts
 /// touch and the clearance fails, as it must.

@@ -2,9 +2,9 @@
 //!
 //! * `part`: a part file (or built-in example) with a decomposition: component count, volume, centre of gravity,
 //!   bounding box, boundary face count.
-//! * `place`: one of the placement scenarios of [A] Figs. 15-17 (`"scenario"`: `channel`, `triangle`, `complex`;
+//! * `place`: one of the placement scenarios of \[A\] Figs. 15-17 (`"scenario"`: `channel`, `triangle`, `complex`;
 //!   built by `stackplan::planner::regress`): the best placement (theta, cost, position), nesting height, pairs
-//!   evaluated over the total, obstacles constructed and extrapolated ([A] Table I).
+//!   evaluated over the total, obstacles constructed and extrapolated (\[A\] Table I).
 //! * `plan`: a stacking plan (`stackplan::planner::plan_stack`) of `count` parts at weight `w`: parts placed, height,
 //!   footprint, total cost, layers (distinct c.g. heights), the largest release drop (a part released above inclined
 //!   supports drops onto them), whether every part passed and the whole stack is stable.
@@ -17,8 +17,8 @@
 //!   each angle of `"theta_deg"` (`stackplan::cspace::obstacle`): per angle and pair the vertex and face counts and
 //!   the volume, face-kind totals, and the route (Gauss map or hull fallback); every obstacle must pass `validate()`.
 //! * `contacts`: the assembly contact state graph of `"moving"` against `"fixed"` (placed by `"fixed_pose"`) within
-//!   `"t_min"`/`"t_max"` (mm and degrees) at the default GA settings and `"seed"` ([P] V; deterministic at any
-//!   thread count): feasible states per level, their labels, and each state's extremal ranges (the [P] Table I
+//!   `"t_min"`/`"t_max"` (mm and degrees) at the default GA settings and `"seed"` (\[P\] V; deterministic at any
+//!   thread count): feasible states per level, their labels, and each state's extremal ranges (the \[P\] Table I
 //!   rows: lowest and highest x, y, z, rx, ry, rz, mm and radians).
 //! * `orient_intervals`: the constant-topology intervals and sweep counts of every convex pair of two parts over a
 //!   full turn (`stackplan::orient_interval::regress_summary`).

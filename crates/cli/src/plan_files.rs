@@ -3,7 +3,7 @@
 //! plan file and then draws from the very text it wrote) and `stackplan render` (which draws from a plan file on
 //! disk), so the two produce byte-identical pictures for the same plan.
 //!
-//! The build strip is the seed's Fig. 3 ([A] section II-B): one small isometric frame per added part, the new part in
+//! The build strip is the seed's Fig. 3 (\[A\] section II-B): one small isometric frame per added part, the new part in
 //! its colour and numbered, the earlier ones grey; for more than [`MAX_BUILD_FRAMES`] parts one frame per `k` parts
 //! (`k = ceil(n / MAX_BUILD_FRAMES)`), each frame captioned with its part count. All frames share one scale and floor
 //! line so the stack's growth can be compared frame to frame.

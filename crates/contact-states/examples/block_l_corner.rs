@@ -1,4 +1,4 @@
-//! Times the ACSG of the block / L-corner example ([P] V) and prints the states per level, the counters and the
+//! Times the ACSG of the block / L-corner example (\[P\] V) and prints the states per level, the counters and the
 //! Table I-style extremal table. `cargo run --profile dev -p stackplan-contact-states --example block_l_corner --
 //! [population generations polish seed extremal_budget analytic_steps]` (defaults: the crate's default settings, seed
 //! 2004).

@@ -1,4 +1,4 @@
-//! The assembly contact state graph (ACSG), generated bottom-up with search-range refinement ([P] IV-B, steps 1-7,
+//! The assembly contact state graph (ACSG), generated bottom-up with search-range refinement (\[P\] IV-B, steps 1-7,
 //! Propositions 1-2).
 //!
 //! 1. PPCs (f-v, v-f, e-e) between the surfaces ([`all_ppcs`]); a PPC whose elements cannot meet for any
@@ -578,7 +578,7 @@ impl Acsg {
         s
     }
 
-    /// A [P] Table I-style table: state, objective, feasibility, lower and upper bounds (mm, rad).
+    /// A \[P\] Table I-style table: state, objective, feasibility, lower and upper bounds (mm, rad).
     pub fn extremal_table(&self) -> String {
         let mut out = format!(
             "{:<32} {:>11} {:<11} {:<60} {:<60}\n",

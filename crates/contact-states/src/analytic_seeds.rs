@@ -1,4 +1,4 @@
-//! Analytic candidate configurations for edge-edge contacts (a deterministic complement to the GA of [P] II-D).
+//! Analytic candidate configurations for edge-edge contacts (a deterministic complement to the GA of \[P\] II-D).
 //!
 //! An e-e state is thin: the two edges must cross at one point while the faces next to them stay clear, and eq. 8
 //! has its minimum on a 5-dimensional manifold next to the f-e, e-f and f-f states that share the edges. The GA

@@ -1,9 +1,9 @@
-//! Contact-state criteria ([P] II-A..C): feature criteria `h_PC(T) >= 0`, zero exactly when the PC holds, the
-//! non-penetration term `d_G(T)` from the growth distance, and the objective of [P] eq. 8.
+//! Contact-state criteria (\[P\] II-A..C): feature criteria `h_PC(T) >= 0`, zero exactly when the PC holds, the
+//! non-penetration term `d_G(T)` from the growth distance, and the objective of \[P\] eq. 8.
 //!
 //! All criteria are evaluated in the coordinates of the part that owns the face (the fixed part A for f-v, f-e, f-f;
 //! the moving part B, through the inverse pose, for v-f, e-f), so face polygons never need transforming.
-//! Each criterion is `h = W1 h1 + W2 h2` ([P] eq. 3) with an *intersection* condition `h1` and a *bounding*
+//! Each criterion is `h = W1 h1 + W2 h2` (\[P\] eq. 3) with an *intersection* condition `h1` and a *bounding*
 //! condition `h2`, both lengths in millimetres (angles enter multiplied by the characteristic length `L`):
 //!
 //! * f-v (face F, vertex p): `h1 = |n.p - d|` (distance to the face plane); `h2 = dist_2(pi(p), F)`, the in-plane
@@ -23,8 +23,9 @@
 //! `W1 = W2 = 1` (the paper leaves the weights to the implementer; with every term already a length, unit weights keep
 //! the feature criteria comparable between PC types, and the feasibility threshold is one length).
 //! Non-penetration: `d_G = sum over convex piece pairs of max(0, 1 - sigma)` with `sigma` the growth distance
-//! ([`crate::growth_distance`]), weighted by `W3 = L`. The objective of eq. 8 is `f = sum h_PC + W3 d_G`.
-//! The bounded-misalignment criterion (eq. 7) is enforced by the optimiser keeping `t` in its box.
+//! ([`crate::growth_distance`](fn@crate::growth_distance)), weighted by `W3 = L`. The objective of eq. 8 is
+//! `f = sum h_PC + W3 d_G`. The bounded-misalignment criterion (eq. 7) is enforced by the optimiser keeping `t` in its
+//! box.
 //! Cost per evaluation: O(size of the PC's elements) per PC plus one growth distance per piece pair whose bounding
 //! boxes overlap.
 
@@ -243,7 +244,7 @@ pub fn face_face_terms(a: &ContactPart, fa: usize, b: &ContactPart, fb: usize, t
     (h1, h2)
 }
 
-/// The feature criterion `h_PC(T) = W1 h1 + W2 h2` ([P] eq. 3) of `pc` at pose `pose` of the moving part B.
+/// The feature criterion `h_PC(T) = W1 h1 + W2 h2` (\[P\] eq. 3) of `pc` at pose `pose` of the moving part B.
 pub fn pc_criterion(pc: &PrincipalContact, a: &ContactPart, b: &ContactPart, pose: &Pose, w: &Weights) -> f64 {
     let (h1, h2) = pc_terms(pc, a, b, pose, w.length);
     w.intersection * h1 + w.bounding * h2
@@ -274,7 +275,7 @@ pub fn pc_terms(pc: &PrincipalContact, a: &ContactPart, b: &ContactPart, pose: &
     }
 }
 
-/// The penetration measure `d_G = sum over piece pairs of max(0, 1 - sigma)` ([P] eq. 5 with Ong-Gilbert growth
+/// The penetration measure `d_G = sum over piece pairs of max(0, 1 - sigma)` (\[P\] eq. 5 with Ong-Gilbert growth
 /// distances), zero iff no pair of convex pieces penetrates.
 pub fn penetration(a: &ContactPart, b: &ContactPart, pose: &Pose) -> f64 {
     thread_local! {
@@ -307,7 +308,7 @@ fn penetration_with(a: &ContactPart, b: &ContactPart, pose: &Pose, moved: &mut O
     total
 }
 
-/// The objective of [P] eq. 8 for a hypothesised state: `f(T) = sum h_PC(T) + W3 d_G(T)` with `W3 = L`.
+/// The objective of \[P\] eq. 8 for a hypothesised state: `f(T) = sum h_PC(T) + W3 d_G(T)` with `W3 = L`.
 #[derive(Debug, Clone, Copy)]
 pub struct Objective<'a> {
     /// Fixed part A.

@@ -1,4 +1,4 @@
-//! Reading part surfaces from DXF files ([P] II step 1: "generate the set of PPCs from DXF files of the parts").
+//! Reading part surfaces from DXF files (\[P\] II step 1: "generate the set of PPCs from DXF files of the parts").
 //!
 //! Two kinds of entity describe a polyhedral surface in DXF: `3DFACE` (a triangle or quadrilateral; the fourth
 //! corner equals the third for a triangle) and the polyface mesh (`POLYLINE` with flag 64 followed by position

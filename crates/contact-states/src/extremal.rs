@@ -1,7 +1,7 @@
-//! Extremal configurations of a feasible contact state ([P] III, Definition 1, eq. 9-12).
+//! Extremal configurations of a feasible contact state (\[P\] III, Definition 1, eq. 9-12).
 //!
 //! For each configuration variable `t_k` the lower extremal solves eq. 9, `min t_k` subject to the state's criteria
-//! (eq. 4), non-penetration (eq. 5) and the box (eq. 7), and the upper one eq. 10 (`min -t_k`). [P] solves the
+//! (eq. 4), non-penetration (eq. 5) and the box (eq. 7), and the upper one eq. 10 (`min -t_k`). \[P\] solves the
 //! penalised forms eq. 11-12 with a GA; the penalty leaves a slack (the minimiser of `t_k + lambda f` sits where the
 //! decrease of `t_k` balances the growth of `lambda f`), and a GA/compass search on a thin manifold stops short of
 //! the true extreme (the earlier version of this module did: the face-down cube test could only assert that a vertex

@@ -1,7 +1,7 @@
-//! Seeded real-coded genetic algorithm with a local polish: the outer optimisation of [P] II-D (feasibility, eq. 8)
+//! Seeded real-coded genetic algorithm with a local polish: the outer optimisation of \[P\] II-D (feasibility, eq. 8)
 //! and III (extremals, eq. 11-12).
 //!
-//! The GA (D. Goldberg 1989, as in [P]) keeps a population of configurations inside the search box: binary
+//! The GA (D. Goldberg 1989, as in \[P\]) keeps a population of configurations inside the search box: binary
 //! tournament selection, blend crossover BLX-0.5 (each child gene uniform in the parents' interval widened by half
 //! its width on both sides), Gaussian mutation of each gene with probability 1/6 and standard deviation 10 % of the
 //! box width (shrinking linearly to 1 % over the generations), clamping to the box, and elitism (the two best

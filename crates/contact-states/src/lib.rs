@@ -2,15 +2,15 @@
 //!
 //! Assembly contact states of two polyhedral parts and their extremal configurations, after F. Pan and
 //! J. M. Schimmels, *Robust procedures for obtaining assembly contact state extremal configurations*, ICRA 2004
-//! ([P]):
+//! (\[P\]):
 //!
 //! * [`surface`]: vertices, edges, faces of a part's boundary with adjacency and edge convexity; [`dxf_input`] reads
 //!   them from DXF (3DFACE, polyface meshes);
 //! * [`principal_contact`]: the six principal contact types, PPCs, contact states and their highest-level form;
 //! * [`pose`]: configurations `t = (x, y, z, rx, ry, rz)` (`R = Rz Ry Rx` about the moving part's origin) and boxes;
-//! * [`criteria`]: feature criteria, the growth-distance penetration term and the objective of [P] eq. 8;
-//! * [`growth_distance`]: Ong & Gilbert's growth distance of convex pieces;
-//! * [`ga`]: the seeded real-coded GA with a local polish; [`extremal`]: extremal configurations ([P] eq. 11-12);
+//! * [`criteria`]: feature criteria, the growth-distance penetration term and the objective of \[P\] eq. 8;
+//! * [`growth_distance`](mod@growth_distance): Ong & Gilbert's growth distance of convex pieces;
+//! * [`ga`]: the seeded real-coded GA with a local polish; [`extremal`]: extremal configurations (\[P\] eq. 11-12);
 //! * [`manifold`]: projection onto a state's contact manifold, the strict check of a state at a configuration,
 //!   extremals by a compass search on the manifold;
 //! * [`analytic_seeds`]: deterministic edge-edge crossing configurations that seed the thin e-e states;

@@ -1,9 +1,9 @@
 //! Exact contact manifolds: projection of a configuration onto the set where a state's PCs hold, strict
 //! verification of a state at a configuration, and extremal configurations by a compass search on the manifold
-//! ([P] II-A, III; the projection and the strict check are ours, see the crate README "Exact feasibility").
+//! (\[P\] II-A, III; the projection and the strict check are ours, see the crate README "Exact feasibility").
 //!
 //! **Equalities.** Each PC holds on a smooth manifold given by signed lengths (the *intersection conditions* of
-//! [P] eq. 1 with signs): f-v / v-f the height of the vertex over the face plane (1 equation); e-e the signed
+//! \[P\] eq. 1 with signs): f-v / v-f the height of the vertex over the face plane (1 equation); e-e the signed
 //! distance between the carrier lines, `(b0 - a0).(da x db) / |da x db|` (1); f-e / e-f the heights of both end
 //! points (2); f-f the heights of all vertices of the moving face over the fixed face's plane (rank 3). The bounding
 //! conditions and non-penetration are inequalities, checked after the projection.
@@ -26,7 +26,7 @@
 //! witness is projected; if the strict check fails, seeded random perturbations of growing size
 //! (`1e-4 .. 0.1` of the box widths) are projected and checked until one passes.
 //!
-//! **Extremals** ([P] eq. 9-10 solved on the manifold): from a configuration of the state, a compass search on
+//! **Extremals** (\[P\] eq. 9-10 solved on the manifold): from a configuration of the state, a compass search on
 //! `±t_k` whose trial moves change one variable `t_j` by a step and let the other variables restore the closure of
 //! the state (projection with `t_j` frozen onto the equalities, the bounding terms and non-penetration, so a move
 //! blocked by a face boundary or another contact is restored by the other variables, e.g. a turn that lets a face

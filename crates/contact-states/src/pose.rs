@@ -1,4 +1,4 @@
-//! Relative configurations `t = (x, y, z, rx, ry, rz)` and the bounded-misalignment box ([P] eq. 6-7).
+//! Relative configurations `t = (x, y, z, rx, ry, rz)` and the bounded-misalignment box (\[P\] eq. 6-7).
 //!
 //! Convention: the moving part's own coordinates `p` map to the fixed part's coordinates by
 //! `T(p) = R p + (x, y, z)` with `R = Rz(rz) Ry(ry) Rx(rx)` (rotations about the fixed axes x, then y, then z, all
@@ -54,7 +54,7 @@ impl Pose {
     }
 }
 
-/// Box bounds `t_min <= t <= t_max` on the configuration ([P] eq. 7).
+/// Box bounds `t_min <= t <= t_max` on the configuration (\[P\] eq. 7).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ConfigBox {
     /// Lower bounds.

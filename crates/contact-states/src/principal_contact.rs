@@ -1,4 +1,4 @@
-//! Principal contacts (PCs), primitive principal contacts (PPCs) and contact states ([P] I-A, II steps 1-3, IV-A).
+//! Principal contacts (PCs), primitive principal contacts (PPCs) and contact states (\[P\] I-A, II steps 1-3, IV-A).
 //!
 //! A PC is a pair of surface elements in contact, one of the fixed part **A** and one of the moving part **B**
 //! (the paper's `se^A - se^B`, e.g. `f2-v3` = face 2 of A touches vertex 3 of B), that are not boundaries of other
@@ -6,7 +6,7 @@
 //! one-point contacts f-v, v-f, e-e. A contact state is a set of PCs; its *level* is the number of point contacts it
 //! stands for (f-v, v-f, e-e: 1; f-e, e-f: 2; f-f: 3), the amount of kinematic constraint.
 //!
-//! **Highest-level description** ([P] II step 3). Combining a state with a PPC can describe the same contact with
+//! **Highest-level description** (\[P\] II step 3). Combining a state with a PPC can describe the same contact with
 //! lower-level PCs; the mapping replaces two PCs `(x1, y1)`, `(x2, y2)` by `(X, Y)` with `X = join(x1, x2)`,
 //! `Y = join(y1, y2)` (the lowest element having both within it, see [`SurfaceElements::join`]) when `(X, Y)` is f-e,
 //! e-f or f-f and the contact points force it:
@@ -20,7 +20,7 @@
 //!
 //! Then PCs whose elements both lie within another PC's elements are dropped (they are not principal).
 //!
-//! **Neighbours** ([P] IV-A): `pa` is a close less constrained neighbour (CLCN) PC of `pb` when one element is the
+//! **Neighbours** (\[P\] IV-A): `pa` is a close less constrained neighbour (CLCN) PC of `pb` when one element is the
 //! same and the other element of `pa` is on the immediate boundary of that of `pb`. State `a` is a CLCN of state `b`
 //! when they have equally many PCs and differ in one pair `pa`, `pb` with `pa` a CLCN PC of `pb`, or when `b` has one
 //! more PC, a PPC, and contains `a`. Costs: the mapping is O(k^2) joins per pass for k PCs.
@@ -208,7 +208,7 @@ impl ContactState {
         format!("{{{}}}", parts.join(", "))
     }
 
-    /// Whether `self` is a close less constrained neighbour of `other` ([P] IV-A).
+    /// Whether `self` is a close less constrained neighbour of `other` (\[P\] IV-A).
     pub fn is_clcn_of(&self, other: &Self, sa: &SurfaceElements, sb: &SurfaceElements) -> bool {
         let only_self: Vec<&PrincipalContact> = self.pcs.iter().filter(|p| !other.pcs.contains(p)).collect();
         let only_other: Vec<&PrincipalContact> = other.pcs.iter().filter(|p| !self.pcs.contains(p)).collect();

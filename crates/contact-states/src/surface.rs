@@ -1,4 +1,4 @@
-//! Surface elements of a part's boundary: vertices, edges and faces with adjacency and convexity ([P] II step 1).
+//! Surface elements of a part's boundary: vertices, edges and faces with adjacency and convexity (\[P\] II step 1).
 //!
 //! The input is a set of planar convex polygons, each counter-clockwise seen from outside: the faces of the convex
 //! components of a [`Part`] (whose union is the part), or the 3DFACE / polyface-mesh facets of a DXF file. Faces of

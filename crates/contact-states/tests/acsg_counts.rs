@@ -126,7 +126,7 @@ fn cube_face_down_with_small_rotations_has_nine_states() {
 /// Face on face with a turn: the unit cube on a 2 x 2 plate. The f-f state holds while the bottom face overlaps the
 /// plate; with `|rz| <= pi/4` the farthest x is reached with a corner first, `x = 1 + sqrt(2)/2`, at `rz = +-pi/4`
 /// (without the turn only 1.5). The y extremes are the same by symmetry. (Analytic check of the extremal search,
-/// which in the penalty form of [P] eq. 11-12 stopped short.)
+/// which in the penalty form of \[P\] eq. 11-12 stopped short.)
 #[test]
 fn face_on_face_extremal_translations_are_exact() {
     let plate = box_part("plate", DVec3::new(-1.0, -1.0, -1.0), DVec3::new(1.0, 1.0, 0.0));

@@ -1,4 +1,4 @@
-//! The seed's example ([P] V): the block inserted into the L-corner from the top, with
+//! The seed's example (\[P\] V): the block inserted into the L-corner from the top, with
 //! `t_min = (-5, -5, 0, -9deg, -9deg, -9deg)`, `t_max = (5, 5, 240, 9deg, 9deg, 9deg)`.
 //!
 //! Geometry: `geom::examples::{l_corner_part, block_part}` (the seed gives no dimensions). The L-corner is shifted by

@@ -8,7 +8,7 @@
 //! ```
 //!
 //! i.e. minimise the separable convex quadratic `f` (an LP when `h = 0`) and break ties among its minimisers by the
-//! lowest coordinate in the order `tie`. This is the hot path of [A] VI-A-1/VI-A-4 (Ayyadevara et al. 2002: "use a
+//! lowest coordinate in the order `tie`. This is the hot path of \[A\] VI-A-1/VI-A-4 (Ayyadevara et al. 2002: "use a
 //! closed-form method to compute the optimal position for each convex component") and, with `h = 0` and one more
 //! variable, the LP behind the Chebyshev centre, emptiness, redundancy and touching tests of a cell.
 //!

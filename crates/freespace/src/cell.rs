@@ -1,6 +1,6 @@
 //! Convex free-space cells: H-polytopes `{p : a_j . p <= b_j}` in 2 or 3 variables with provenance tags.
 //!
-//! [A] VI-A-1 (Ayyadevara et al. 2002, section 6.1.1): "each convex component of free space is represented as a set
+//! \[A\] VI-A-1 (Ayyadevara et al. 2002, section 6.1.1): "each convex component of free space is represented as a set
 //! of linear inequalities that describe the bounding faces of the component". A [`Cell`] stores its inequalities with
 //! unit normals, a [`Tag`] per inequality (so the planner can map an active constraint back to an obstacle face or a
 //! side of the floor volume), the problem's [`Tolerance`], and its [`CellShape`], computed once at construction from

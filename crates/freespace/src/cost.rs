@@ -1,9 +1,9 @@
-//! Separable convex quadratic costs of a position: the stacking cost (1) of [A] and the squared distance to a desired
-//! position ([A] VII-A).
+//! Separable convex quadratic costs of a position: the stacking cost (1) of \[A\] and the squared distance to a desired
+//! position (\[A\] VII-A).
 //!
 //! Convention: `f(p) = 1/2 sum_i h_i p_i^2 + sum_i g_i p_i + c` with `h_i >= 0` (the diagonal of the Hessian).
 //!
-//! **Cost (1) of [A]** (Ayyadevara et al. 2002, section 2.1) for one part at a fixed orientation `R`, with the
+//! **Cost (1) of \[A\]** (Ayyadevara et al. 2002, section 2.1) for one part at a fixed orientation `R`, with the
 //! part's extents after rotation `xmax = max_v (R v)_x`, `xmin`, `ymax`, `ymin` and the height of its centre of
 //! gravity above the position, `zc = (R c)_z` (`c` the c.g. in part coordinates; a vertex sits at `R v + p`):
 //!
@@ -18,7 +18,7 @@
 //! (`h_z = 0`), `w = 0` leaves `x, y` free. The reference `(x0, y0, z0)` defaults to the centroid of the floor
 //! polygon and `z0 = 0` (the floor).
 //!
-//! **Desired position** ([A] VII-A): `f(p) = |p + R c - p_d|^2`: `h = 2`, `g = 2 (R c - p_d)`, `c = |R c - p_d|^2`.
+//! **Desired position** (\[A\] VII-A): `f(p) = |p + R c - p_d|^2`: `h = 2`, `g = 2 (R c - p_d)`, `c = |R c - p_d|^2`.
 //!
 //! Evaluation and gradient are O(D).
 
@@ -122,7 +122,7 @@ impl<const D: usize> SeparableQuadratic<D> for SeparableCost<D> {
 }
 
 impl SeparableCost<3> {
-    /// The cost with `p_z` fixed, as a cost in `(p_x, p_y)` (for the 2-D Omega of [A] VII-A-2).
+    /// The cost with `p_z` fixed, as a cost in `(p_x, p_y)` (for the 2-D Omega of \[A\] VII-A-2).
     pub fn with_fixed_z(&self, pz: f64) -> SeparableCost<2> {
         SeparableCost {
             h: [self.h[0], self.h[1]],
@@ -179,7 +179,7 @@ impl RotatedExtents {
     }
 }
 
-/// Cost (1) of [A] at a fixed orientation: see the module documentation. `reference = (x0, y0, z0)`.
+/// Cost (1) of \[A\] at a fixed orientation: see the module documentation. `reference = (x0, y0, z0)`.
 pub fn stacking_cost(w: f64, extents: &RotatedExtents, reference: DVec3) -> Result<SeparableCost<3>, CostError> {
     if !(0.0..=1.0).contains(&w) {
         return Err(CostError::BadWeight(w));
@@ -195,7 +195,7 @@ pub fn stacking_cost(w: f64, extents: &RotatedExtents, reference: DVec3) -> Resu
     SeparableCost::new(h, g, c)
 }
 
-/// Squared distance of the part's c.g. (at `p + R c`) to a desired position `desired` ([A] VII-A).
+/// Squared distance of the part's c.g. (at `p + R c`) to a desired position `desired` (\[A\] VII-A).
 pub fn desired_position_cost(rotated_cg: DVec3, desired: DVec3) -> Result<SeparableCost<3>, CostError> {
     let o = rotated_cg - desired;
     SeparableCost::new([2.0; 3], [2.0 * o.x, 2.0 * o.y, 2.0 * o.z], o.length_squared())

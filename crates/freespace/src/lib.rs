@@ -1,15 +1,16 @@
 //! # stackplan-freespace
 //!
-//! Free space for one part at a fixed orientation ([A] = Ayyadevara, Bourne, Shimada, Sturges, *Interference-free
+//! Free space for one part at a fixed orientation (\[A\] = Ayyadevara, Bourne, Shimada, Sturges, *Interference-free
 //! polyhedral configurations for stacking*, IEEE T-RA 2002, section VI-A): with the orientation fixed, c-space
 //! obstacles and free regions are polyhedral; free space is a set of disjoint convex cells; the cost is a separable
 //! convex quadratic minimised per cell; the optima of all cells, sorted by cost, are the candidate list.
 //!
 //! * [`cell`]: convex H-polytopes in 2 or 3 variables with provenance tags; emptiness, Chebyshev centre,
 //!   redundancy removal, membership ([`vertices`] enumerates their vertices and faces);
-//! * [`omega`]: the permissible set Omega(R) of [A] eq. (3) and its 2-D variant at fixed `p_z`;
-//! * [`subtract`]: subtraction of a convex obstacle (optionally grown by a clearance) from a cell ([A] Fig. 13);
-//! * [`cost`]: the stacking cost (1) of [A] and the squared distance to a desired position, as separable quadratics;
+//! * [`omega`](mod@omega): the permissible set Omega(R) of \[A\] eq. (3) and its 2-D variant at fixed `p_z`;
+//! * [`subtract`](mod@subtract): subtraction of a convex obstacle (optionally grown by a clearance) from a cell
+//!   (\[A\] Fig. 13);
+//! * [`cost`]: the stacking cost (1) of \[A\] and the squared distance to a desired position, as separable quadratics;
 //! * [`qp`]: the exact active-set QP (hot path, KKT-verified, deterministic tie-break) and clarabel's QP;
 //! * [`ranking`]: one optimum per cell, sorted by cost;
 //! * [`active_set`]: the small exact solver behind all LPs and QPs of the crate.

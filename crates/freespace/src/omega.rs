@@ -1,14 +1,14 @@
 //! The permissible set Omega(R): positions at which the rotated part lies inside the floor volume.
 //!
-//! [A] eq. (3) (Ayyadevara et al. 2002, section 2.1): `p in Omega(theta) <=> Lambda(p, theta) ⊆ Sigma`. With the floor
-//! volume `Sigma = {x : a_k . x <= b_k}` (a convex floor polygon times `[0, H]`) and the part's vertices `v` at
+//! \[A\] eq. (3) (Ayyadevara et al. 2002, section 2.1): `p in Omega(theta) <=> Lambda(p, theta) ⊆ Sigma`. With the
+//! floor volume `Sigma = {x : a_k . x <= b_k}` (a convex floor polygon times `[0, H]`) and the part's vertices `v` at
 //! orientation `R` (a vertex sits at `R v + p`), a convex part lies in the convex `Sigma` iff all its vertices do, so
 //!
 //! ```text
 //! Omega = { p : a_k . p <= b_k - max_v a_k . (R v) }.
 //! ```
 //!
-//! With `p_z` fixed ([A] VII-A-2) the same inequalities in `(p_x, p_y)`, plus a check that `p_z` is within the
+//! With `p_z` fixed (\[A\] VII-A-2) the same inequalities in `(p_x, p_y)`, plus a check that `p_z` is within the
 //! z-range. An empty Omega (floor too small for the part at `R`) is an empty [`Cell`], not an error. Omega is
 //! bounded (by the floor polygon and `[0, H]`). O(n k) for n part vertices and k polygon sides; the convexity check
 //! of the polygon is O(k^2) exact `orient2d` tests.
@@ -185,7 +185,7 @@ pub fn omega_for_part(floor: &FloorVolume, part: &Part, rotation: DMat3) -> Resu
     omega(floor, &rotated)
 }
 
-/// The 2-D Omega in `(p_x, p_y)` at fixed `p_z` ([A] VII-A-2); empty when `p_z` puts the part below the floor or
+/// The 2-D Omega in `(p_x, p_y)` at fixed `p_z` (\[A\] VII-A-2); empty when `p_z` puts the part below the floor or
 /// above the ceiling (by more than the tolerance).
 pub fn omega_fixed_z(floor: &FloorVolume, rotated_vertices: &[DVec3], pz: f64) -> Result<Cell<2>, OmegaError> {
     if !pz.is_finite() {

@@ -1,6 +1,6 @@
 //! The placement QP: minimum of a separable convex quadratic over a cell, with the active inequalities.
 //!
-//! [A] VI-A-1 and VI-A-4 (Ayyadevara et al. 2002, sections 6.1.1, 6.1.4): the optimum of the convex quadratic cost
+//! \[A\] VI-A-1 and VI-A-4 (Ayyadevara et al. 2002, sections 6.1.1, 6.1.4): the optimum of the convex quadratic cost
 //! per convex free-space component; its active inequalities name the contacts (obstacle faces) or the walls of the
 //! floor volume.
 //!

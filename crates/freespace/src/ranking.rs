@@ -1,6 +1,6 @@
 //! Multiple interference-free positions for one orientation: one optimum per cell, sorted by cost.
 //!
-//! [A] VI-A-4 (Ayyadevara et al. 2002, section 6.1.4): "since a position in every convex component has already been
+//! \[A\] VI-A-4 (Ayyadevara et al. 2002, section 6.1.4): "since a position in every convex component has already been
 //! computed, the interference analysis module sorts them in increasing order of cost and then returns the list";
 //! the other modules (stability, grasp) search this list. Different cells have different faces, so the list tends to
 //! offer different contact states. O(c * QP + c log c) for c cells.

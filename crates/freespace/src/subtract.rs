@@ -1,9 +1,9 @@
-//! Subtraction of a convex obstacle from a convex cell: disjoint convex pieces ([A] VI-A-3, Fig. 13).
+//! Subtraction of a convex obstacle from a convex cell: disjoint convex pieces (\[A\] VI-A-3, Fig. 13).
 //!
-//! [A] section 6.1.3 (Ayyadevara et al. 2002): free-space components completely inside the obstacle are eliminated;
+//! \[A\] section 6.1.3 (Ayyadevara et al. 2002): free-space components completely inside the obstacle are eliminated;
 //! a component that intersects the obstacle is decomposed "by manipulating the sign of the inequalities describing
 //! the obstacle"; components not affected are kept. With the obstacle `O = {n_k . p <= d_k + delta}` (unit normals,
-//! faces optionally grown by a clearance `delta`, [A] eq. 10-11 and section 6.1.2) and a cell `F`:
+//! faces optionally grown by a clearance `delta`, \[A\] eq. 10-11 and section 6.1.2) and a cell `F`:
 //!
 //! ```text
 //! F \ int(O) = U_k  F ∩ {n_k . p >= d_k + delta} ∩ {n_j . p <= d_j + delta : j before k}
@@ -95,7 +95,7 @@ impl Obstacle<3> {
 /// Options of a subtraction.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SubtractOptions {
-    /// Clearance `delta >= 0` added to every face offset (robot positioning error, [A] eq. 10-11).
+    /// Clearance `delta >= 0` added to every face offset (robot positioning error, \[A\] eq. 10-11).
     pub clearance: f64,
     /// Remove redundant inequalities from each piece (one LP per inequality; keeps later QPs fast).
     pub remove_redundant: bool,

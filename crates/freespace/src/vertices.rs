@@ -1,6 +1,6 @@
 //! Vertex enumeration of cells, for pictures and tests.
 //!
-//! Brute force, which is adequate for the small cells of [A] VI-A: in 3-D every triple of inequalities whose planes
+//! Brute force, which is adequate for the small cells of \[A\] VI-A: in 3-D every triple of inequalities whose planes
 //! meet in one point (|det| above a relative threshold) gives a candidate; candidates that satisfy all inequalities
 //! within the tolerance are the vertices (duplicates from degenerate vertices merged within 10 x tolerance). Each
 //! face lists the vertices on its plane, sorted counter-clockwise seen from outside (by angle around their mean).

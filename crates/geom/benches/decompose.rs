@@ -1,6 +1,6 @@
 //! Sheet-metal decomposition benchmark: building parts from zero-thickness models.
 //!
-//! * `complex/triangulation` and `complex/convex_merge`: the Complex Part of [A] Fig. 14c (see
+//! * `complex/triangulation` and `complex/convex_merge`: the Complex Part of \[A\] Fig. 14c (see
 //!   `stackplan_geom::examples::complex`), built into a `Part` (validation, triangulation, Delaunay flips, merging,
 //!   extrusion, validation of every prism, mass properties, boundary faces);
 //! * `plate_100_holes/*`: a 400 x 400 plate with a 10 x 10 grid of octagonal holes (n = 804 vertices), to show how

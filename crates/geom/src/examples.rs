@@ -1,7 +1,7 @@
-//! Built-in example parts: the three test parts of [A] Fig. 14, the unit cube of [A] Fig. 2, and the L-shaped
-//! corner and block of [P] (Pan & Schimmels 2004, Fig. 1). All lengths in millimetres.
+//! Built-in example parts: the three test parts of \[A\] Fig. 14, the unit cube of \[A\] Fig. 2, and the L-shaped
+//! corner and block of \[P\] (Pan & Schimmels 2004, Fig. 1). All lengths in millimetres.
 //!
-//! The seed gives no dimensions, only pictures and component counts ([A] sec. 7, Tables 1 and 2: Channel 3,
+//! The seed gives no dimensions, only pictures and component counts (\[A\] sec. 7, Tables 1 and 2: Channel 3,
 //! Triangle 6, Complex 79 convex components). The sheet-metal parts below are modelled to reproduce those counts
 //! exactly with [`Decomposition::Triangulation`] (the seed's scheme: convex faces extruded whole, concave faces and
 //! faces with holes triangulated, `n + 2h - 2` triangles for `n` vertices and `h` holes), and to have the features
@@ -67,7 +67,7 @@ fn p(x: f64, y: f64, z: f64) -> DVec3 {
     DVec3::new(x, y, z)
 }
 
-/// Channel Part ([A] Fig. 14a): a U channel of three convex faces, so 3 components with either decomposition.
+/// Channel Part (\[A\] Fig. 14a): a U channel of three convex faces, so 3 components with either decomposition.
 ///
 /// Mid-surface: base `[0, 200] x [0, 100]` in `z = 0`; two side flanges bent up by 90 degrees along the long edges,
 /// in the planes `y = 0` and `y = 100`, 50 high. Thickness 2. The seed calls it a part with "three flanges" and
@@ -80,7 +80,7 @@ pub fn channel() -> SheetMetal {
     SheetMetal { thickness: THICKNESS, faces: vec![base, front, back] }
 }
 
-/// Triangle Part ([A] Fig. 14b): six flanges, all convex, so 6 components with either decomposition.
+/// Triangle Part (\[A\] Fig. 14b): six flanges, all convex, so 6 components with either decomposition.
 ///
 /// An open triangular hopper: three trapezoidal walls splayed outwards and three horizontal lips around the rim.
 /// The walls join an equilateral triangle of inradius 30 at `z = 0` to one of inradius 50 at `z = 40` (each wall
@@ -125,7 +125,7 @@ fn rect_yz(x: f64, y0: f64, z0: f64, y1: f64, z1: f64) -> Vec<DVec3> {
     vec![p(x, y0, z0), p(x, y1, z0), p(x, y1, z1), p(x, y0, z1)]
 }
 
-/// Complex Part ([A] Fig. 8 and 14c): a base with holes, two tall flanges with windows, two short flanges and a lip;
+/// Complex Part (\[A\] Fig. 8 and 14c): a base with holes, two tall flanges with windows, two short flanges and a lip;
 /// 79 components with the plain triangulation, as in the seed.
 ///
 /// Mid-surface (thickness 2):
@@ -184,12 +184,12 @@ fn solid(name: &str, boxes: &[(DVec3, DVec3)]) -> Part {
         .expect("boxes with positive volume make a part")
 }
 
-/// The unit cube of [A] Fig. 2 (the 121-cube stacks): `[0, 1]^3` mm, one component.
+/// The unit cube of \[A\] Fig. 2 (the 121-cube stacks): `[0, 1]^3` mm, one component.
 pub fn cube() -> Part {
     solid("cube", &[(DVec3::ZERO, DVec3::ONE)])
 }
 
-/// The L-shaped corner of [P] Fig. 1 (the fixed part of the contact-state example), as three disjoint boxes:
+/// The L-shaped corner of \[P\] Fig. 1 (the fixed part of the contact-state example), as three disjoint boxes:
 /// a floor `[0, 150] x [0, 150] x [0, 20]`, a wall `[0, 20] x [0, 150] x [20, 120]` and a wall
 /// `[20, 150] x [0, 20] x [20, 120]`. Seen from above the walls form an L; the block is inserted into the corner
 /// from the top. The seed gives no dimensions; these leave the block of [`block_part`] 50 mm of play either way.
@@ -204,7 +204,7 @@ pub fn l_corner_part() -> Part {
     )
 }
 
-/// The rectangular block of [P] Fig. 1 (the moving part): `[0, 80] x [0, 80] x [0, 100]`, one component.
+/// The rectangular block of \[P\] Fig. 1 (the moving part): `[0, 80] x [0, 80] x [0, 100]`, one component.
 pub fn block_part() -> Part {
     solid("block", &[(DVec3::ZERO, p(80.0, 80.0, 100.0))])
 }

@@ -1,6 +1,6 @@
 //! Rigid parts: convex components, mass properties and the boundary faces of the whole part.
 //!
-//! A part is the union of convex components with pairwise disjoint interiors (the seed's decomposition, [A] V-A-1).
+//! A part is the union of convex components with pairwise disjoint interiors (the seed's decomposition, \[A\] V-A-1).
 //! Everything interference analysis needs lives in the components; resting poses, grasp and contact analysis need the
 //! boundary of the union, kept as planar polygons with holes in [`Part::boundary`].
 

@@ -1,6 +1,6 @@
 //! Rigid poses: a proper rotation and a translation, `world = rotation . v + position`.
 //!
-//! This is the placement of a part in a stack ([A] section III: a configuration is a position `p` and a rotation
+//! This is the placement of a part in a stack (\[A\] section III: a configuration is a position `p` and a rotation
 //! `R(theta) R(phi, psi)`). Composition follows function composition: `a.compose(&b)` applies `b` first, then `a`,
 //! i.e. `R = R_a R_b`, `p = R_a p_b + p_a`; the inverse is `(R^T, -R^T p)`. All operations are O(1).
 //!

@@ -1,4 +1,4 @@
-//! The sheet-metal part model of [A] V-A-1: planar mid-surface polygons (with holes) plus a thickness.
+//! The sheet-metal part model of \[A\] V-A-1: planar mid-surface polygons (with holes) plus a thickness.
 //!
 //! Each face of the zero-thickness model is extruded by the sheet thickness (symmetrically about the mid-surface,
 //! `thickness / 2` to each side) into convex prisms: a convex face without holes gives one prism; a concave face or a
@@ -58,7 +58,7 @@ pub enum Decomposition {
     /// Triangulate, then merge triangles into larger convex polygons (Hertel-Mehlhorn): few components.
     #[default]
     ConvexMerge,
-    /// The plain triangulation of [A]: reproduces the seed's component counts (Channel 3, Triangle 6, Complex 79).
+    /// The plain triangulation of \[A\]: reproduces the seed's component counts (Channel 3, Triangle 6, Complex 79).
     Triangulation,
 }
 

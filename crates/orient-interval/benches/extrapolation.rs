@@ -1,4 +1,4 @@
-//! Extrapolation vs construction per call on the example parts' component pairs ([A] Table I: extrapolation ~12% of
+//! Extrapolation vs construction per call on the example parts' component pairs (\[A\] Table I: extrapolation ~12% of
 //! construction), and the sweep counters over 1-degree steps (intervals per turn, extrapolations per construction).
 
 use criterion::{Criterion, criterion_group, criterion_main};

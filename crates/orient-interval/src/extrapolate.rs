@@ -1,6 +1,6 @@
 //! Extrapolation of a c-space obstacle within its constant-structure interval.
 //!
-//! Paper: Ayyadevara et al. 2002 ([A]) section IV-B (manuscript 4.2) and eq. 4; DESIGN.md section 4. While the
+//! Paper: Ayyadevara et al. 2002 (\[A\]) section IV-B (manuscript 4.2) and eq. 4; DESIGN.md section 4. While the
 //! structure (faces, edges, vertex provenance `[i, j]`, face kinds) stays constant, the obstacle at a new angle is
 //! obtained by moving every vertex to `V_j^B - R(theta) V_i^A` (eq. 4) and recomputing each face plane from its
 //! generating features ([`NormalRecipe`]: a face of `B` keeps `n^B`; a face of `-RA` gets `-R n^A`; an edge-edge

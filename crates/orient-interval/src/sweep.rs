@@ -1,6 +1,6 @@
 //! Obstacle sweeps over discrete orientations: build at interval starts, extrapolate elsewhere.
 //!
-//! Paper: Ayyadevara et al. 2002 ([A]) section IV-B (manuscript 4.2) and Table I (constructions vs extrapolations);
+//! Paper: Ayyadevara et al. 2002 (\[A\]) section IV-B (manuscript 4.2) and Table I (constructions vs extrapolations);
 //! DESIGN.md section 4. A [`PairSweep`] holds one convex pair, its event bands over the full turn
 //! ([`PairEvents`], computed once in O(F_B E_A + F_A E_B)), and the structures built so far. Asked for the obstacle at
 //! angle index `k` it extrapolates from a cached structure whose interval covers the angle (O(size)), or builds the
@@ -15,7 +15,7 @@ use stackplan_geom::polytope::ConvexPolytope;
 use std::f64::consts::TAU;
 use std::time::{Duration, Instant};
 
-/// Counters and timers of a sweep ([A] Table I).
+/// Counters and timers of a sweep (\[A\] Table I).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct SweepStats {
     /// Obstacles built from scratch.

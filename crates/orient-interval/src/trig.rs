@@ -1,8 +1,8 @@
 //! Closed-form solution of the event equations `alpha cos(theta) + beta sin(theta) + gamma = 0`.
 //!
-//! Paper: Ayyadevara et al. 2002 ([A]) Appendix C, eq. 14-16. Every event function of a rotation about `z` is a
+//! Paper: Ayyadevara et al. 2002 (\[A\]) Appendix C, eq. 14-16. Every event function of a rotation about `z` is a
 //! trigonometric polynomial of degree one, because every product of two rotated vectors reduces through
-//! `Ra . Rb = a . b` and `Ra x Rb = R (a x b)`. [A] substitutes `t = tan(theta / 2)` and solves a quadratic (eq. 16);
+//! `Ra . Rb = a . b` and `Ra x Rb = R (a x b)`. \[A\] substitutes `t = tan(theta / 2)` and solves a quadratic (eq. 16);
 //! here the equivalent phase form is used: with `h = hypot(alpha, beta)` and `phi = atan2(beta, alpha)`,
 //! `f(theta) = h cos(theta - phi) + gamma`, so the roots are `theta = phi +- acos(-gamma / h)` (no division by a
 //! vanishing leading coefficient at `theta = pi`, which the tangent form has). The set where `|f| <= tol` (the
@@ -121,7 +121,7 @@ impl Trig {
         if x == 0.0 || x == PI { vec![wrap(phi + x)] } else { vec![wrap(phi + x), wrap(phi - x)] }
     }
 
-    /// The roots from [A] eq. 16: with `t = tan(theta / 2)`, `(gamma - alpha) t^2 + 2 beta t + (alpha + gamma) = 0`,
+    /// The roots from \[A\] eq. 16: with `t = tan(theta / 2)`, `(gamma - alpha) t^2 + 2 beta t + (alpha + gamma) = 0`,
     /// solved with the cancellation-free quadratic formula; a vanishing leading coefficient means a root at
     /// `theta = pi`. Kept as an independent check of [`Trig::roots`].
     pub fn roots_tan_half(&self) -> Vec<f64> {

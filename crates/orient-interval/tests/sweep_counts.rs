@@ -1,4 +1,4 @@
-//! Sweep counters on the example parts over 1-degree steps ([A] Table I reports 6-21 extrapolations per
+//! Sweep counters on the example parts over 1-degree steps (\[A\] Table I reports 6-21 extrapolations per
 //! construction): every obstacle equals the from-scratch one, and the counts are printed for docs/benchmarks.md.
 
 use stackplan_cspace::minkowski::obstacle;

@@ -1,5 +1,5 @@
-//! The check of one part added to a stack that passed before: the stacking planner's per-candidate test ([A] II-B,
-//! conditions (ii)-(iv) for the new part; the step of [A] Fig. 1 that follows the placement search).
+//! The check of one part added to a stack that passed before: the stacking planner's per-candidate test (\[A\] II-B,
+//! conditions (ii)-(iv) for the new part; the step of \[A\] Fig. 1 that follows the placement search).
 //!
 //! A planner adds parts one at a time and tests each candidate position of the new part `n` on the stack `0..n` it
 //! has accepted. It needs the new part's report only, and [`crate::check::check_stack`] would also re-check every

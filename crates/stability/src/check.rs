@@ -1,4 +1,4 @@
-//! The whole-stack check ([A] II-B conditions (i)-(iv) for every part of a stack).
+//! The whole-stack check (\[A\] II-B conditions (i)-(iv) for every part of a stack).
 //!
 //! For a stack `0..n` (in placement order) and every part `i`:
 //!

@@ -1,5 +1,5 @@
-//! Horizontal clearance between parts ([A] section 7.2: "parts are separated in the plane by at least 5 mm to account for
-//! robot positioning error").
+//! Horizontal clearance between parts (\[A\] section 7.2: "parts are separated in the plane by at least 5 mm to account
+//! for robot positioning error").
 //!
 //! A robot places a part with a horizontal positioning error `e` (|e| <= delta) before lowering it. Two convex
 //! components `A`, `B` keep clear under every such error iff no horizontal `e` with `|e| < delta` makes `A + e`

@@ -1,5 +1,5 @@
-//! A stack that grows one part at a time, and the stacking planner's test of a candidate for its next part ([A]
-//! II-B, the "test" of generate-and-test: conditions (ii)-(iv) for the new part, [A] Fig. 1).
+//! A stack that grows one part at a time, and the stacking planner's test of a candidate for its next part (\[A\]
+//! II-B, the "test" of generate-and-test: conditions (ii)-(iv) for the new part, \[A\] Fig. 1).
 //!
 //! [`crate::check_added_part`] reports every field of the new part's check; a planner tests many candidates per
 //! part and needs only the verdict. [`GrowingStack::check_candidate`] gives the verdict of the conditions the planner

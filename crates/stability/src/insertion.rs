@@ -1,4 +1,4 @@
-//! Insertion straight down and removal straight up ([A] II-B condition (iv); DESIGN.md sections 3 and 7).
+//! Insertion straight down and removal straight up (\[A\] II-B condition (iv); DESIGN.md sections 3 and 7).
 //!
 //! Part `i` reaches its pose by translating along -z from far above. It collides on the way iff some component `C`
 //! of it, swept upward to above everything present (`C (+) [0, L z]`), penetrates a component of a part already in

@@ -1,9 +1,9 @@
 //! # stackplan-stability
 //!
-//! Conditions (ii)-(iv) of a stacking configuration (Ayyadevara et al. 2002, [A] II-B; DESIGN.md section 7):
+//! Conditions (ii)-(iv) of a stacking configuration (Ayyadevara et al. 2002, \[A\] II-B; DESIGN.md section 7):
 //!
-//! * [`resting_poses`]: the faces of a part's convex hull it rests on stably, with rotation (phi, psi), margin and
-//!   c.g. height — the planner's candidate orientations;
+//! * [`resting_poses`](mod@resting_poses): the faces of a part's convex hull it rests on stably, with rotation
+//!   (phi, psi), margin and c.g. height — the planner's candidate orientations;
 //! * [`grasp`]: upward horizontal faces holding a suction cup (largest inscribed disc; cup patterns);
 //! * [`contacts`]: contact patches between parts and with the floor;
 //! * [`equilibrium`]: static equilibrium with Coulomb friction cones (SOCP, clarabel) and a robustness margin;

@@ -1,7 +1,7 @@
-//! Resting poses of a part on a flat floor (DESIGN.md section 7; [A] II-B, the orientation parameters (phi, psi)).
+//! Resting poses of a part on a flat floor (DESIGN.md section 7; \[A\] II-B, the orientation parameters (phi, psi)).
 //!
 //! A rigid body resting on a plane touches it with the convex hull of its contact set, which is a face of the convex
-//! hull of the body ([A] leaves this to the author's thesis; it is the classical "stable faces" analysis). The body
+//! hull of the body (\[A\] leaves this to the author's thesis; it is the classical "stable faces" analysis). The body
 //! rests stably on hull face `F` iff its centre of gravity projects (along the face normal) strictly inside `F`; the
 //! stability margin is the distance from the projected c.g. to the boundary of `F` (for a convex polygon and an
 //! interior point, the smallest distance to an edge line). A face is reported when the margin exceeds the part's
@@ -16,7 +16,7 @@
 //! ```
 //!
 //! both wrapped into (-pi, pi]. The remaining free rotation theta about the vertical (the planner's third
-//! orientation parameter, [A] Fig. 4) is fixed at 0, and the position puts the face on z = 0 with the c.g. above the
+//! orientation parameter, \[A\] Fig. 4) is fixed at 0, and the position puts the face on z = 0 with the c.g. above the
 //! origin, so `rotation`, `position` are deterministic. Full orientation: `Rz(theta) Ry(psi) Rx(phi)`.
 //!
 //! Sorting: by c.g. height ascending, then by margin descending, then by face index (deterministic).

@@ -3,7 +3,7 @@
 //! For two convex polytopes the separating-axis theorem (S. Gottschalk, M. Lin, D. Manocha, *OBBTree*, SIGGRAPH
 //! 1996; C. Ericson, *Real-Time Collision Detection*, 2005, 5.2.1) needs only the face normals of each and the cross
 //! products of their edge directions: these are exactly the face normals of the Minkowski difference `B (+) (-A)`
-//! ([A] App. B). The largest signed separation over these axes is
+//! (\[A\] App. B). The largest signed separation over these axes is
 //!
 //! * positive iff the polytopes are disjoint (and then a lower bound of their distance),
 //! * minus the exact penetration depth (the minimum translation distance) when they overlap,
@@ -11,7 +11,7 @@
 //! because the Minkowski difference is the intersection of its face half-spaces and the penetration depth is the
 //! distance from the origin to its boundary. A polytope swept along `s` is `C (+) [0, s]`: its faces are C's faces
 //! and parallelograms spanned by C's edges and `s`, its edges C's edges and `s`, and its support interval on an axis
-//! `n` is C's interval extended by `min(0, n.s)` and `max(0, n.s)` — so sweeps (insertion from above, [A] condition
+//! `n` is C's interval extended by `min(0, n.s)` and `max(0, n.s)` — so sweeps (insertion from above, \[A\] condition
 //! (iv)) need no hull construction. Cost: O((F_A + F_B + E_A E_B) (V_A + V_B)) with directions deduplicated up to sign.
 
 use crate::world::WorldComponent;

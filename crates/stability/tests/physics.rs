@@ -231,7 +231,7 @@ fn seesaw_tips() {
     assert!(moved(&simulate(&stack[..2], 0.5, 3.0)) < 1.0);
 }
 
-/// The example sheet-metal parts of [A] Fig. 14 (channel, triangle, complex) on the floor in each of their resting
+/// The example sheet-metal parts of \[A\] Fig. 14 (channel, triangle, complex) on the floor in each of their resting
 /// poses: the check calls every pose stable (single part on the floor), and the simulation agrees.
 #[test]
 fn example_parts_rest_in_their_poses() {

@@ -1,6 +1,6 @@
 //! `stackplan contacts MOVING FIXED --t-min X,Y,Z,RX,RY,RZ --t-max ... [--offset X,Y,Z] [--seed S]
 //! [--population P] [--generations G] [--json] [--dot F]`: the assembly contact state graph of the moving part
-//! against the fixed part within box bounds on `t = (x, y, z, rx, ry, rz)` ([P] Pan & Schimmels 2004). Angles in
+//! against the fixed part within box bounds on `t = (x, y, z, rx, ry, rz)` (\[P\] Pan & Schimmels 2004). Angles in
 //! the bounds are in degrees; the moving part's own origin is its reference point, `R = Rz Ry Rx`.
 
 use crate::Outcome;

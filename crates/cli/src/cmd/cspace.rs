@@ -1,7 +1,7 @@
 //! `stackplan cspace MOVING FIXED [--fixed-pose POSE.json] [--theta-deg T] [--extrapolate-from T0] [--pair I,J]
 //! [--clearance MM] [--insertion] [--slice-z Z] [--json | --obj F | --svg F]`: the translational c-space obstacle of
-//! every convex pair ([A] App. B); with `--extrapolate-from T0` each obstacle is built at `T0` and extrapolated to `T`
-//! within its constant-structure interval ([A] IV-B, eq. 4), an error when `T` is outside that interval.
+//! every convex pair (\[A\] App. B); with `--extrapolate-from T0` each obstacle is built at `T0` and extrapolated to
+//! `T` within its constant-structure interval (\[A\] IV-B, eq. 4), an error when `T` is outside that interval.
 //!
 //! Convention: the moving part's pose is the rotation about world z by `theta` applied to its file coordinates, then
 //! the translation `p`; `p` is in the obstacle of a pair iff `normal . p <= offset` for every face of that pair.

@@ -1,6 +1,6 @@
 //! `stackplan interference MOVING FIXED --position X,Y,Z [--theta-deg T] [--fixed-pose POSE.json] [--clearance MM]
 //! [--json]`: the convex component pairs whose interiors overlap (penetrating), whose boundaries touch, or (with a
-//! clearance) that are closer than the clearance ([A] eq. 6-8).
+//! clearance) that are closer than the clearance (\[A\] eq. 6-8).
 
 use crate::Outcome;
 use crate::input::{PartPair, load_pair};

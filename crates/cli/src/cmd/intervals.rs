@@ -1,6 +1,6 @@
 //! `stackplan intervals MOVING FIXED [--fixed-pose POSE.json] [--pair I,J] [--from-deg A] [--to-deg B] [--json]`:
 //! the constant-structure orientation intervals of every convex pair (moving component rotating about world z
-//! against a fixed component), with the event that ends each ([A] section IV, Appendix C).
+//! against a fixed component), with the event that ends each (\[A\] section IV, Appendix C).
 
 use crate::Outcome;
 use crate::input::{PartPair, load_pair};

@@ -1,5 +1,5 @@
 //! `stackplan place PART --stack STACK.json [...]`: the best interference-free placements of one part in a stack
-//! (the placement search of `stackplan-planner`, [A] sections V-VI).
+//! (the placement search of `stackplan-planner`, \[A\] sections V-VI).
 //!
 //! Output: `{"placements": [{"position", "rotation", "theta_deg", "resting_pose", "cost", "contacts"}...],
 //! "exhausted": null | "empty_omega" | "fits_nowhere", "stats": {...}}` (`--json`), or a short text summary.

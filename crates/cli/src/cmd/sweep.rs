@@ -1,5 +1,5 @@
 //! `stackplan sweep PART --count N --w-values 0,0.5,1 [--out DIR] [the plan options]`: the same stack planned for
-//! several weights w of cost (1), like the seed's Fig. 2 ([A] section II-A: 121 cubes from a flat pattern at w = 0
+//! several weights w of cost (1), like the seed's Fig. 2 (\[A\] section II-A: 121 cubes from a flat pattern at w = 0
 //! through pyramids to a single column at w = 1). Writes `plan-w<W>.json` per weight (plan files: `stackplan check`
 //! and `stackplan render` read them), `sweep.json` (per weight: parts placed, height, footprint, layers, total cost,
 //! seconds) and `sweep.svg` / `sweep.png` (the stacks side by side at one scale, captioned with w).

@@ -1,7 +1,7 @@
 //! Part JSON, in two forms (see `docs/formats.md`):
 //!
 //! * `{"name", "sheet_metal": {"thickness", "faces": [{"outline": [[x,y,z],...], "holes": [[[x,y,z],...],...]}]},
-//!   "density"?}` — the sheet-metal model of [A] V-A-1, built by [`SheetMetal::build_part`];
+//!   "density"?}` — the sheet-metal model of \[A\] V-A-1, built by [`SheetMetal::build_part`];
 //! * `{"name", "convex_pieces": [[[x,y,z],...],...], "density"?}` — each piece is the exact convex hull
 //!   ([`convex_hull`]) of its points; a flat, collinear or coincident piece is an error naming its index.
 //!

@@ -1,5 +1,5 @@
 //! The vertical-force certificate of one rigid body on its contact points, for verdicts only (DESIGN.md section 7;
-//! [A] II-B (ii)): the closed-form test "c.g. over the support polygon" generalised to inclined contacts that admit
+//! \[A\] II-B (ii)): the closed-form test "c.g. over the support polygon" generalised to inclined contacts that admit
 //! a vertical push.
 //!
 //! A rigid body of weight `m g` (c.g. `c`) on contact points `p_k` with normals `n_k` (pointing into the body) is in

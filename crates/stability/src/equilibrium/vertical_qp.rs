@@ -1,4 +1,4 @@
-//! The vertical-force certificate of a group's stability as a small QP (DESIGN.md section 7; [A] II-B (ii)), for
+//! The vertical-force certificate of a group's stability as a small QP (DESIGN.md section 7; \[A\] II-B (ii)), for
 //! verdicts only.
 //!
 //! A group of movable parts is stable when *some* admissible force distribution exists. Vertical forces `f_k >= 0` at
