@@ -479,6 +479,8 @@ thread_local! {
     pub(crate) static GENERAL_ROUTE_ONLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
     /// Tests: assemble a tame z-prism pair by the polygon merges too (`z_prism::derived_cycles`).
     pub(crate) static NO_DERIVED_CYCLES: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// Tests: search the support of every side normal of a z-prism pair through all arcs (`z_prism::face_specs`).
+    pub(crate) static ALL_ARCS: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
     /// Tests: find the parallel faces of a z-prism pair by `z_prism::parallel_faces` first (not the poles alone).
     pub(crate) static NO_POLE_MERGES_FIRST: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
     /// Tests: assemble the derived cycles of a tame z-prism pair by the general assembly (`prism_assembly.rs`).
@@ -554,8 +556,10 @@ fn overlay(
 
     // two z-prisms turned about z (sheet metal): the same faces without sign tables or crossings (`z_prism.rs`)
     let z_prisms = !test_switch!(GENERAL_ROUTE_ONLY)
-        && z_prism::vertical_arcs(moving, neg_ra, am, &mut prism.a_classes, &mut prism.a)
-        && z_prism::vertical_arcs(fixed, bv, bn, &mut prism.b_classes, &mut prism.b);
+        && z_prism::vertical_arcs(moving, neg_ra, am, &mut prism.a_classes, &mut prism.a, &mut prism.wide[0])
+        && z_prism::vertical_arcs(fixed, bv, bn, &mut prism.b_classes, &mut prism.b, &mut prism.wide[1]);
+    // (tests: the supports searched through all arcs)
+    let wide = if test_switch!(ALL_ARCS) { [false; 2] } else { prism.wide };
 
     // parallel faces: merged_with_b[f] = Some(g) when -R n_f == n_g within half the tolerance.
     merged_with_b.clear();
@@ -577,6 +581,7 @@ fn overlay(
                 bn,
                 &prism.a,
                 &prism.b,
+                wide,
                 neg_ra,
                 bv,
                 merged_with_a,
@@ -602,6 +607,7 @@ fn overlay(
                 bn,
                 &prism.a,
                 &prism.b,
+                wide,
                 neg_ra,
                 bv,
                 merged_with_a,

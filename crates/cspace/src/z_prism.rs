@@ -78,6 +78,8 @@ pub(crate) struct Scratch {
     /// The vertical arcs of `-RA` and of `B`.
     pub(crate) a: Vec<VerticalArc>,
     pub(crate) b: Vec<VerticalArc>,
+    /// Whether every arc of `-RA`, of `B` is at least [`WIDE`] wide ([`vertical_arcs`]).
+    pub(crate) wide: [bool; 2],
 }
 
 const SIDE: u8 = 0;
@@ -99,19 +101,28 @@ const TAME_HI: f64 = 1e60;
 /// two orders of magnitude above the angular tolerance, nine above rounding.
 pub(crate) const MARGIN: f64 = 1e-7;
 
+/// The least sine of the angle between the end normals of every vertical arc of a summand for [`face_specs`] to stop
+/// searching the support of a side normal of the other summand at the first arc that holds it with margin.
+pub(crate) const WIDE: f64 = 1e-12;
+
 /// The vertical arcs of `p` (vertices `vertices`, face normals `normals`) into `out`, in edge order, when `p` is a
 /// z-prism (see the module documentation), else `false` (the buffers then hold garbage). The circle is the general
 /// route's (`minkowski::arcs`, the same operations); a vertical arc's must come out as `(±0, ±0, cz)` (it does unless
 /// the normalisation divides by an underflowed length), a horizontal arc's is `d * s` for an edge vector `d` with
 /// `d.z == 0` and some `s`: its `z` is `±0` or NaN, and either way its product with a pole is not a sign, and no test
 /// with it is positive (NaN compares false), which is all the module documentation uses.
+///
+/// `wide` is set to whether every vertical arc is at least [`WIDE`] wide (the sine of the angle between its end
+/// normals; what lets [`face_specs`] stop at a support found with margin).
 pub(crate) fn vertical_arcs(
     p: &ConvexPolytope,
     vertices: &[DVec3],
     normals: &[DVec3],
     classes: &mut Vec<u8>,
     out: &mut Vec<VerticalArc>,
+    wide: &mut bool,
 ) -> bool {
+    *wide = true;
     classes.clear();
     for n in normals {
         classes.push(if n.z == 0.0 && n.x.is_finite() && n.y.is_finite() {
@@ -145,6 +156,7 @@ pub(crate) fn vertical_arcs(
                 let cz = d.z * s;
                 let w = n0.x * n1.y - n1.x * n0.y;
                 let cz = if w * cz >= 0.0 { cz } else { -cz };
+                *wide &= w.abs() >= WIDE;
                 out.push(VerticalArc { edge: k, from: [n0.x, n0.y], to: [n1.x, n1.y], cz });
             }
             1 => {
@@ -240,8 +252,22 @@ pub(crate) fn no_side_merged(a_classes: &[u8], merged_with_b: &[Option<usize>]) 
 
 /// The support feature of the other summand for the face normal `u` that is merged with none of its faces: an edge
 /// whose (vertical) arc holds `u` strictly inside, else the vertex `argmax(points, u)`; as the general route decides.
+///
+/// When the arcs are `wide` (every one at least [`WIDE`], from [`vertical_arcs`]) the search stops at the first arc
+/// holding `u` with both tests above [`MARGIN`]: no other arc can pass both tests then (the general route's
+/// ambiguity check), because the arcs of a convex prism's vertical edges are disjoint wedges between angularly
+/// adjacent side normals (each narrower than a half-turn). `u` lies at least about `MARGIN` from the found wedge's
+/// ends and so from every side normal of the other summand; for another wedge of width `w`, `u` outside it, one of
+/// the two sines is then at most `-min(MARGIN, sin(w / 2))` (the worst case is `u` opposite the wedge's middle), far
+/// below the tests' rounding error (about 1e-16 for unit normals) when `sin w >= WIDE`.
 #[inline]
-fn support(u: DVec3, arcs: &[VerticalArc], points: &[DVec3], margin: &mut f64) -> Result<Feature, OverlayFailure> {
+fn support(
+    u: DVec3,
+    arcs: &[VerticalArc],
+    wide: bool,
+    points: &[DVec3],
+    margin: &mut f64,
+) -> Result<Feature, OverlayFailure> {
     if u.z != 0.0 {
         // a pole lies strictly inside no arc
         return Ok(Feature::Vertex(argmax(points, u)));
@@ -257,7 +283,11 @@ fn support(u: DVec3, arcs: &[VerticalArc], points: &[DVec3], margin: &mut f64) -
                 return Err(OverlayFailure::AmbiguousSupport);
             }
             found = Some(arc.edge);
-            *margin = margin.min(before.min(after));
+            let least = before.min(after);
+            *margin = margin.min(least);
+            if wide && least > MARGIN {
+                break;
+            }
         }
     }
     Ok(match found {
@@ -278,6 +308,7 @@ pub(crate) fn face_specs(
     bn: &[DVec3],
     a_arcs: &[VerticalArc],
     b_arcs: &[VerticalArc],
+    [a_wide, b_wide]: [bool; 2],
     neg_ra: &[DVec3],
     bv: &[DVec3],
     merged_with_a: &[Option<usize>],
@@ -288,7 +319,7 @@ pub(crate) fn face_specs(
     for (g, &u) in bn.iter().enumerate() {
         let moving = match merged_with_a[g] {
             Some(f) => Feature::Face(f),
-            None => support(u, a_arcs, neg_ra, margin)?,
+            None => support(u, a_arcs, a_wide, neg_ra, margin)?,
         };
         faces.push(FaceSpec { normal: u, fixed: Feature::Face(g), moving });
     }
@@ -296,7 +327,7 @@ pub(crate) fn face_specs(
         if merged_with_b[f].is_some() {
             continue;
         }
-        let fixed = support(u, b_arcs, bv, margin)?;
+        let fixed = support(u, b_arcs, b_wide, bv, margin)?;
         faces.push(FaceSpec { normal: u, fixed, moving: Feature::Face(f) });
     }
     Ok(())
@@ -546,7 +577,7 @@ thread_local! {
 #[cfg(test)]
 mod tests {
     use crate::minkowski::{
-        GENERAL_ROUTE_ONLY, NO_DERIVED_CYCLES, NO_DIRECT_ASSEMBLY, NO_POLE_MERGES_FIRST, gauss_map_obstacle,
+        ALL_ARCS, GENERAL_ROUTE_ONLY, NO_DERIVED_CYCLES, NO_DIRECT_ASSEMBLY, NO_POLE_MERGES_FIRST, gauss_map_obstacle,
     };
     use glam::{DMat3, DVec3};
     use stackplan_geom::{ConvexPolytope, convex_hull};
@@ -613,7 +644,7 @@ mod tests {
             .iter()
             .filter(|s| {
                 let n: Vec<DVec3> = s.faces().iter().map(|f| f.plane.normal).collect();
-                super::vertical_arcs(s, s.vertices(), &n, &mut Vec::new(), &mut Vec::new())
+                super::vertical_arcs(s, s.vertices(), &n, &mut Vec::new(), &mut Vec::new(), &mut false)
             })
             .count();
         assert_eq!(z_prisms, 9);
@@ -635,6 +666,11 @@ mod tests {
                     let all_pairs = format!("{:?}", gauss_map_obstacle(a, r, b));
                     NO_POLE_MERGES_FIRST.with(|c| c.set(false));
                     assert_eq!(fast, all_pairs, "{a:?} {r:?} {b:?}");
+                    // every support searched through all arcs (no stop at one found with margin)
+                    ALL_ARCS.with(|c| c.set(true));
+                    let all_arcs = format!("{:?}", gauss_map_obstacle(a, r, b));
+                    ALL_ARCS.with(|c| c.set(false));
+                    assert_eq!(fast, all_arcs, "{a:?} {r:?} {b:?}");
                     // the z-prism route with the general polygon merges (no derived cycles), and the general route
                     NO_DERIVED_CYCLES.with(|c| c.set(true));
                     let merged_cycles = format!("{:?}", gauss_map_obstacle(a, r, b));
@@ -651,12 +687,12 @@ mod tests {
                 }
             }
         }
-        // (each z-prism case ran the z-prism route four times: with everything, without the direct assembly, without
-        // the poles merged first, without the derived cycles; the first three derive the cycles of a tame pair and
-        // the first and the third assemble them directly)
-        let taken = (super::TAKEN.with(std::cell::Cell::get) - taken_before) / 4;
-        let derived = (super::DERIVED.with(std::cell::Cell::get) - derived_before) / 3;
-        let direct = (super::DIRECT.with(std::cell::Cell::get) - direct_before) / 2;
+        // (each z-prism case ran the z-prism route five times: with everything, without the direct assembly, without
+        // the poles merged first, with all arcs searched, without the derived cycles; the first four derive the
+        // cycles of a tame pair and all but the second assemble them directly)
+        let taken = (super::TAKEN.with(std::cell::Cell::get) - taken_before) / 5;
+        let derived = (super::DERIVED.with(std::cell::Cell::get) - derived_before) / 4;
+        let direct = (super::DIRECT.with(std::cell::Cell::get) - direct_before) / 3;
         // every tame pair assembled directly
         assert_eq!(direct, derived, "{direct} of {derived} derived pairs assembled directly");
         // the tame pairs (most pairs at generic angles; not the quarter turns, not within 1e-6 of one, not the huge
