@@ -4,9 +4,9 @@
 //!   of `gauss_map_obstacle` (the obstacle with its planes, edges, provenance and kinds, or the failure) on 100
 //!   polytopes x 4 400 pairs x 86 rotations and writes one line per case to `FILE`: run it before and after a change,
 //!   then `cmp` the two files;
-//! * `... --example obstacle_identity -- profile box|prism|general|random [CALLS]` builds and drops `CALLS` (default
-//!   10 000) obstacles of the benchmark's box or prism pair (`general`: the boxes under a general rotation, `random`:
-//!   two hulls of 20 and 24 points) in `build_and_drop`, for `valgrind --tool=callgrind
+//! * `... --example obstacle_identity -- profile box|prism|quarter|general|random [CALLS]` builds and drops `CALLS`
+//!   (default 10 000) obstacles of the benchmark's box or prism pair (`quarter`: the boxes at a quarter turn about
+//!   `z`, `general`: the boxes under a general rotation, `random`: two hulls of 20 and 24 points) in `build_and_drop`, for `valgrind --tool=callgrind
 //!   --toggle-collect='*build_and_drop*'` or `perf stat -e task-clock`.
 
 #![allow(clippy::print_stdout, clippy::print_stderr)] // a command-line tool reports its counts
@@ -171,6 +171,12 @@ fn profile(case: &str, n: usize) {
             DMat3::from_rotation_z(0.3),
         ),
         "prism" => (prism(1.0), prism(0.7), DMat3::from_rotation_z(0.3)),
+        // a quarter turn: side faces merge, the pair is not tame (the z-prism route with the polygon merges)
+        "quarter" => (
+            common::cuboid(DVec3::ZERO, DVec3::new(100.0, 50.0, 2.0)),
+            common::cuboid(DVec3::ZERO, DVec3::new(80.0, 60.0, 2.0)),
+            DMat3::from_rotation_z(std::f64::consts::FRAC_PI_2),
+        ),
         "random" => {
             // hulls of 20 and 24 points on ellipsoids (more than 64 obstacle vertices: the star-sort edge table)
             let cloud = |n: usize, seed: f64| {
@@ -208,7 +214,7 @@ fn main() {
         }
         _ => {
             eprintln!(
-                "usage: obstacle_identity dump FILE | obstacle_identity profile box|prism|general|random [CALLS]"
+                "usage: obstacle_identity dump FILE | obstacle_identity profile box|prism|quarter|general|random [CALLS]"
             );
             std::process::exit(2);
         }

@@ -588,6 +588,7 @@ fn overlay(
                 merged_with_b,
                 faces,
                 &mut margin,
+                true,
             )
             .is_ok()
             && margin > z_prism::MARGIN;
@@ -614,6 +615,7 @@ fn overlay(
                 merged_with_b,
                 faces,
                 &mut margin,
+                false,
             )?;
         }
         // a tame pair: every cycle without the polygon merges (`z_prism::derived_cycles`)

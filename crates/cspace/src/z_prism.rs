@@ -202,7 +202,7 @@ pub(crate) fn parallel_faces(
 
 /// The parallel faces among the poles only, exactly as [`parallel_faces`] finds them (the same pairs in the same
 /// order) when no side normal of one summand is parallel to one of the other; `false` (nothing written) when some pole
-/// is not far from the sides (as [`parallel_faces`]). The caller confirms that no side normals are parallel by
+/// is not far from the sides (as [`parallel_faces`]) or a summand has more than two poles. The caller confirms that no side normals are parallel by
 /// [`face_specs`] run on these merges: when every side normal of `B` lies strictly inside a vertical arc of `-RA` with
 /// both its support tests above [`MARGIN`] (the sines of its angles to the arc's two end normals, up to the circle's
 /// `|cz|`, 1 within rounding), it is at least about `MARGIN` away from the arc's ends, and the ends are the side
@@ -217,15 +217,26 @@ pub(crate) fn pole_merges(
     merged_with_a: &mut [Option<usize>],
     merged_with_b: &mut [Option<usize>],
 ) -> bool {
-    let far = |normals: &[DVec3], classes: &[u8]| {
-        normals.iter().zip(classes).all(|(n, &c)| c != POLE || n.z * n.z > PARALLEL_SQ)
+    // the poles of a summand (at most two here, else `false`), each far from the sides
+    let poles = |normals: &[DVec3], classes: &[u8]| {
+        let (mut out, mut count) = ([0; 2], 0);
+        for (f, (n, &c)) in normals.iter().zip(classes).enumerate() {
+            if c == POLE {
+                if count == 2 || n.z * n.z <= PARALLEL_SQ {
+                    return None;
+                }
+                out[count] = f;
+                count += 1;
+            }
+        }
+        Some((out, count))
     };
-    if !(far(am, a_classes) && far(bn, b_classes)) {
+    let (Some((a_poles, na)), Some((b_poles, nb))) = (poles(am, a_classes), poles(bn, b_classes)) else {
         return false;
-    }
-    for ((f, m), _) in am.iter().enumerate().zip(a_classes).filter(|(_, c)| **c == POLE) {
-        for ((g, n), _) in bn.iter().enumerate().zip(b_classes).filter(|(_, c)| **c == POLE) {
-            if (*m - *n).length_squared() <= PARALLEL_SQ {
+    };
+    for &f in &a_poles[..na] {
+        for &g in &b_poles[..nb] {
+            if (am[f] - bn[g]).length_squared() <= PARALLEL_SQ {
                 merged_with_b[f] = Some(g);
                 merged_with_a[g] = Some(f);
             }
@@ -301,7 +312,10 @@ fn support(
 }
 
 /// Steps 1 and 2 of the overlay (step 3, the arc crossings, is empty) for a z-prism pair whose vertical arcs came
-/// from [`vertical_arcs`]: the faces of `B`, then those of `-RA` not parallel to a face of `B`, into `faces`.
+/// from [`vertical_arcs`]: the faces of `B`, then those of `-RA` not parallel to a face of `B`, into `faces`; the least
+/// support test value of the side normals into `margin`. With `tame_only`, it stops (with the face list incomplete)
+/// at the first face of `B` that leaves `margin` at most [`MARGIN`] (a side face of `B` parallel to one of `-RA`, as
+/// at quarter turns, lies on an arc's end and fails there).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn face_specs(
     am: &[DVec3],
@@ -315,6 +329,7 @@ pub(crate) fn face_specs(
     merged_with_b: &[Option<usize>],
     faces: &mut Vec<FaceSpec>,
     margin: &mut f64,
+    tame_only: bool,
 ) -> Result<(), OverlayFailure> {
     for (g, &u) in bn.iter().enumerate() {
         let moving = match merged_with_a[g] {
@@ -322,6 +337,9 @@ pub(crate) fn face_specs(
             None => support(u, a_arcs, a_wide, neg_ra, margin)?,
         };
         faces.push(FaceSpec { normal: u, fixed: Feature::Face(g), moving });
+        if tame_only && *margin <= MARGIN {
+            return Ok(());
+        }
     }
     for (f, &u) in am.iter().enumerate() {
         if merged_with_b[f].is_some() {
