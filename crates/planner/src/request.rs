@@ -109,9 +109,22 @@ pub struct PlacementRequest<'a> {
     /// Extrapolate obstacles within their constant-topology intervals instead of constructing each one
     /// ([`crate::interval_obstacles`], [A] IV-B). Off: every obstacle is constructed (the reference route).
     pub extrapolate: bool,
-    /// Largest number of search nodes popped before giving up with [`PlacementError::NodeBudget`].
+    /// Largest number of search nodes popped before giving up with [`PlacementError::NodeBudget`] (per partition
+    /// of the orientations: each partition counts its own pops).
     pub node_budget: usize,
+    /// Into how many partitions the search splits the orientations (blocks of a few consecutive orientations dealt
+    /// round-robin, searched in parallel and merged in the search's total order, [`crate::search`]'s "Partitions";
+    /// 1: the sequential search). The results depend on this number, never on the thread count. Default
+    /// [`DEFAULT_PARTITIONS`].
+    pub partitions: usize,
 }
+
+/// The default [`PlacementRequest::partitions`]: the two cores of the machines the planner is built for (a fixed
+/// number, not the thread count, so that results do not depend on the machine).
+pub const DEFAULT_PARTITIONS: usize = 2;
+
+/// The largest [`PlacementRequest::partitions`] accepted.
+pub const MAX_PARTITIONS: usize = 64;
 
 /// `n` angles `0, 2 pi / n, ...` (a full turn in equal steps).
 pub fn uniform_thetas(n: usize) -> Vec<f64> {
@@ -147,6 +160,7 @@ impl<'a> PlacementRequest<'a> {
             use_symmetry: true,
             extrapolate: true,
             node_budget: 2_000_000,
+            partitions: DEFAULT_PARTITIONS,
         }
     }
 
@@ -213,6 +227,12 @@ impl<'a> PlacementRequest<'a> {
         }
         if self.k == 0 {
             return Err(PlacementError::BadOption("k must be at least 1".into()));
+        }
+        if !(1..=MAX_PARTITIONS).contains(&self.partitions) {
+            return Err(PlacementError::BadOption(format!(
+                "the number of search partitions must lie in 1..={MAX_PARTITIONS}, got {}",
+                self.partitions
+            )));
         }
         if self.node_budget == 0 {
             return Err(PlacementError::BadOption("the node budget must be at least 1".into()));

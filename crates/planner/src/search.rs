@@ -43,8 +43,41 @@
 //! node budget guards against numerical trouble with a typed error.
 //!
 //! **Cost.** One QP per node; per popped node one interference detection (O(m_part m_stack) box tests plus the
-//! narrow phase on overlapping boxes) and at most one obstacle construction. Root QPs run in parallel (rayon); the
-//! loop itself is sequential, so the result does not depend on the thread count.
+//! narrow phase on overlapping boxes) and at most one obstacle construction. Root QPs run in parallel (rayon).
+//!
+//! **Partitions** ([`PlacementRequest::partitions`] = `P`, default 2). Every node belongs to one orientation, and
+//! what the loop learns is per orientation (the known obstacles, the derived obstacles, the found points), so the
+//! orientations are split into `P` fixed partitions, blocks of [`LANE_BLOCK`] consecutive orientations dealt
+//! round-robin ([`lane_of`]; `P` is a number of the request, never the thread count), and each partition runs the
+//! loop above on its own state: heap, node ids, obstacle table and known obstacles, derived obstacles, the
+//! constant-topology structures ([`IntervalObstacles`]), the carried frontier and the detection's scratch
+//! ([`Search`] and [`RunState`] per partition; the obstacle cache is shared, it is `Sync` and a pure function). The
+//! placements are merged in the heap's total order (rounded cost, orientation, id; the orientations of two
+//! partitions differ, so the ids of two partitions are never compared): the next placement of the whole search is
+//! the cheapest of the partitions' next placements, and it is known once every other partition's next key pops
+//! after it. Each partition keeps the placements it found but the merge has not returned (a look-ahead queue, at
+//! most [`LOOK_AHEAD`]), which a later call returns first; a cost limit
+//! ([`PlacementSearch::next_placements_within`]) stops each partition at its own keys. So the placements, their
+//! order and their values are the sequential loop's over the same obstacles, and the first placement of every
+//! search is the exact optimum.
+//!
+//! *Rounds and determinism.* The partitions advance in rounds on rayon, each at most [`ROUND_POPS`] pops: a
+//! partition without a found placement whose next key pops before the best found one (of any partition, fixed at the
+//! round's start) searches on up to that key; the others, while one such partition runs, look ahead for their next
+//! placements (the caller often asks for more: the stacking planner rejects candidates; the work stays in the carried
+//! frontier either way). A partition that runs alone runs without rounds (nothing can change its bound). The bound is
+//! exchanged only between rounds and every round's work is a function of the states at its start, so the states
+//! after each call, hence the carried frontiers, the later candidates and the plans, depend on `P` but never on the
+//! thread count or the timing (a shared atomic "best so far" would make them timing-dependent). `P = 1` is the
+//! sequential loop itself, bit for bit.
+//!
+//! *What changes with `P`.* The placements, in the same order, up to which obstacles exist: a partition
+//! extrapolates an obstacle only from structures it built itself ([`crate::interval_obstacles`]: an obstacle's
+//! last bits depend on the angle its structure was built at), and the partitions search past the merge's current
+//! placement (up to a round, and the look-ahead), so the carried frontiers are further along and a later placement
+//! can lie in another cell of the same free space (another contact listed at the same position, or, rarely, another
+//! later candidate). The statistics ([`PlacementStats`]) are sums over the partitions (`orientations_considered`
+//! too: each orientation is in one partition; the node budget applies to each partition's pops).
 
 use crate::dary_heap::DaryHeap;
 use crate::detect::{CandidateQueue, DetectCounts, DetectScratch, StackScene, SweepAxes};
@@ -60,7 +93,7 @@ use serde::{Deserialize, Serialize};
 use stackplan_cspace::ObstacleCache;
 use stackplan_freespace::cell::{Cell, Halfspace, Tag};
 use stackplan_geom::{Pose, Tolerance};
-use std::collections::HashMap;
+use std::collections::{HashMap, VecDeque};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -249,6 +282,11 @@ struct RunState<const D: usize> {
     free_nodes: Vec<Node<D>>,
     /// Lists reused from node to node (no allocation per node once warm).
     buffers: Buffers<D>,
+    /// The keys of the nodes of the placements the last [`Search::advance`] returned, in order.
+    found_keys: Vec<HeapKey>,
+    /// A partition's placements found but not yet returned, cheapest first, with their nodes' keys (the merge's
+    /// look-ahead, see "Partitions" in the module documentation); their nodes are in `free_nodes`.
+    ahead: VecDeque<(HeapKey, Placement)>,
 }
 
 /// The loop's reusable lists: a child's extra inequalities, a split's outside half-spaces and its children's keys.
@@ -274,6 +312,8 @@ impl<const D: usize> RunState<D> {
         self.considered.fill(false);
         self.found_points.clear();
         self.pops = 0;
+        self.found_keys.clear();
+        self.ahead.clear();
         self
     }
 }
@@ -418,6 +458,11 @@ impl<const D: usize> NodeHeap<D> {
         self.keys.len()
     }
 
+    /// The key popped next.
+    fn peek_key(&self) -> Option<HeapKey> {
+        self.keys.peek().copied()
+    }
+
     /// The cheapest key's (rounded) cost: a lower bound of every cost the heap still holds.
     fn peek_cost(&self) -> Option<f64> {
         self.keys.peek().map(HeapKey::cost)
@@ -493,12 +538,16 @@ impl KnownObstacles {
     }
 }
 
-/// The search state shared by the loop.
+/// The search state of one partition of the orientations (the whole search when there is one): everything the loop
+/// changes, for the orientations `lane_of(i) == lane` (the other orientations' entries stay untouched).
 struct Search<'r, 'a> {
     request: &'r PlacementRequest<'a>,
+    /// This partition's index and the number of partitions.
+    lane: usize,
+    lanes: usize,
     orientations: Vec<Orientation>,
     sweeps: Vec<Option<SweepAxes>>,
-    scene: StackScene,
+    scene: Arc<StackScene>,
     tol: Tolerance,
     cache: &'r ObstacleCache,
     obstacles: Vec<Arc<DerivedObstacle>>,
@@ -512,6 +561,8 @@ struct Search<'r, 'a> {
     detect_scratch: DetectScratch,
     intervals: IntervalObstacles,
     stats: PlacementStats,
+    /// Rounds of the partitioned loop run (first partition only; for the debug log).
+    rounds: u64,
 }
 
 /// Places the part (see the module documentation) with a fresh obstacle cache.
@@ -536,18 +587,28 @@ pub fn place_with_cache(
 /// components of the new stack, bit for bit (parts appended, never moved); otherwise they are cleared. The derived
 /// obstacles are pure functions of those inputs; an extrapolated obstacle depends (in its last bits) on which angle its
 /// structure was built at, so a plan's results depend on its search history, deterministically.
+///
+/// With several partitions of the orientations ([`PlacementRequest::partitions`]) each partition keeps its own
+/// caches (its orientations' derived obstacles, structures and obstacle ids).
 #[derive(Debug, Default)]
 pub struct SearchCaches {
     signature: Option<CacheSignature>,
+    /// Whether searches continue the open frontier of an earlier search ([`SearchCaches::carrying_frontiers`]).
+    carry: bool,
+    /// One per partition.
+    lanes: Vec<LaneCaches>,
+    /// The states of the last searches, by floor and cost, newest last (at most [`CARRIED_FRONTIERS`]).
+    frontiers: Vec<(FrontierSignature, States)>,
+}
+
+/// What one partition of the orientations keeps from search to search ([`SearchCaches`]).
+#[derive(Debug, Default)]
+struct LaneCaches {
     detect_scratch: DetectScratch,
     derived: HashMap<(usize, usize, usize), Arc<DerivedObstacle>>,
     intervals: IntervalObstacles,
-    /// Whether searches continue the open frontier of an earlier search ([`SearchCaches::carrying_frontiers`]).
-    carry: bool,
     /// The derived obstacles by id (the ids the carried cells' tags and paths name).
     table: ObstacleTable,
-    /// The states of the last searches, by floor and cost, newest last (at most [`CARRIED_FRONTIERS`]).
-    frontiers: Vec<(FrontierSignature, States)>,
 }
 
 /// How many frontiers [`SearchCaches`] keeps: the stacking planner alternates a stage-1 search (a floor that grows
@@ -600,6 +661,7 @@ struct CacheSignature {
     insertion: bool,
     horizontal: bool,
     extrapolate: bool,
+    partitions: usize,
     stack: Vec<Vec<DVec3>>,
 }
 
@@ -627,29 +689,37 @@ impl SearchCaches {
                 && old.insertion == next.insertion
                 && old.horizontal == next.horizontal
                 && old.extrapolate == next.extrapolate
+                && old.partitions == next.partitions
                 && old.stack.len() <= next.stack.len()
                 && old.stack.iter().zip(&next.stack).all(|(a, b)| a == b)
         });
         if !keep {
-            self.derived.clear();
-            self.intervals.clear();
-            self.table = ObstacleTable::default();
+            self.lanes.clear();
             self.frontiers.clear();
         }
+        self.lanes.resize_with(next.partitions, LaneCaches::default);
         self.signature = Some(next);
     }
 }
 
-/// [`place_with_cache`] sharing `caches` with earlier searches (see [`SearchCaches`]); the stacking planner passes
-/// the same caches to every search of a plan.
+/// Orientations per block dealt to the partitions in turn ([`lane_of`]).
+const LANE_BLOCK: usize = 4;
+
+/// The partition of orientation `i` among `lanes` partitions: blocks of [`LANE_BLOCK`] consecutive orientations
+/// dealt round-robin (neighbouring angles cost about the same to search, so the partitions' work is balanced, and a
+/// block keeps some constant-topology intervals inside one partition).
+fn lane_of(i: usize, lanes: usize) -> usize {
+    (i / LANE_BLOCK) % lanes
+}
+
 /// The search's setup: validation, orientations (one symmetry period per resting pose), the scene, the
-/// statistics' constants, and the shared caches adopted (their contents move into the search until
-/// [`Search::give_back`]).
+/// statistics' constants, and the shared caches adopted (their contents move into the searches until
+/// [`Search::give_back`]); one search per partition of the orientations.
 fn prepare<'r, 'a>(
     request: &'r PlacementRequest<'a>,
     cache: &'r ObstacleCache,
     caches: &mut SearchCaches,
-) -> Result<Search<'r, 'a>, PlacementError> {
+) -> Result<Vec<Search<'r, 'a>>, PlacementError> {
     request.validate()?;
     let part = request.part;
     let scale = request
@@ -688,13 +758,13 @@ fn prepare<'r, 'a>(
             (1u64 << (64 - ID_BITS)) - 1
         )));
     }
-    let orientations: Vec<Orientation> = orientations
+    let mut orientations: Vec<Orientation> = orientations
         .into_par_iter()
         .enumerate()
         .map(|(i, (rest, ti, theta, r))| Orientation::without_components(part, i, rest, ti, theta, r, &request.cost))
         .collect();
     let stack_refs: Vec<(&stackplan_geom::Part, Pose)> = request.stack.iter().map(|s| (s.part, s.pose)).collect();
-    let scene = StackScene::new(&stack_refs);
+    let scene = Arc::new(StackScene::new(&stack_refs));
     // rotated components and sweep axes are built when an orientation is first expanded
     let sweeps: Vec<Option<SweepAxes>> = vec![None; orientations.len()];
     let stats = PlacementStats {
@@ -714,57 +784,99 @@ fn prepare<'r, 'a>(
         insertion: request.insertion,
         horizontal: request.horizontal_clearance,
         extrapolate: request.extrapolate,
+        partitions: request.partitions,
         stack: scene.components.iter().map(|c| c.placed.vertices.clone()).collect(),
     });
     let n_orientations = orientations.len();
-    // the pairs earlier searches built, by orientation (one pass over the shared derived obstacles); caches that
-    // carry frontiers keep the obstacle table itself (carried cells name obstacles by id)
-    let mut shared_pairs = vec![Vec::new(); n_orientations];
-    let mut table = ObstacleTable::default();
-    if caches.carry {
-        table = std::mem::take(&mut caches.table);
-    } else {
-        for &(oi, moving, fixed) in caches.derived.keys() {
-            if let Some(list) = shared_pairs.get_mut(oi) {
-                list.push((moving, fixed));
+    let lanes = request.partitions;
+    let mut searches = Vec::with_capacity(lanes);
+    for (lane, lane_caches) in caches.lanes.iter_mut().enumerate() {
+        // the pairs earlier searches built, by orientation (one pass over the shared derived obstacles); caches that
+        // carry frontiers keep the obstacle table itself (carried cells name obstacles by id)
+        let mut shared_pairs = vec![Vec::new(); n_orientations];
+        let mut table = ObstacleTable::default();
+        if caches.carry {
+            table = std::mem::take(&mut lane_caches.table);
+        } else {
+            for &(oi, moving, fixed) in lane_caches.derived.keys() {
+                if let Some(list) = shared_pairs.get_mut(oi) {
+                    list.push((moving, fixed));
+                }
             }
         }
+        table.by_orientation.resize_with(n_orientations, KnownObstacles::default);
+        searches.push(Search {
+            request,
+            lane,
+            lanes,
+            // the last partition takes the list itself (one partition: no copy)
+            orientations: if lane + 1 == lanes { std::mem::take(&mut orientations) } else { orientations.clone() },
+            sweeps: sweeps.clone(),
+            scene: Arc::clone(&scene),
+            tol,
+            cache,
+            obstacles: table.obstacles,
+            obstacle_ids: table.ids,
+            by_orientation: table.by_orientation,
+            shared_pairs,
+            detect_scratch: std::mem::take(&mut lane_caches.detect_scratch),
+            derived: std::mem::take(&mut lane_caches.derived),
+            intervals: std::mem::take(&mut lane_caches.intervals),
+            stats: stats.clone(),
+            rounds: 0,
+        });
     }
-    table.by_orientation.resize_with(n_orientations, KnownObstacles::default);
-    let search = Search {
-        request,
-        orientations,
-        sweeps,
-        scene,
-        tol,
-        cache,
-        obstacles: table.obstacles,
-        obstacle_ids: table.ids,
-        by_orientation: table.by_orientation,
-        shared_pairs,
-        detect_scratch: std::mem::take(&mut caches.detect_scratch),
-        derived: std::mem::take(&mut caches.derived),
-        intervals: std::mem::take(&mut caches.intervals),
-        stats,
-    };
-    Ok(search)
+    Ok(searches)
 }
 
+/// The statistics of a partitioned search: the counters and times summed over the partitions, the constants
+/// (orientations, components, pairs) of the first.
+fn merged_stats(searches: &[Search<'_, '_>]) -> PlacementStats {
+    let mut stats = searches.first().map(|s| s.stats.clone()).unwrap_or_default();
+    for s in searches.iter().skip(1).map(|s| &s.stats) {
+        stats.orientations_considered += s.orientations_considered;
+        stats.orientations_empty_omega += s.orientations_empty_omega;
+        stats.pairs_evaluated += s.pairs_evaluated;
+        stats.obstacles_constructed += s.obstacles_constructed;
+        stats.obstacles_extrapolated += s.obstacles_extrapolated;
+        stats.obstacle_cache_hits += s.obstacle_cache_hits;
+        stats.interference_tests += s.interference_tests;
+        stats.known_obstacle_cuts += s.known_obstacle_cuts;
+        stats.narrow_phase_tests += s.narrow_phase_tests;
+        stats.nodes_expanded += s.nodes_expanded;
+        stats.nodes_pushed += s.nodes_pushed;
+        stats.cells_empty += s.cells_empty;
+        stats.qp_solves += s.qp_solves;
+        stats.time_setup_ms += s.time_setup_ms;
+        stats.time_roots_ms += s.time_roots_ms;
+        stats.time_interference_ms += s.time_interference_ms;
+        stats.time_obstacles_ms += s.time_obstacles_ms;
+        stats.time_cells_ms += s.time_cells_ms;
+    }
+    stats
+}
+
+/// [`place_with_cache`] sharing `caches` with earlier searches (see [`SearchCaches`]); the stacking planner passes
+/// the same caches to every search of a plan.
 pub fn place_with_caches(
     request: &PlacementRequest<'_>,
     cache: &ObstacleCache,
     caches: &mut SearchCaches,
 ) -> Result<PlacementResult, PlacementError> {
     let start = Instant::now();
-    let mut search = prepare(request, cache, caches)?;
+    let mut searches = prepare(request, cache, caches)?;
     let before = cache.stats();
-    search.stats.time_setup_ms = ms(start);
+    if let Some(first) = searches.first_mut() {
+        first.stats.time_setup_ms = ms(start);
+    }
     let result = match request.fixed_z {
-        None => search.run::<3>(0.0),
-        Some(z) => search.run::<2>(z),
+        None => run::<3>(&mut searches, 0.0),
+        Some(z) => run::<2>(&mut searches, z),
     };
     let after = cache.stats();
-    search.give_back(caches);
+    for (search, lane) in searches.iter_mut().zip(&mut caches.lanes) {
+        search.give_back(lane);
+    }
     let mut result = result?;
     result.stats.obstacles_constructed = after.constructions - before.constructions;
     result.stats.obstacle_cache_hits = after.hits - before.hits;
@@ -780,17 +892,21 @@ pub fn place_with_caches(
     Ok(result)
 }
 
-/// The search's state in 2 or 3 variables.
+/// The search's state in 2 or 3 variables, one per partition of the orientations.
 enum States {
-    Two(RunState<2>),
-    Three(RunState<3>),
+    Two(Vec<RunState<2>>),
+    Three(Vec<RunState<3>>),
 }
 
 impl std::fmt::Debug for States {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let (dimensions, open, free) = match self {
-            States::Two(s) => (2, s.heap.len(), s.free_nodes.len()),
-            States::Three(s) => (3, s.heap.len(), s.free_nodes.len()),
+            States::Two(s) => {
+                (2, s.iter().map(|s| s.heap.len()).sum::<usize>(), s.iter().map(|s| s.free_nodes.len()).sum::<usize>())
+            }
+            States::Three(s) => {
+                (3, s.iter().map(|s| s.heap.len()).sum::<usize>(), s.iter().map(|s| s.free_nodes.len()).sum::<usize>())
+            }
         };
         f.debug_struct("States")
             .field("dimensions", &dimensions)
@@ -833,7 +949,8 @@ impl std::fmt::Debug for States {
 /// # }
 /// ```
 pub struct PlacementSearch<'r, 'a, 'c> {
-    search: Search<'r, 'a>,
+    /// One per partition of the orientations.
+    searches: Vec<Search<'r, 'a>>,
     caches: &'c mut SearchCaches,
     /// `None`: Omega is empty at every orientation.
     state: Option<States>,
@@ -851,7 +968,7 @@ impl std::fmt::Debug for PlacementSearch<'_, '_, '_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("PlacementSearch")
             .field("empty_omega", &self.state.is_none())
-            .field("stats", &self.search.stats)
+            .field("stats", &merged_stats(&self.searches))
             .finish_non_exhaustive()
     }
 }
@@ -865,8 +982,10 @@ impl<'r, 'a, 'c> PlacementSearch<'r, 'a, 'c> {
     ) -> Result<Self, PlacementError> {
         let start = Instant::now();
         let before = cache.stats();
-        let mut search = prepare(request, cache, caches)?;
-        search.stats.time_setup_ms = ms(start);
+        let mut searches = prepare(request, cache, caches)?;
+        if let Some(first) = searches.first_mut() {
+            first.stats.time_setup_ms = ms(start);
+        }
         // the state of the last search with this floor, else of the newest one whose floor lies inside it
         let signature = caches.carry.then(|| FrontierSignature::of(request));
         let carried = signature.as_ref().and_then(|sig| {
@@ -880,18 +999,20 @@ impl<'r, 'a, 'c> PlacementSearch<'r, 'a, 'c> {
         });
         let state = match (carried, request.fixed_z) {
             (Some((States::Three(s), old)), None) => {
-                search.widen(s.reopened(), old.as_ref()).map(|s| Some(States::Three(s)))
+                widen_all(&mut searches, s, old.as_ref()).map(|s| Some(States::Three(s)))
             }
             (Some((States::Two(s), old)), Some(_)) => {
-                search.widen(s.reopened(), old.as_ref()).map(|s| Some(States::Two(s)))
+                widen_all(&mut searches, s, old.as_ref()).map(|s| Some(States::Two(s)))
             }
-            (_, None) => search.start::<3>(0.0).map(|s| s.map(States::Three)),
-            (_, Some(z)) => search.start::<2>(z).map(|s| s.map(States::Two)),
+            (_, None) => start_all::<3>(&mut searches, 0.0).map(|s| s.map(States::Three)),
+            (_, Some(z)) => start_all::<2>(&mut searches, z).map(|s| s.map(States::Two)),
         };
         let state = match state {
             Ok(state) => state,
             Err(e) => {
-                search.give_back(caches);
+                for (search, lane) in searches.iter_mut().zip(&mut caches.lanes) {
+                    search.give_back(lane);
+                }
                 // the obstacle table the kept states name by id is lost with the search
                 caches.frontiers.clear();
                 return Err(e);
@@ -899,7 +1020,7 @@ impl<'r, 'a, 'c> PlacementSearch<'r, 'a, 'c> {
         };
         let after = cache.stats();
         let cache_counts = (after.constructions - before.constructions, after.hits - before.hits);
-        Ok(Self { search, caches, state, cache, cache_counts, elapsed_ms: ms(start), signature })
+        Ok(Self { searches, caches, state, cache, cache_counts, elapsed_ms: ms(start), signature })
     }
 
     /// The next `more` placements (fewer, with `exhausted` set, when the free space runs out); statistics over the
@@ -926,8 +1047,8 @@ impl<'r, 'a, 'c> PlacementSearch<'r, 'a, 'c> {
                     stats: self.stats(),
                 });
             }
-            Some(States::Two(state)) => self.search.advance(state, more, max_cost),
-            Some(States::Three(state)) => self.search.advance(state, more, max_cost),
+            Some(States::Two(states)) => advance_all(&mut self.searches, states, more, max_cost),
+            Some(States::Three(states)) => advance_all(&mut self.searches, states, more, max_cost),
         };
         let after = self.cache.stats();
         self.cache_counts.0 += after.constructions - before.constructions;
@@ -948,28 +1069,46 @@ impl<'r, 'a, 'c> PlacementSearch<'r, 'a, 'c> {
 
     /// The statistics of the search so far.
     pub fn stats(&self) -> PlacementStats {
-        let mut stats = self.search.stats.clone();
+        let mut stats = merged_stats(&self.searches);
         (stats.obstacles_constructed, stats.obstacle_cache_hits) = self.cache_counts;
         stats.time_total_ms = self.elapsed_ms;
         stats
+    }
+
+    /// The statistics of each partition of the orientations so far (one entry per
+    /// [`PlacementRequest::partitions`]; [`Self::stats`] sums them): the balance of the partitioned search.
+    pub fn partition_stats(&self) -> Vec<PlacementStats> {
+        self.searches.iter().map(|s| s.stats.clone()).collect()
     }
 }
 
 impl Drop for PlacementSearch<'_, '_, '_> {
     fn drop(&mut self) {
-        self.search.give_back(self.caches);
-        if self.caches.carry {
-            self.caches.table = ObstacleTable {
-                obstacles: std::mem::take(&mut self.search.obstacles),
-                ids: std::mem::take(&mut self.search.obstacle_ids),
-                by_orientation: std::mem::take(&mut self.search.by_orientation),
-            };
-            if let (Some(signature), Some(state)) = (self.signature.take(), self.state.take()) {
-                self.caches.frontiers.retain(|(s, _)| *s != signature);
-                self.caches.frontiers.push((signature, state));
-                if self.caches.frontiers.len() > CARRIED_FRONTIERS {
-                    self.caches.frontiers.remove(0);
-                }
+        if self.searches.len() > 1 {
+            tracing::debug!(
+                nodes = ?self.searches.iter().map(|s| s.stats.nodes_expanded).collect::<Vec<_>>(),
+                pushed = ?self.searches.iter().map(|s| s.stats.nodes_pushed).collect::<Vec<_>>(),
+                rounds = self.searches.first().map_or(0, |s| s.rounds),
+                "partitioned search: nodes per partition"
+            );
+        }
+        for (search, lane) in self.searches.iter_mut().zip(&mut self.caches.lanes) {
+            search.give_back(lane);
+            if self.caches.carry {
+                lane.table = ObstacleTable {
+                    obstacles: std::mem::take(&mut search.obstacles),
+                    ids: std::mem::take(&mut search.obstacle_ids),
+                    by_orientation: std::mem::take(&mut search.by_orientation),
+                };
+            }
+        }
+        if self.caches.carry
+            && let (Some(signature), Some(state)) = (self.signature.take(), self.state.take())
+        {
+            self.caches.frontiers.retain(|(s, _)| *s != signature);
+            self.caches.frontiers.push((signature, state));
+            if self.caches.frontiers.len() > CARRIED_FRONTIERS {
+                self.caches.frontiers.remove(0);
             }
         }
     }
@@ -979,9 +1118,139 @@ fn ms(since: Instant) -> f64 {
     since.elapsed().as_secs_f64() * 1e3
 }
 
+/// Whether key `a` pops after key `b` (the heap's order: cheaper, then lower orientation, then lower id first; the
+/// slot is not part of the order).
+fn pops_after(a: HeapKey, b: HeapKey) -> bool {
+    (a.rank_cost, a.rank_tie) < (b.rank_cost, b.rank_tie)
+}
+
+/// How many placements a partition finds ahead of the merge while another partition searches up to the best found
+/// one ("Partitions" in the module documentation).
+const LOOK_AHEAD: usize = 4;
+
+/// Pops per partition between two exchanges of the partitions' next placements ("Partitions" in the module
+/// documentation).
+const ROUND_POPS: u64 = 256;
+
+/// The whole search of [`place_with_caches`]: roots, then `k` placements.
+fn run<const D: usize>(searches: &mut [Search<'_, '_>], fixed_z: f64) -> Result<PlacementResult, PlacementError> {
+    let Some(k) = searches.first().map(|s| s.request.k) else {
+        return Err(PlacementError::BadOption("no search partition".into()));
+    };
+    let Some(mut states) = start_all::<D>(searches, fixed_z)? else {
+        return Ok(PlacementResult {
+            placements: Vec::new(),
+            exhausted: Some(NoPlacement::EmptyOmega),
+            stats: merged_stats(searches),
+        });
+    };
+    let (placements, _) = advance_all(searches, &mut states, k, f64::INFINITY)?;
+    let exhausted = (placements.len() < k).then_some(NoPlacement::FitsNowhere);
+    Ok(PlacementResult { placements, exhausted, stats: merged_stats(searches) })
+}
+
+/// Every partition's roots and state; `None` when Omega is empty at every orientation.
+fn start_all<const D: usize>(
+    searches: &mut [Search<'_, '_>],
+    fixed_z: f64,
+) -> Result<Option<Vec<RunState<D>>>, PlacementError> {
+    let states = searches.iter_mut().map(|s| s.start::<D>(fixed_z)).collect::<Result<Vec<_>, _>>()?;
+    Ok(states.iter().any(|s| !s.heap.is_empty()).then_some(states))
+}
+
+/// Every partition's carried state reopened and widened ([`Search::widen`]).
+fn widen_all<const D: usize>(
+    searches: &mut [Search<'_, '_>],
+    states: Vec<RunState<D>>,
+    old: Option<&FloorVolume>,
+) -> Result<Vec<RunState<D>>, PlacementError> {
+    searches.iter_mut().zip(states).map(|(s, state)| s.widen(state.reopened(), old)).collect()
+}
+
+/// The next `want` placements of the partitioned search ("Partitions" in the module documentation): a k-way merge
+/// of the partitions' next placements in the heap's order, the partitions advanced in rounds; one partition is the
+/// sequential loop itself ([`Search::advance`]). Returns `true` when it stopped at `max_cost`.
+fn advance_all<const D: usize>(
+    searches: &mut [Search<'_, '_>],
+    states: &mut [RunState<D>],
+    want: usize,
+    max_cost: f64,
+) -> Result<(Vec<Placement>, bool), PlacementError> {
+    if let ([search], [state]) = (&mut *searches, &mut *states) {
+        return search.advance(state, want, max_cost, None, u64::MAX);
+    }
+    let mut placements = Vec::new();
+    if want == 0 {
+        return Ok((placements, false));
+    }
+    // per partition: 0 idle, 1 needed (its next placement may precede every found one), 2 looking ahead
+    let mut roles = vec![0u8; states.len()];
+    loop {
+        // the cheapest found placement of all partitions: every other partition searches up to its key
+        let best = states
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| s.ahead.front().map(|(key, _)| (i, *key)))
+            .reduce(|a, b| if pops_after(b.1, a.1) { a } else { b });
+        let bound = best.map(|(_, key)| key);
+        for (role, s) in roles.iter_mut().zip(states.iter()) {
+            let open = s.heap.peek_key().filter(|top| top.cost() <= max_cost);
+            *role = match open {
+                Some(top) if s.ahead.is_empty() && bound.is_none_or(|b| pops_after(b, top)) => 1,
+                Some(_) if s.ahead.len() < LOOK_AHEAD => 2,
+                _ => 0,
+            };
+        }
+        let needed = roles.iter().filter(|r| **r == 1).count();
+        if needed == 0 {
+            // every partition either holds its next placement or has nothing left before the best one (or within
+            // the limit): the best one is the next placement of the whole search
+            match best {
+                Some((i, key)) if key.cost() <= max_cost => {
+                    if let Some((_, placement)) = states[i].ahead.pop_front() {
+                        placements.push(placement);
+                    }
+                    if placements.len() >= want {
+                        return Ok((placements, false));
+                    }
+                    continue;
+                }
+                _ => {
+                    let limited = states.iter().any(|s| !s.ahead.is_empty() || !s.heap.is_empty());
+                    return Ok((placements, limited));
+                }
+            }
+        }
+        let running = roles.iter().filter(|r| **r != 0).count();
+        if running == 1 {
+            // alone it cannot learn a new bound from the others: no rounds
+            if let Some(i) = roles.iter().position(|r| *r == 1) {
+                searches[i].step(&mut states[i], 1, max_cost, bound, u64::MAX)?;
+            }
+            continue;
+        }
+        // a round: the needed partitions search for their next placement up to the best one, the others look
+        // further ahead (placements the caller may ask for next; the work stays in the state either way)
+        let results: Vec<Result<(), PlacementError>> = searches
+            .par_iter_mut()
+            .zip(states.par_iter_mut())
+            .zip(roles.par_iter())
+            .map(|((search, state), &role)| match role {
+                1 => search.step(state, 1, max_cost, bound, ROUND_POPS),
+                2 => search.step(state, LOOK_AHEAD - state.ahead.len(), max_cost, None, ROUND_POPS),
+                _ => Ok(()),
+            })
+            .collect();
+        for result in results {
+            result?;
+        }
+        searches[0].rounds += 1;
+    }
+}
+
 impl Search<'_, '_> {
-    /// Moves the shared caches' contents back into `caches`.
-    fn give_back(&mut self, caches: &mut SearchCaches) {
+    /// Moves the shared caches' contents back into `caches` (this partition's).
+    fn give_back(&mut self, caches: &mut LaneCaches) {
         caches.detect_scratch = std::mem::take(&mut self.detect_scratch);
         caches.derived = std::mem::take(&mut self.derived);
         caches.intervals = std::mem::take(&mut self.intervals);
@@ -1024,6 +1293,9 @@ impl Search<'_, '_> {
             .orientations
             .par_iter()
             .map(|o| {
+                if !self.owns(o.index) {
+                    return Ok(Vec::new());
+                }
                 let fs_err = |reason: String| PlacementError::FreeSpace { orientation: o.index, reason };
                 let Some(new_hs) = self.omega::<D>(o, &self.request.floor, fixed_z) else {
                     return Ok(Vec::new());
@@ -1085,28 +1357,23 @@ impl Search<'_, '_> {
         Ok((!cell.is_empty()).then_some(cell))
     }
 
-    fn run<const D: usize>(&mut self, fixed_z: f64) -> Result<PlacementResult, PlacementError> {
-        let Some(mut state) = self.start::<D>(fixed_z)? else {
-            return Ok(PlacementResult {
-                placements: Vec::new(),
-                exhausted: Some(NoPlacement::EmptyOmega),
-                stats: self.stats.clone(),
-            });
-        };
-        let (placements, _) = self.advance(&mut state, self.request.k, f64::INFINITY)?;
-        let exhausted = (placements.len() < self.request.k).then_some(NoPlacement::FitsNowhere);
-        Ok(PlacementResult { placements, exhausted, stats: self.stats.clone() })
+    /// Whether orientation `i` belongs to this partition.
+    fn owns(&self, i: usize) -> bool {
+        lane_of(i, self.lanes) == self.lane
     }
 
-    /// The roots (one QP per orientation, in parallel) and the search's state; `None` when Omega is empty at every
-    /// orientation.
-    fn start<const D: usize>(&mut self, fixed_z: f64) -> Result<Option<RunState<D>>, PlacementError> {
+    /// The roots of this partition's orientations (one QP per orientation, in parallel) and its state (an empty
+    /// heap when Omega is empty at every one of them).
+    fn start<const D: usize>(&mut self, fixed_z: f64) -> Result<RunState<D>, PlacementError> {
         let t_roots = Instant::now();
         // roots in parallel, collected in orientation order; Omega's normals are those of the floor's sides and
         // (3-D) of the floor and the ceiling at every orientation, only the offsets change, so the first non-empty
         // root's boundedness check (as `Cell::new` makes it) answers for all of them
-        let cells: Vec<Result<Option<Cell<D>>, PlacementError>> =
-            self.orientations.par_iter().map(|o| self.root_cell::<D>(o, fixed_z)).collect();
+        let cells: Vec<Result<Option<Cell<D>>, PlacementError>> = self
+            .orientations
+            .par_iter()
+            .map(|o| if self.owns(o.index) { self.root_cell::<D>(o, fixed_z) } else { Ok(None) })
+            .collect();
         let mut cells: Vec<Option<Cell<D>>> = cells.into_iter().collect::<Result<_, _>>()?;
         if let Some((i, cell)) = cells.iter().enumerate().find_map(|(i, c)| c.as_ref().map(|c| (i, c))) {
             cell.check_bounded().map_err(|e| PlacementError::FreeSpace { orientation: i, reason: e.to_string() })?;
@@ -1140,16 +1407,14 @@ impl Search<'_, '_> {
                         applied: Arc::from([]),
                     });
                 }
-                None => self.stats.orientations_empty_omega += 1,
+                None if self.owns(i) => self.stats.orientations_empty_omega += 1,
+                None => {}
             }
             next_id += 1;
         }
         self.stats.nodes_pushed = heap.len() as u64;
         self.stats.time_roots_ms = ms(t_roots);
-        if heap.is_empty() {
-            return Ok(None);
-        }
-        Ok(Some(RunState {
+        Ok(RunState {
             fixed_z,
             heap,
             next_id,
@@ -1158,20 +1423,46 @@ impl Search<'_, '_> {
             pops: 0,
             free_nodes: Vec::new(),
             buffers: Buffers::default(),
-        }))
+            found_keys: Vec::new(),
+            ahead: VecDeque::new(),
+        })
+    }
+
+    /// [`Search::advance`] for up to `want` placements of this partition, queued as its look-ahead (`state.ahead`),
+    /// within a round: at most `max_pops` pops, stopping where the next key would pop after `bound`.
+    fn step<const D: usize>(
+        &mut self,
+        state: &mut RunState<D>,
+        want: usize,
+        max_cost: f64,
+        bound: Option<HeapKey>,
+        max_pops: u64,
+    ) -> Result<(), PlacementError> {
+        let (found, _) = self.advance(state, want, max_cost, bound, max_pops)?;
+        let keys = std::mem::take(&mut state.found_keys);
+        state.ahead.extend(keys.iter().copied().zip(found));
+        state.found_keys = keys;
+        Ok(())
     }
 
     /// Continues the search from `state` until `want` more placements are found, the free space is exhausted or
     /// the cheapest open key exceeds `max_cost` (fewer returned; `true` for the last); the loop of the module
     /// documentation. Stopping after the `want`-th (or at the limit) and calling again continues exactly where one
-    /// call with the sum of the `want`s would have been: the state is the whole loop's.
+    /// call with the sum of the `want`s would have been: the state is the whole loop's. A partition's round
+    /// ("Partitions" in the module documentation) also stops after `max_pops` pops or where the next key would pop
+    /// after `bound` (neither is a limit of the whole search).
     fn advance<const D: usize>(
         &mut self,
         state: &mut RunState<D>,
         want: usize,
         max_cost: f64,
+        bound: Option<HeapKey>,
+        max_pops: u64,
     ) -> Result<(Vec<Placement>, bool), PlacementError> {
-        let RunState { fixed_z, heap, next_id, considered, found_points, pops, free_nodes, buffers } = state;
+        let RunState {
+            fixed_z, heap, next_id, considered, found_points, pops, free_nodes, buffers, found_keys, ..
+        } = state;
+        found_keys.clear();
         let fixed_z = *fixed_z;
         let mut placements: Vec<Placement> = Vec::new();
         if want == 0 {
@@ -1180,12 +1471,17 @@ impl Search<'_, '_> {
         let clearance = self.request.clearance;
         let tol = self.tol.linear;
         let mut limited = false;
+        let mut round_pops: u64 = 0;
         loop {
             // the keys are lower bounds of every cost still to come: past the limit, nothing within it is left
             if heap.peek_cost().is_some_and(|cost| cost > max_cost) {
                 limited = true;
                 break;
             }
+            if round_pops >= max_pops || bound.is_some_and(|b| heap.peek_key().is_some_and(|top| pops_after(top, b))) {
+                break;
+            }
+            round_pops += 1;
             let Some(popped) = heap.pop() else { break };
             *pops += 1;
             if *pops > self.request.node_budget as u64 {
@@ -1301,8 +1597,10 @@ impl Search<'_, '_> {
                     .any(|(oi, q)| *oi == node.orientation && (*q - p).abs().max_element() <= 1e3 * tol);
                 let found = (!dup).then(|| self.placement(&node.cell, optimum, node.orientation, p));
                 let orientation = node.orientation;
+                let key = HeapKey::new(node.cost, orientation, node.id, 0);
                 free_nodes.push(node);
                 if let Some(placement) = found {
+                    found_keys.push(key);
                     found_points.push((orientation, p));
                     placements.push(placement);
                     if placements.len() >= want {

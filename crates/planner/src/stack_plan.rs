@@ -74,15 +74,24 @@ pub struct PlanOptions {
     pub max_resting_poses: usize,
     /// How far stage 1 may grow the stack's footprint to nest a part (mm).
     pub nest_allowance: f64,
+    /// Partitions of the orientations each placement search splits into, searched in parallel
+    /// ([`crate::request::PlacementRequest::partitions`]; the plan depends on this number, never on the thread
+    /// count; 1: the sequential search).
+    #[serde(default = "default_partitions")]
+    pub partitions: usize,
 }
 
 fn default_max_candidates() -> usize {
     1024
 }
 
+fn default_partitions() -> usize {
+    crate::request::DEFAULT_PARTITIONS
+}
+
 impl PlanOptions {
     /// Defaults of the seed's examples: w = 0.5, 5 mm clearance, 1-degree steps, mu = 0.5, 10 mm cup, insertion,
-    /// 8 candidates (up to 1024 when all fail), 3 resting poses, 5 mm nesting allowance.
+    /// 8 candidates (up to 1024 when all fail), 3 resting poses, 5 mm nesting allowance, 2 search partitions.
     pub fn new(count: usize, floor: FloorVolume) -> Self {
         Self {
             count,
@@ -98,6 +107,7 @@ impl PlanOptions {
             max_candidates: default_max_candidates(),
             max_resting_poses: 3,
             nest_allowance: 5.0,
+            partitions: default_partitions(),
         }
     }
 }
@@ -339,6 +349,7 @@ pub fn plan_stack_with_progress(
             request.horizontal_clearance = true;
             request.cost = Cost::Stacking { w: options.w, origin };
             request.insertion = options.insertion;
+            request.partitions = options.partitions;
             // a stage tests `candidates` candidates; the last one, when nothing at all was accepted, continues the
             // same search up to `max_candidates`
             let limit =
