@@ -227,3 +227,80 @@ pub(crate) fn assemble(
         Err(e) => Err(OverlayFailure::Assembly(e)),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::minkowski::gauss_map_obstacle;
+    use stackplan_geom::convex_hull;
+
+    fn hex_prism(scale: f64) -> ConvexPolytope {
+        let hex = [(0.0, 0.0), (60.0, 0.0), (90.0, 30.0), (80.0, 70.0), (20.0, 80.0), (-10.0, 40.0)];
+        let points: Vec<DVec3> =
+            hex.iter().flat_map(|&(x, y)| [0.0, 2.0].map(|z| DVec3::new(x * scale, y * scale, z))).collect();
+        convex_hull(&points).expect("prism").polytope
+    }
+
+    /// The inputs of [`assemble`] recovered from an obstacle of a tame pair: its face specs, vertex-pair cycles, starts.
+    fn inputs(o: &Obstacle) -> (Vec<FaceSpec>, Vec<[usize; 2]>, Vec<usize>) {
+        let p = o.polytope();
+        let mut specs = Vec::new();
+        let (mut cycles, mut starts) = (Vec::new(), vec![0]);
+        for (face, kind) in p.faces().iter().zip(o.face_kinds()) {
+            let (Some(fixed), Some(moving)) = (kind.fixed_feature(), kind.moving_feature()) else { panic!("{kind:?}") };
+            specs.push(FaceSpec { normal: face.plane.normal, fixed, moving });
+            cycles.extend(face.vertices.iter().map(|&v| o.vertex_pairs()[v]));
+            starts.push(cycles.len());
+        }
+        (specs, cycles, starts)
+    }
+
+    fn run(
+        b: &ConvexPolytope,
+        r: DMat3,
+        ra: &[DVec3],
+        (specs, cycles, starts): (&[FaceSpec], &[[usize; 2]], &[usize]),
+    ) -> Option<String> {
+        let b_levels: Vec<u8> = b.vertices().iter().map(|v| u8::from(v.z > 1.0)).collect();
+        let mut index_of = Vec::new();
+        let result = assemble(b, r, ra, specs, cycles, starts, &b_levels, &mut index_of, &mut Scratch::default())?;
+        Some(format!("{result:?}"))
+    }
+
+    #[test]
+    fn equals_the_general_assembly_and_refuses_broken_cycles() {
+        let (a, b) = (hex_prism(1.0), hex_prism(0.7));
+        for angle in [0.3, 1.0, 2.0, -2.5] {
+            let r = DMat3::from_rotation_z(angle);
+            let o = gauss_map_obstacle(&a, r, &b).expect("obstacle");
+            let ra: Vec<DVec3> = a.vertices().iter().map(|v| r * *v).collect();
+            let (specs, cycles, starts) = inputs(&o);
+            assert_eq!(specs.len(), 14);
+            // the same obstacle, bit for bit
+            let direct = run(&b, r, &ra, (&specs, &cycles, &starts));
+            assert_eq!(direct, Some(format!("{:?}", Ok::<_, OverlayFailure>(o.clone()))));
+            // broken cycles: refused (`None`; in debug builds geom would also reject a wrong table), never a panic
+            let side = (0..specs.len()).find(|&s| starts[s + 1] - starts[s] == 4).expect("a side face");
+            let pole = (0..specs.len()).find(|&s| starts[s + 1] - starts[s] > 4).expect("a pole face");
+            let mut broken: Vec<Vec<[usize; 2]>> = Vec::new();
+            let mut swapped = cycles.clone();
+            swapped.swap(starts[side], starts[side] + 1);
+            broken.push(swapped);
+            let mut reversed = cycles.clone();
+            reversed[starts[pole]..starts[pole + 1]].reverse();
+            broken.push(reversed);
+            let mut repeated = cycles.clone();
+            repeated[starts[side] + 2] = repeated[starts[side]];
+            broken.push(repeated);
+            let mut moved = cycles.clone();
+            moved[starts[pole]] = [0, 0];
+            broken.push(moved);
+            for cycles in &broken {
+                assert_eq!(run(&b, r, &ra, (&specs, cycles, &starts)), None);
+            }
+            // wrong lengths
+            assert_eq!(run(&b, r, &ra, (&specs[..13], &cycles, &starts[..14])), None);
+            assert_eq!(run(&b, r, &ra, (&specs, &cycles[..cycles.len() - 1], &starts)), None);
+        }
+    }
+}
