@@ -56,7 +56,8 @@
 //! crossing pass: for them those numbers are exact zeros by the data, and `z_prism.rs` builds the same face list
 //! (bit for bit the same obstacle) in O(FA FB + FB EA + FA EB) with far fewer products; for a *tame* such pair (the
 //! usual one, away from quarter turns) it also reads every face cycle off the features (`z_prism::derived_cycles`)
-//! instead of merging polygons, with the same result.
+//! instead of merging polygons, and numbers, offsets and links them from the prism structure (`prism_assembly.rs`)
+//! instead of the general assembly's half-edge table, with the same result.
 
 use glam::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
