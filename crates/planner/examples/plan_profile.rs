@@ -1,5 +1,5 @@
 //! Times a stacking plan of a fixture part (for profiling): `cargo run -p stackplan-planner --example plan_profile
-//! -- PART.json [COUNT] [W] [DTHETA_DEG] [HALF_SIZE] [HEIGHT] [CLEARANCE] [CUP_DIAMETER]`. Prints the plan's totals
+//! -- PART.json [COUNT] [W] [DTHETA_DEG] [HALF_SIZE] [HEIGHT] [CLEARANCE] [CUP_DIAMETER] [PARTITIONS]`. Prints the plan's totals
 //! and statistics as JSON (default floor 660 x 660 mm centred at the origin, height 400 mm; 5 mm clearance and a
 //! 10 mm cup, as the Channel plan regression scenarios; the 121 unit cubes of Fig. 2: `cube.json 121 0.5 90 5.5 126
 //! 0 0.5`).
@@ -11,7 +11,8 @@ use stackplan_planner::{FloorVolume, PlanOptions, plan_stack};
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let path = args.get(1).ok_or(
-        "usage: plan_profile PART.json [COUNT] [W] [DTHETA_DEG] [HALF_SIZE] [HEIGHT] [CLEARANCE] [CUP_DIAMETER]",
+        "usage: plan_profile PART.json [COUNT] [W] [DTHETA_DEG] [HALF_SIZE] [HEIGHT] [CLEARANCE] [CUP_DIAMETER] \
+         [PARTITIONS]",
     )?;
     let count: usize = args.get(2).map_or(Ok(15), |s| s.parse())?;
     let w: f64 = args.get(3).map_or(Ok(0.5), |s| s.parse())?;
@@ -20,12 +21,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let height: f64 = args.get(6).map_or(Ok(400.0), |s| s.parse())?;
     let clearance: Option<f64> = args.get(7).map(|s| s.parse()).transpose()?;
     let cup: Option<f64> = args.get(8).map(|s| s.parse()).transpose()?;
+    let partitions: Option<usize> = args.get(9).map(|s| s.parse()).transpose()?;
     let part = read_part(path, &ReadOptions::default())?;
     let mut options = PlanOptions::new(count, FloorVolume::rectangle(-half, -half, half, half, height));
     options.w = w;
     options.dtheta = dtheta.to_radians();
     options.clearance = clearance.unwrap_or(options.clearance);
     options.cup_diameter = cup.unwrap_or(options.cup_diameter);
+    options.partitions = partitions.unwrap_or(options.partitions);
     let started = std::time::Instant::now();
     let plan = plan_stack(&part, &options)?;
     let seconds = started.elapsed().as_secs_f64();
