@@ -1,8 +1,8 @@
 //! Times a stacking plan of a fixture part (for profiling): `cargo run -p stackplan-planner --example plan_profile
-//! -- PART.json [COUNT] [W] [DTHETA_DEG] [HALF_SIZE] [HEIGHT] [CLEARANCE] [CUP_DIAMETER] [PARTITIONS]`. Prints the plan's totals
-//! and statistics as JSON (default floor 660 x 660 mm centred at the origin, height 400 mm; 5 mm clearance and a
-//! 10 mm cup, as the Channel plan regression scenarios; the 121 unit cubes of Fig. 2: `cube.json 121 0.5 90 5.5 126
-//! 0 0.5`).
+//! -- PART.json [COUNT] [W] [DTHETA_DEG] [HALF_SIZE] [HEIGHT] [CLEARANCE] [CUP_DIAMETER] [PARTITIONS]`. Prints the
+//! plan's totals and statistics as JSON (default floor 660 x 660 mm centred at the origin, height 400 mm; 5 mm
+//! clearance and a 10 mm cup, as the Channel plan regression scenarios; the 121 unit cubes of Fig. 2: `cube.json 121
+//! 0.5 90 5.5 126 0 0.5`; PARTITIONS: the placement searches' partitions of the orientations, default 2).
 
 use stackplan_geom::io::{ReadOptions, read_part};
 use stackplan_planner::{FloorVolume, PlanOptions, plan_stack};
