@@ -1,7 +1,7 @@
 //! The direct assembly of the obstacle of a tame z-prism pair: vertex numbering, offsets and the edge table generated
 //! from the prism structure, without the general assembly's lookup-table pass.
 //!
-//! Paper: Ayyadevara et al. 2002 ([A]) App. B, eq. 12; the obstacle of two z-prisms turned about `z` is itself a
+//! Paper: Ayyadevara et al. 2002 (\[A\]) App. B, eq. 12; the obstacle of two z-prisms turned about `z` is itself a
 //! z-prism, `C = (b (+) (-R a)) x [b_lo - a_hi, b_hi - a_lo]` for the cross-sections `a`, `b` (see `z_prism.rs`).
 //! For a *tame* pair `z_prism::derived_cycles` has read every face cycle off the features: `k` side faces (each a
 //! quadrilateral with two corners on each pole) and two pole faces, `2 k` vertices, `3 k` edges. Every vertex has
