@@ -173,7 +173,7 @@ pub(super) fn flat_minimum_norm(union: &Rigid, points: &[Point]) -> Option<Vec<D
 /// (`s = +1` on `b`, `-1` on `a`): `sum s n_z f_k = m_i` and the moments about the two horizontal axes through `c_i`,
 /// `sum s n_z f_k (y_k - c_y) = 0`, `sum s n_z f_k (x_k - c_x) = 0` (vertical forces have no other moment and no
 /// horizontal resultant, and no load acts). Least squares through the normal equations `(A A^T) y = b` (3 M
-/// unknowns, dense Gaussian elimination with partial pivoting), O(M^3 + M K).
+/// unknowns, faer's dense Cholesky factorisation), O(M^3 + M K).
 ///
 /// The points whose normal lies in the friction cone of the vertical (`|n_xy| <= mu |n_z|`, see
 /// [`super::hull_certificate`]) also take a vertical force: it lies in their cones too.
@@ -231,7 +231,7 @@ fn certificate_with(
     for (m, &i) in movers.iter().enumerate() {
         rhs[3 * m] = bodies[i].mass / weight;
     }
-    let y = solve_dense(gram, rhs.clone(), rows)?;
+    let y = solve_spd(&gram, &rhs, rows)?;
     let mut forces = Vec::with_capacity(points.len());
     let mut residual = vec![0.0f64; rows];
     for (p, col) in points.iter().zip(&columns) {
@@ -272,38 +272,80 @@ pub(super) fn certificate_column(
     out
 }
 
-/// Solves the dense `n x n` system `a y = b` (row-major) by Gaussian elimination with partial pivoting; `None` when a
-/// pivot is below `1e-12` times the largest entry (singular or nearly so).
-fn solve_dense(mut a: Vec<f64>, mut b: Vec<f64>, n: usize) -> Option<Vec<f64>> {
+/// Solves the symmetric positive definite `n x n` system `a y = b` (row-major: the Gram matrix `A A^T` of the
+/// certificate rows) by faer's Cholesky factorisation `a = L L^T`, O(n^3 / 3); `None` when `a` is not numerically
+/// positive definite: the factorisation fails or a pivot `L_kk^2` (the pivot Gaussian elimination would take) is at
+/// most `1e-12` times the largest entry (a singular or nearly singular Gram matrix: rows without support, or
+/// dependent ones). The caller verifies the result's residual, so the verdict never rests on this solve's accuracy.
+fn solve_spd(a: &[f64], b: &[f64], n: usize) -> Option<Vec<f64>> {
+    use faer::linalg::solvers::Solve as _;
     let largest = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    if largest.is_nan() || largest == 0.0 {
+    if largest.is_nan() || largest == 0.0 || a.len() != n * n || b.len() != n {
         return None;
     }
-    for k in 0..n {
-        let pivot = (k..n).max_by(|&i, &j| a[i * n + k].abs().total_cmp(&a[j * n + k].abs()))?;
-        if a[pivot * n + k].abs() <= 1e-12 * largest {
-            return None;
-        }
-        if pivot != k {
-            for c in 0..n {
-                a.swap(k * n + c, pivot * n + c);
+    let matrix = faer::Mat::from_fn(n, n, |i, j| a[i * n + j]);
+    let factor = matrix.llt(faer::Side::Lower).ok()?;
+    let l = factor.L();
+    // NaN-safe: a NaN pivot is not `Greater`, so it fails the test too
+    if (0..n).any(|k| (l[(k, k)] * l[(k, k)]).partial_cmp(&(1e-12 * largest)) != Some(std::cmp::Ordering::Greater)) {
+        return None;
+    }
+    let mut y = faer::Mat::from_fn(n, 1, |i, _| b[i]);
+    factor.solve_in_place(y.as_mut());
+    Some((0..n).map(|i| y[(i, 0)]).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::solve_spd;
+    use proptest::prelude::*;
+
+    /// `M M^T + I / 10` for the `n x n` matrix `M` of `entries` (row-major): symmetric positive definite.
+    fn gram_plus_ridge(entries: &[f64], n: usize) -> Vec<f64> {
+        let mut a = vec![0.0; n * n];
+        for i in 0..n {
+            for j in 0..n {
+                let dot: f64 = (0..n).map(|k| entries[i * n + k] * entries[j * n + k]).sum();
+                a[i * n + j] = dot + if i == j { 0.1 } else { 0.0 };
             }
-            b.swap(k, pivot);
         }
-        for i in k + 1..n {
-            let f = a[i * n + k] / a[k * n + k];
-            if f != 0.0 {
-                for c in k..n {
-                    a[i * n + c] -= f * a[k * n + c];
-                }
-                b[i] -= f * b[k];
+        a
+    }
+
+    proptest! {
+        #[test]
+        fn the_cholesky_solution_satisfies_the_system(
+            entries in prop::collection::vec(-1.0f64..1.0, 36),
+            rhs in prop::collection::vec(-1.0f64..1.0, 6),
+        ) {
+            let n = 6;
+            let a = gram_plus_ridge(&entries, n);
+            let y = solve_spd(&a, &rhs, n);
+            prop_assert!(y.is_some(), "a positive definite system has a solution");
+            let y = y.unwrap_or_default();
+            for i in 0..n {
+                let row: f64 = (0..n).map(|j| a[i * n + j] * y[j]).sum();
+                prop_assert!((row - rhs[i]).abs() <= 1e-9, "row {i}: {row} against {}", rhs[i]);
             }
         }
     }
-    let mut y = vec![0.0; n];
-    for k in (0..n).rev() {
-        let s: f64 = (k + 1..n).map(|c| a[k * n + c] * y[c]).sum();
-        y[k] = (b[k] - s) / a[k * n + k];
+
+    #[test]
+    fn singular_indefinite_or_malformed_systems_have_no_solution() {
+        // rank one
+        assert!(solve_spd(&[1.0, 2.0, 2.0, 4.0], &[1.0, 0.0], 2).is_none());
+        // a zero row and column (a part without a vertical support)
+        assert!(solve_spd(&[1.0, 0.0, 0.0, 0.0], &[1.0, 1.0], 2).is_none());
+        // nearly singular: the second pivot is 1e-14 of the largest entry
+        assert!(solve_spd(&[1.0, 1.0, 1.0, 1.0 + 1e-14], &[1.0, 1.0], 2).is_none());
+        // indefinite
+        assert!(solve_spd(&[1.0, 2.0, 2.0, 1.0], &[1.0, 1.0], 2).is_none());
+        // not a number, wrong sizes, all zero
+        assert!(solve_spd(&[f64::NAN, 0.0, 0.0, 1.0], &[1.0, 1.0], 2).is_none());
+        assert!(solve_spd(&[1.0, 0.0, 0.0], &[1.0, 1.0], 2).is_none());
+        assert!(solve_spd(&[0.0; 4], &[1.0, 1.0], 2).is_none());
+        // a well-conditioned one is solved
+        let y = solve_spd(&[4.0, 2.0, 2.0, 3.0], &[2.0, 1.0], 2).unwrap_or_default();
+        assert!((y[0] - 0.5).abs() < 1e-15 && y[1].abs() < 1e-15, "{y:?}");
     }
-    Some(y)
 }
