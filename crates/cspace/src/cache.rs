@@ -1,4 +1,4 @@
-//! A cache of convex-pair obstacles with construction and hit counters ([A] Table I reports these counts).
+//! A cache of convex-pair obstacles with construction and hit counters (\[A\] Table I reports these counts).
 //!
 //! Key: (moving component index, fixed part index, fixed component index, rotation key). The rotation key is the exact
 //! bit pattern of the rotation matrix, so two rotations share an entry only if they are bit-identical (the planner

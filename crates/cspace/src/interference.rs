@@ -1,8 +1,8 @@
-//! Interference pairs between a moving part and placed parts ([A] eq. 6-8, section 5.1.3).
+//! Interference pairs between a moving part and placed parts (\[A\] eq. 6-8, section 5.1.3).
 //!
 //! A part is a union of convex components; two parts interfere iff some pair of components has overlapping interiors
-//! (touching is not interference, [A] App. A). The list `L` of such pairs at a configuration is what the planner builds
-//! obstacles for.
+//! (touching is not interference, \[A\] App. A). The list `L` of such pairs at a configuration is what the planner
+//! builds obstacles for.
 //!
 //! * **Broad phase**: the world AABBs of all placed components in a parry3d-f64 [`Bvh`] (binned SAH build,
 //!   O(n log n)); the moving component's AABB, enlarged by the clearance and the tolerance, is queried against it.
@@ -440,7 +440,7 @@ impl PlacedScene {
         out
     }
 
-    /// Only the pairs whose interiors overlap by more than the tolerance (the list `L` of [A] eq. 8).
+    /// Only the pairs whose interiors overlap by more than the tolerance (the list `L` of \[A\] eq. 8).
     pub fn penetrating_pairs(&self, moving: &Part, rotation: DMat3, position: DVec3) -> Vec<InterferencePair> {
         let mut v = self.interference_pairs(moving, rotation, position, 0.0);
         v.retain(|p| matches!(p.contact, PairContact::Penetrating { .. }));

@@ -1,12 +1,12 @@
 //! # stackplan-cspace
 //!
-//! Translational configuration-space obstacles of convex component pairs ([A] App. B) and what the planner derives
+//! Translational configuration-space obstacles of convex component pairs (\[A\] App. B) and what the planner derives
 //! from them:
 //!
 //! * [`minkowski`]: `C(A, B) = B (+) (-R A)` by Gauss-map overlay with vertex and face provenance;
-//! * [`offset`]: clearance (mitred plane offset, [A] eq. 10-11), insertion obstacles (`C (+) {-t z}`, [A]
+//! * [`offset`]: clearance (mitred plane offset, \[A\] eq. 10-11), insertion obstacles (`C (+) {-t z}`, \[A\]
 //!   condition 4) and slices at constant `p_z`;
-//! * [`interference`]: interference pairs between placed parts ([A] eq. 6-8): a BVH broad phase and an exact
+//! * [`interference`]: interference pairs between placed parts (\[A\] eq. 6-8): a BVH broad phase and an exact
 //!   separating-axis narrow phase reporting penetrating vs touching;
 //! * [`cache`]: an obstacle cache with construction/hit counters.
 

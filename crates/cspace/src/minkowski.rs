@@ -1,9 +1,9 @@
 //! Translational c-space obstacle of a convex pair: `C(A, B) = B (+) (-R A)` with full provenance.
 //!
-//! Paper: Ayyadevara et al. 2002 ([A]) Appendix B, eq. 12: `C(A, B) = ConvexHull{ V_j^B - R V_i^A }`; [A] VI-A-2 (section
-//! 6.1.2 of the manuscript) asks for both an H-representation and a face-based one. The moving component `A` is placed by
-//! `x -> R x + p`; `p` interferes with the fixed component `B` iff `p` lies in the interior of `C` (touching is not
-//! interference, [A] App. A).
+//! Paper: Ayyadevara et al. 2002 (\[A\]) Appendix B, eq. 12: `C(A, B) = ConvexHull{ V_j^B - R V_i^A }`; \[A\] VI-A-2
+//! (section 6.1.2 of the manuscript) asks for both an H-representation and a face-based one. The moving component `A`
+//! is placed by `x -> R x + p`; `p` interferes with the fixed component `B` iff `p` lies in the interior of `C`
+//! (touching is not interference, \[A\] App. A).
 //!
 //! # Algorithm: overlay of the two Gauss maps
 //!
@@ -87,7 +87,7 @@ pub enum Feature {
 /// What generated a face of the obstacle. Indices refer to the moving polytope `A` (vertices, edges, faces of `A` in
 /// its own coordinates) and the fixed polytope `B`.
 ///
-/// The first three kinds are the generic ones ([A] App. B; DESIGN.md section 3). The last three are the merged faces
+/// The first three kinds are the generic ones (\[A\] App. B; DESIGN.md section 3). The last three are the merged faces
 /// of degenerate configurations (parallel faces, a face parallel to an edge): they are exactly one face of the sum and
 /// name both generating features.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]

@@ -1,6 +1,6 @@
 //! The Gauss-map overlay of two z-prisms turned about `z`: the sheet-metal case of [`crate::minkowski`], exactly.
 //!
-//! Paper: Ayyadevara et al. 2002 ([A]) App. B, eq. 12 (`C(A, B) = ConvexHull{ V_j^B - R V_i^A }`); the overlay of the
+//! Paper: Ayyadevara et al. 2002 (\[A\]) App. B, eq. 12 (`C(A, B) = ConvexHull{ V_j^B - R V_i^A }`); the overlay of the
 //! two normal fans is the one of [`crate::minkowski`] (its module documentation has the algorithm and the tolerance).
 //!
 //! A *z-prism* here is a polytope whose every face normal is either a **side** normal (`z` component exactly 0) or a

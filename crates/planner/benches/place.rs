@@ -1,4 +1,4 @@
-//! End-to-end placement of the scenarios of [A] Figs. 15-17 (Channel and Triangle into a 3-part stack, Complex
+//! End-to-end placement of the scenarios of \[A\] Figs. 15-17 (Channel and Triangle into a 3-part stack, Complex
 //! into a 1-part stack at fixed p_z), 1-degree steps. The stacks are built once, outside the timing.
 //!
 //! Besides criterion's wall-clock figures the bench prints the **on-CPU** median of each scenario (the CPU time of

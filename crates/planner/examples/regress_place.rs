@@ -1,4 +1,4 @@
-//! Prints the placement regression scenarios ([A] Figs. 15-17) as JSON: `cargo run -p stackplan-planner --example
+//! Prints the placement regression scenarios (\[A\] Figs. 15-17) as JSON: `cargo run -p stackplan-planner --example
 //! regress_place --release`.
 //!
 //! For profiling, `regress_place SCENARIO [REPEATS]` builds the one scenario (its stack) and then runs its search

@@ -1,4 +1,4 @@
-//! Interference pairs of the new part at a configuration ([A] eq. 8, section 5.1.3): a broad phase on axis-aligned
+//! Interference pairs of the new part at a configuration (\[A\] eq. 8, section 5.1.3): a broad phase on axis-aligned
 //! boxes and the exact separating-axis narrow phase of `stackplan-cspace` on the complete axis set
 //! (`classify_pair_all_axes`, GJK distance for pairs closer than the clearance).
 //!
@@ -11,7 +11,7 @@
 //!
 //! The broad phase is a linear scan in two levels: the stack components whose boxes meet the whole part's box, then
 //! per moving component those whose boxes meet its own (O(m_stack + m_part m_near) box tests, a few nanoseconds
-//! each; the stacks of [A] have at most a few hundred components); a moving component is translated (or swept)
+//! each; the stacks of \[A\] have at most a few hundred components); a moving component is translated (or swept)
 //! only when some box meets its own. Candidates are returned
 //! in a deterministic order: by violation (deepest first), then by (moving component, stack component).
 

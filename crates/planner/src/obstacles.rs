@@ -1,12 +1,12 @@
 //! The obstacles the search cuts out: the c-space obstacle of one (moving component, stack component) pair at one
-//! orientation ([A] App. B, built by `stackplan-cspace`'s Gauss-map overlay through its [`ObstacleCache`], or
+//! orientation (\[A\] App. B, built by `stackplan-cspace`'s Gauss-map overlay through its [`ObstacleCache`], or
 //! extrapolated within its constant-topology interval by [`crate::interval_obstacles`]), turned
 //! into the half-spaces the search subtracts:
 //!
 //! * plain: the obstacle's face planes `n_k . p <= d_k`;
-//! * with insertion: the insertion obstacle `C (+) {-t z : t >= 0}` ([A] condition 4), whose planes are the faces of
+//! * with insertion: the insertion obstacle `C (+) {-t z : t >= 0}` (\[A\] condition 4), whose planes are the faces of
 //!   `C` that do not face down plus one vertical plane per silhouette edge;
-//! * with clearance `delta`: every plane moved out by `delta` (the mitred offset of [A] eq. 10-11, a superset of the
+//! * with clearance `delta`: every plane moved out by `delta` (the mitred offset of \[A\] eq. 10-11, a superset of the
 //!   exact `delta`-offset).
 //!
 //! Each plane keeps its provenance (the face kind of `C`, or "insertion side") so an active constraint at an optimum

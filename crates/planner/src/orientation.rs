@@ -1,4 +1,4 @@
-//! One discrete orientation of the new part: rotation, the permissible set `Omega` ([A] eq. 3) and the cost as a
+//! One discrete orientation of the new part: rotation, the permissible set `Omega` (\[A\] eq. 3) and the cost as a
 //! separable quadratic (DESIGN.md section 5).
 //!
 //! With `Sigma = {x : a_k . x <= b_k}` and the rotated vertices `R v`,

@@ -1,4 +1,4 @@
-//! The placement QP on one free-space cell ([A] VI-A-1, DESIGN.md section 5): an adapter over
+//! The placement QP on one free-space cell (\[A\] VI-A-1, DESIGN.md section 5): an adapter over
 //! `stackplan-freespace`'s exact active-set solver ([`stackplan_freespace::minimize`], KKT-verified, lexicographic
 //! tie-break "lowest z, then y, then x" when the Hessian is singular, e.g. `w = 0` or `w = 1` in cost (1)).
 //!

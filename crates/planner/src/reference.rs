@@ -1,7 +1,7 @@
 //! Brute-force references for the tests (not used by the search):
 //!
 //! * [`complete_optimum`]: for every orientation, the obstacles of *every* component pair, all subtracted from
-//!   `Omega` ([A] VI-A-3), and the cost minimised over every resulting cell — the "complete c-space" method the seed
+//!   `Omega` (\[A\] VI-A-3), and the cost minimised over every resulting cell — the "complete c-space" method the seed
 //!   compares with (section 5.2). Cells that do not meet an obstacle's interior are kept unsplit. Exponential in the
 //!   number of overlapping obstacles in the worst case: small cases only.
 //! * [`violations`]: an independent all-pairs check of a placement (the narrow phase of `stackplan-cspace` on every

@@ -1,4 +1,4 @@
-//! The placement scenarios of [A] section 7.1 (Figs. 15-17, Tables I-II) for regression runs.
+//! The placement scenarios of \[A\] section 7.1 (Figs. 15-17, Tables I-II) for regression runs.
 //!
 //! * `channel`: a Channel part added to a 3-part Channel stack, 3-D `Omega`;
 //! * `triangle`: a Triangle part added to a 3-part Triangle stack, 3-D `Omega`;
@@ -6,7 +6,7 @@
 //!
 //! The seed gives neither dimensions nor the stacks' poses ("chosen at random"), so the stacks are built here, part
 //! by part, with this crate's own placement: the first part on the floor at the floor's centre turned by 30 degrees,
-//! the next ones placed at the desired position `p_d` (c.g. at the centroid of the first part's base face, [A] 7.1:
+//! the next ones placed at the desired position `p_d` (c.g. at the centroid of the first part's base face, \[A\] 7.1:
 //! "the new part lies at the bottom of the stack") by the same search. Channel parts alternate upright and flipped
 //! (the seed nests them "by flipping alternate parts"); Triangle parts keep one resting pose (they nest as they are).
 //! All parts use the seed's plain triangulation (3, 6 and 79 components). 1-degree steps, no clearance.

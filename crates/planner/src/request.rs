@@ -1,4 +1,4 @@
-//! The inputs of a placement ([A] section II-C, problem (2)): the new part and its candidate orientations, the
+//! The inputs of a placement (\[A\] section II-C, problem (2)): the new part and its candidate orientations, the
 //! stack, the floor volume `Sigma` (or a fixed `p_z`), the clearance, the cost, the insertion option and `k`.
 //!
 //! Validation ([`PlacementRequest::validate`]) is O(size of the floor polygon + number of orientations) and turns every
@@ -50,7 +50,7 @@ impl FloorVolume {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Cost {
-    /// The new part's term of [A] eq. (1) with the rotated part's bounding-box extents and c.g. height
+    /// The new part's term of \[A\] eq. (1) with the rotated part's bounding-box extents and c.g. height
     /// (DESIGN.md section 5): `w [(p_x + x_max - x0)^2 + (p_x + x_min - x0)^2 + (p_y + y_max - y0)^2 +
     /// (p_y + y_min - y0)^2] + 4 (1 - w) (p_z + z_c - z0)^2`.
     Stacking {
@@ -59,7 +59,7 @@ pub enum Cost {
         /// `(x0, y0, z0)`: the centre or a corner of the floor area.
         origin: DVec3,
     },
-    /// The squared distance of the part's c.g. to a desired position ([A] section 7.1).
+    /// The squared distance of the part's c.g. to a desired position (\[A\] section 7.1).
     Target {
         /// Desired c.g. position (mm).
         target: DVec3,
@@ -89,11 +89,12 @@ pub struct PlacementRequest<'a> {
     pub stack: Vec<StackPart<'a>>,
     /// The floor volume `Sigma`.
     pub floor: FloorVolume,
-    /// `Some(z)`: the 2-D permissible set at `p_z = z` ([A] VII-A-2); `None`: the 3-D one.
+    /// `Some(z)`: the 2-D permissible set at `p_z = z` (\[A\] VII-A-2); `None`: the 3-D one.
     pub fixed_z: Option<f64>,
-    /// Minimum distance between the new part's components and the stack's (mm); obstacles grown by it ([A] eq. 10-11).
+    /// Minimum distance between the new part's components and the stack's (mm); obstacles grown by it (\[A\] eq.
+    /// 10-11).
     pub clearance: f64,
-    /// Measure the clearance in the horizontal plane only ([A] VII-B: "the parts are separated in the plane by at
+    /// Measure the clearance in the horizontal plane only (\[A\] VII-B: "the parts are separated in the plane by at
     /// least 5 mm"): each obstacle is grown by a horizontal disc of radius `clearance` (face offsets
     /// `clearance |n_xy|`, mitred), so a part may rest on another while keeping `clearance` sideways. `false`: the
     /// distance in space (every face offset by `clearance`).
@@ -107,7 +108,7 @@ pub struct PlacementRequest<'a> {
     /// Search one period of the part's rotational symmetry about z only (when the theta set allows it).
     pub use_symmetry: bool,
     /// Extrapolate obstacles within their constant-topology intervals instead of constructing each one
-    /// ([`crate::interval_obstacles`], [A] IV-B). Off: every obstacle is constructed (the reference route).
+    /// ([`crate::interval_obstacles`], \[A\] IV-B). Off: every obstacle is constructed (the reference route).
     pub extrapolate: bool,
     /// Largest number of search nodes popped before giving up with [`PlacementError::NodeBudget`] (per partition
     /// of the orientations: each partition counts its own pops).

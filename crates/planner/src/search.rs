@@ -1,7 +1,7 @@
-//! Best-first search over (orientation, free-space cell) nodes: the placement of one part ([A] V-A..C, DESIGN.md
+//! Best-first search over (orientation, free-space cell) nodes: the placement of one part (\[A\] V-A..C, DESIGN.md
 //! section 6).
 //!
-//! A node is an orientation `theta_k`, a convex cell `K` of positions (an H-polytope, [A] VI-A-1) and the optimum
+//! A node is an orientation `theta_k`, a convex cell `K` of positions (an H-polytope, \[A\] VI-A-1) and the optimum
 //! `p*` of the cost over `K` (`f(p*)` is the key). The roots are `(theta_k, Omega(theta_k))`. Loop:
 //!
 //! 1. pop the cheapest node (costs compared rounded to about `1e-12` relative, so that exact ties do not depend
@@ -13,7 +13,7 @@
 //!    component pairs at `(theta_k, p*)` ([`crate::detect`]);
 //! 3. take the first of them (deepest violation first) whose obstacle ([`crate::obstacles`]) contains `p*` in its
 //!    interior by more than the tolerance, and split `K` into the children
-//!    `K n {n_k . p >= d_k} n {n_j . p <= d_j, j < k}` ([A] VI-A-3). Children are pushed *lazily* keyed by a lower
+//!    `K n {n_k . p >= d_k} n {n_j . p <= d_j, j < k}` (\[A\] VI-A-3). Children are pushed *lazily* keyed by a lower
 //!    bound of their cost: the largest of the parent's cost, the minimum of the cost over the half-space
 //!    `n_k . p >= d_k` alone (closed form, [`Quadratic::halfspace_lower_bound`]) and the bound that the parent's
 //!    optimality conditions give over the part of `K` beyond that plane ([`Quadratic::lower_bound_beyond`]: it grows
@@ -25,11 +25,11 @@
 //!    the cheapest are never solved. The keys only decide *when* a pending child is solved, never the order of the
 //!    solved nodes (a total order by (cost, orientation, id) that a valid lower bound cannot overtake), so the
 //!    search pops the same solved nodes in the same order as with the parent's cost as key;
-//! 4. if there is none, `p*` is free: it is the next placement (one per cell, in cost order, [A] VI-A-4).
+//! 4. if there is none, `p*` is free: it is the next placement (one per cell, in cost order, \[A\] VI-A-4).
 //!
 //! **Exactness.** The children cover `K` minus the obstacle's interior and each lies in `K`, so no child costs less
 //! than its parent; a position is free iff it lies in no pair's obstacle interior. Hence the first free optimum popped
-//! is the minimum of the cost over the free positions of all discrete orientations ([A] eq. 9 and section 5.3); the
+//! is the minimum of the cost over the free positions of all discrete orientations (\[A\] eq. 9 and section 5.3); the
 //! next pops give the next best cells. Orientations whose root is never popped before the `k`-th solution are never
 //! expanded, and only the obstacles of pairs met at popped optima are built.
 //!
@@ -47,21 +47,21 @@
 //!
 //! **Partitions** ([`PlacementRequest::partitions`] = `P`, default 2). Every node belongs to one orientation, and
 //! what the loop learns is per orientation (the known obstacles, the derived obstacles, the found points), so the
-//! orientations are split into `P` fixed partitions, blocks of [`LANE_BLOCK`] consecutive orientations dealt
-//! round-robin ([`lane_of`]; `P` is a number of the request, never the thread count), and each partition runs the
+//! orientations are split into `P` fixed partitions, blocks of `LANE_BLOCK` consecutive orientations dealt
+//! round-robin (`lane_of`; `P` is a number of the request, never the thread count), and each partition runs the
 //! loop above on its own state: heap, node ids, obstacle table and known obstacles, derived obstacles, the
 //! constant-topology structures ([`IntervalObstacles`]), the carried frontier and the detection's scratch
-//! ([`Search`] and [`RunState`] per partition; the obstacle cache is shared, it is `Sync` and a pure function). The
+//! (`Search` and `RunState` per partition; the obstacle cache is shared, it is `Sync` and a pure function). The
 //! placements are merged in the heap's total order (rounded cost, orientation, id; the orientations of two
 //! partitions differ, so the ids of two partitions are never compared): the next placement of the whole search is
 //! the cheapest of the partitions' next placements, and it is known once every other partition's next key pops
 //! after it. Each partition keeps the placements it found but the merge has not returned (a look-ahead queue, at
-//! most [`LOOK_AHEAD`]), which a later call returns first; a cost limit
+//! most `LOOK_AHEAD`), which a later call returns first; a cost limit
 //! ([`PlacementSearch::next_placements_within`]) stops each partition at its own keys. So the placements, their
 //! order and their values are the sequential loop's over the same obstacles, and the first placement of every
 //! search is the exact optimum.
 //!
-//! *Rounds and determinism.* The partitions advance in rounds on rayon, each at most [`ROUND_POPS`] pops: a
+//! *Rounds and determinism.* The partitions advance in rounds on rayon, each at most `ROUND_POPS` pops: a
 //! partition without a found placement whose next key pops before the best found one (of any partition, fixed at the
 //! round's start) searches on up to that key; the others, while one such partition runs, look ahead for their next
 //! placements (the caller often asks for more: the stacking planner rejects candidates; the work stays in the carried
@@ -154,7 +154,7 @@ impl Placement {
     }
 }
 
-/// Counters and timings of a search, as [A] Tables I-II.
+/// Counters and timings of a search, as \[A\] Tables I-II.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct PlacementStats {
     /// Resting poses x theta values asked for.
@@ -644,7 +644,7 @@ impl FrontierSignature {
     /// Whether a frontier searched under `self` can be continued under `next`: the same cost and fixed height, and
     /// `self`'s floor volume inside `next`'s (the same height; every corner of the old polygon inside the new one),
     /// so every old cell lies in the new permissible set and only the difference needs new cells
-    /// ([`Search::widen`]).
+    /// (`Search::widen`).
     fn continues_into(&self, next: &Self) -> bool {
         self.fixed_z == next.fixed_z
             && self.cost == next.cost
@@ -674,7 +674,7 @@ impl SearchCaches {
     /// Empty caches that also carry each [`PlacementSearch`]'s state, when it is dropped, to the next search with the
     /// same fixed height and cost and a floor volume that contains its floor, into the grown stack: that search
     /// starts from the open cells and the cells found free of the earlier one (and the new strip of a grown floor,
-    /// [`Search::widen`]) instead of the roots. Its first placement is the same exact optimum; the later ones are one
+    /// `Search::widen`) instead of the roots. Its first placement is the same exact optimum; the later ones are one
     /// per cell of a different partition of the free space, so they can differ from a fresh search's, as can the
     /// counters (a carried search evaluates only pairs no earlier search did). The stacking planner uses these.
     pub fn carrying_frontiers() -> Self {
@@ -1033,7 +1033,7 @@ impl<'r, 'a, 'c> PlacementSearch<'r, 'a, 'c> {
     /// (fewer returned, `exhausted` = [`NoPlacement::CostLimit`]) as soon as every open node's key exceeds
     /// `max_cost`; the keys are lower bounds of the costs of every placement still to come, so none of those costs
     /// `max_cost` or less. The placements returned are those of [`Self::next_placements`] up to the first dearer
-    /// than `max_cost` (to the keys' rounding, [`quantised_cost`]: one may cost up to `2^-40` relative more), and a
+    /// than `max_cost` (to the keys' rounding, `quantised_cost`: one may cost up to `2^-40` relative more), and a
     /// later call, with any limit, continues exactly where this one stopped. Use: a caller that needs only
     /// placements cheaper than one it already has (the stacking planner's stage 2 against stage 1's part).
     pub fn next_placements_within(&mut self, more: usize, max_cost: f64) -> Result<PlacementResult, PlacementError> {
@@ -1158,7 +1158,7 @@ fn start_all<const D: usize>(
     Ok(states.iter().any(|s| !s.heap.is_empty()).then_some(states))
 }
 
-/// Every partition's carried state reopened and widened ([`Search::widen`]).
+/// Every partition's carried state reopened and widened (`Search::widen`).
 fn widen_all<const D: usize>(
     searches: &mut [Search<'_, '_>],
     states: Vec<RunState<D>>,
@@ -1275,7 +1275,7 @@ impl Search<'_, '_> {
     /// A carried state ([`SearchCaches::carrying_frontiers`]) widened from the floor volume `old` (inside the
     /// request's) to the request's: its cells lie in the old permissible set, so the difference
     /// `Omega_new(theta) \ Omega_old(theta)` of every orientation is added as new roots, split as a subtraction
-    /// ([A] VI-A-3 with `Omega_old` as the convex set taken away): child `j` is `Omega_new` with `Omega_old`'s
+    /// (\[A\] VI-A-3 with `Omega_old` as the convex set taken away): child `j` is `Omega_new` with `Omega_old`'s
     /// half-space `j` reversed and those before it kept (tagged as cuts, not as floor sides). Sides the two sets
     /// share give no child. O(orientations x sides) cells and QPs, in parallel.
     fn widen<const D: usize>(
@@ -1706,7 +1706,7 @@ impl Search<'_, '_> {
         Ok(id)
     }
 
-    /// The children of a cell cut by obstacle `id` ([A] VI-A-3): child `k` adds `n_k . p >= d_k` and `n_j . p <= d_j`
+    /// The children of a cell cut by obstacle `id` (\[A\] VI-A-3): child `k` adds `n_k . p >= d_k` and `n_j . p <= d_j`
     /// for `j < k` ([`Search::child_inequalities`]); here only each child's outside half-space and face index. The
     /// children are built and solved lazily.
     fn split<const D: usize>(

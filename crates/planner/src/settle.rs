@@ -1,8 +1,8 @@
 //! Settling a released part: the vertical drop from the position the search found, where the robot releases the
-//! part, to where it comes to rest ([A] VII-B; DESIGN.md section 7).
+//! part, to where it comes to rest (\[A\] VII-B; DESIGN.md section 7).
 //!
 //! **Why.** With the seed's clearance for robot positioning error ("the parts are separated in the plane by at least
-//! 5 mm", [A] VII-B, grown as in eq. 10-11) an obstacle face of unit normal `n` moves out by `delta |n_xy|`. A
+//! 5 mm", \[A\] VII-B, grown as in eq. 10-11) an obstacle face of unit normal `n` moves out by `delta |n_xy|`. A
 //! horizontal face does not move, so a part resting on a flat top rests exactly; an upward-facing *inclined* face
 //! (the walls a Triangle part nests on) is lifted by `delta |n_xy| / n_z`, and the search's optimum floats that
 //! far above its support. That is where the robot lets go; the part then drops straight down until it touches.
@@ -10,7 +10,7 @@
 //! drop (the release height above it).
 //!
 //! **The drop.** For the moving component `A_i` and a stack component `B_j` with zero-clearance c-space obstacle
-//! `C_ij = {n_k . p <= d_k}` ([A] App. B, from the shared [`ObstacleCache`]), the downward ray `q(s) = p - s z`
+//! `C_ij = {n_k . p <= d_k}` (\[A\] App. B, from the shared [`ObstacleCache`]), the downward ray `q(s) = p - s z`
 //! lies in the interior of `C_ij` (by more than the tolerance, the search's test) iff for every face
 //! `n_k . p - s n_{k,z} < d_k - tol`: a lower bound on `s` for faces with `n_{k,z} > 0`, an upper bound for
 //! `n_{k,z} < 0`, a fixed test for vertical faces. The ray enters at `s_ij = max(0, max lower bounds)` when that is

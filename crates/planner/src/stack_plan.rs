@@ -1,10 +1,11 @@
-//! The stacking planner for n identical parts ([A] section II-B, "generate and test"; DESIGN.md sections 6-7).
+//! The stacking planner for n identical parts (\[A\] section II-B, "generate and test"; DESIGN.md sections 6-7).
 //!
 //! Parts are added one at a time; the parts already placed never move. For each new part:
 //!
 //! 1. candidate orientations: the part's stable resting poses that present an upward face holding the suction cup
-//!    ([`stackplan_stability::resting_poses`], [`stackplan_stability::grasp`]; at most
-//!    [`PlanOptions::max_resting_poses`], lowest c.g. first) x the discrete theta set;
+//!    ([`stackplan_stability::resting_poses`](fn@stackplan_stability::resting_poses),
+//!    [`stackplan_stability::grasp`]; at most [`PlanOptions::max_resting_poses`], lowest c.g. first) x the discrete
+//!    theta set;
 //! 2. the best-first placement search ([`crate::search::PlacementSearch`]) gives interference-free positions one at
 //!    a time in the order of the part's term of cost (1), one per free-space cell, up to
 //!    [`PlanOptions::candidates`] per stage (the search stops at the first that passes step 3, so later ones are
@@ -52,8 +53,8 @@ pub struct PlanOptions {
     pub w: f64,
     /// `(x0, y0, z0)` of cost (1); `None`: the floor polygon's centroid at `z0 = 0`.
     pub origin: Option<DVec3>,
-    /// Horizontal clearance between parts (mm), for the robot's positioning error ([A] eq. 10-11; "separated in the
-    /// plane by at least 5 mm", [A] VII-B); parts may still rest on each other.
+    /// Horizontal clearance between parts (mm), for the robot's positioning error (\[A\] eq. 10-11; "separated in the
+    /// plane by at least 5 mm", \[A\] VII-B); parts may still rest on each other.
     pub clearance: f64,
     /// Step of the discrete rotation about z (radians).
     pub dtheta: f64,
@@ -660,7 +661,7 @@ mod tests {
         assert_eq!(&repeated.parts[..3], &once.parts[..3]);
     }
 
-    /// The Triangle part with the seed's 5 mm horizontal clearance nests ([A] Fig. 19): the search's position floats
+    /// The Triangle part with the seed's 5 mm horizontal clearance nests (\[A\] Fig. 19): the search's position floats
     /// above the first part's inclined walls (the clearance lifts them), and the part drops onto them.
     #[test]
     fn triangle_parts_with_clearance_drop_into_the_nest() {

@@ -1,4 +1,4 @@
-//! Rotational symmetry of a part about the vertical axis through its c.g. in a resting pose ([A] VII-C names the
+//! Rotational symmetry of a part about the vertical axis through its c.g. in a resting pose (\[A\] VII-C names the
 //! missing speed-up: "symmetry of parts is not exploited").
 //!
 //! Let `X` be the part's components rotated into the resting pose and `S` the rotation by `2 pi / k` about the

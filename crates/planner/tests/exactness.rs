@@ -1,4 +1,4 @@
-//! Exactness of the best-first search against brute force ([A] eq. 9): the complete obstacle of every pair at every
+//! Exactness of the best-first search against brute force (\[A\] eq. 9): the complete obstacle of every pair at every
 //! orientation subtracted from Omega, minimised over every cell; a dense sample of positions checked pair by pair;
 //! every returned placement checked by an independent all-pairs test.
 

@@ -1,4 +1,4 @@
-//! The planner's obstacles through constant-topology intervals ([A] IV-B, `interval_obstacles`): every extrapolated
+//! The planner's obstacles through constant-topology intervals (\[A\] IV-B, `interval_obstacles`): every extrapolated
 //! obstacle equals the one constructed from scratch at its angle (same structure and provenance, coordinates within
 //! 1e-9 relative), and searches with extrapolation find what searches that construct every obstacle find.
 

@@ -1,4 +1,4 @@
-//! The search at a fixed `p_z` (the seed's 2-D `Omega`, [A] VI-A and 7.1.2) against brute force: a dense grid of
+//! The search at a fixed `p_z` (the seed's 2-D `Omega`, \[A\] VI-A and 7.1.2) against brute force: a dense grid of
 //! positions `(x, y, fixed_z)` inside the 2-D permissible set of every orientation, each checked for penetration
 //! pair by pair (`stackplan-cspace`'s all-pairs narrow phase, independent of the search's obstacles and cells). No
 //! free sample may beat the search's optimum; when the search finds nothing, no sample may be free; every returned

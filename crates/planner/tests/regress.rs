@@ -1,4 +1,4 @@
-//! The scenarios of [A] Figs. 15-17: the Triangle part nests, every placement is valid, statistics are recorded.
+//! The scenarios of \[A\] Figs. 15-17: the Triangle part nests, every placement is valid, statistics are recorded.
 
 use stackplan_planner::reference::violations;
 use stackplan_planner::regress::{run, scenario};
