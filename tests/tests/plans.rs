@@ -171,6 +171,27 @@ fn plans_do_not_depend_on_the_thread_count() {
     assert_eq!(without_timings(a), without_timings(b));
 }
 
+#[test]
+fn the_search_partitions_are_recorded_and_keep_the_first_placement_optimal() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let one = read_json(&small_plan(dir.path(), "p1", "4", &["--search-partitions", "1"]).join("plan.json"));
+    let three = read_json(&small_plan(dir.path(), "p3", "4", &["--search-partitions", "3"]).join("plan.json"));
+    assert_eq!(one["plan"]["options"]["partitions"], 1);
+    assert_eq!(three["plan"]["options"]["partitions"], 3);
+    for plan in [&one, &three] {
+        assert_eq!(plan["placements"].as_array().map(Vec::len), Some(4), "{}", plan["plan"]);
+    }
+    // the first placement of a search is the exact optimum whatever the partitions
+    let cost = |v: &Value| v["placements"][0]["cost"].as_f64().expect("a cost");
+    assert!((cost(&one) - cost(&three)).abs() <= 1e-9 * cost(&one).abs().max(1.0), "{} {}", cost(&one), cost(&three));
+    for bad in ["0", "65"] {
+        let o = run_in(dir.path(), &["plan", "example:channel", "--search-partitions", bad, "--out", "bad"]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(stderr(&o).contains("--search-partitions must lie in 1..=64"), "{}", stderr(&o));
+        assert!(!dir.path().join("bad").exists());
+    }
+}
+
 /// The Chromium binary: `$CHROMIUM`, else `/usr/bin/chromium`, if it exists.
 fn chromium() -> Option<PathBuf> {
     let candidate = std::env::var_os("CHROMIUM").map(PathBuf::from).unwrap_or_else(|| "/usr/bin/chromium".into());

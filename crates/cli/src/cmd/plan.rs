@@ -60,6 +60,11 @@ pub struct PlannerArgs {
     /// Split concave sheet-metal faces by plain triangulation (the seed's component counts).
     #[arg(long)]
     pub triangulate: bool,
+    /// Partitions of the placement search's orientations, searched in parallel (1 to 64; 1 is the sequential
+    /// search). The first placement of every search is the exact optimum for any number; the plan depends on this
+    /// number (ties and the open cells carried between searches), never on the thread count.
+    #[arg(long, default_value_t = stackplan::planner::request::DEFAULT_PARTITIONS)]
+    pub search_partitions: usize,
 }
 
 fn parse_floor(s: &str) -> anyhow::Result<[f64; 4]> {
@@ -88,6 +93,13 @@ impl PlannerArgs {
         if self.count == 0 {
             bail!("--count must be at least 1");
         }
+        if !(1..=stackplan::planner::request::MAX_PARTITIONS).contains(&self.search_partitions) {
+            bail!(
+                "--search-partitions must lie in 1..={}, got {}",
+                stackplan::planner::request::MAX_PARTITIONS,
+                self.search_partitions
+            );
+        }
         if !(self.dtheta_deg > 0.0 && self.dtheta_deg <= 360.0) {
             bail!("--dtheta-deg must lie in (0, 360], got {}", self.dtheta_deg);
         }
@@ -111,6 +123,7 @@ impl PlannerArgs {
         options.mu = self.mu;
         options.cup_diameter = self.cup_diameter;
         options.candidates = self.candidates;
+        options.partitions = self.search_partitions;
         // (the repeated search never asks for fewer than the user's own candidate count)
         options.max_candidates = options.max_candidates.max(self.candidates);
         Ok(options)
