@@ -214,6 +214,17 @@ pub enum PlanError {
     /// The part has no stable resting pose.
     #[error("the part has no stable resting pose: {0}")]
     NoRestingPose(String),
+    /// The part rests stably, but no resting pose presents an upward face that holds the suction cup.
+    #[error(
+        "none of the part's {poses} stable resting poses presents an upward face that holds a {cup_diameter} mm \
+         suction cup; a smaller cup diameter may fit"
+    )]
+    NoGraspablePose {
+        /// Number of stable resting poses the part has.
+        poses: usize,
+        /// The cup diameter asked for (mm).
+        cup_diameter: f64,
+    },
     /// The placement search failed.
     #[error(transparent)]
     Placement(#[from] PlacementError),
@@ -293,11 +304,7 @@ pub fn plan_stack_with_progress(
         .map(|p| p.rotation)
         .collect();
     if rests.is_empty() {
-        return Err(PlanError::NoRestingPose(format!(
-            "none of the {} stable resting poses presents an upward face that holds a {} mm suction cup",
-            poses.len(),
-            options.cup_diameter
-        )));
+        return Err(PlanError::NoGraspablePose { poses: poses.len(), cup_diameter: options.cup_diameter });
     }
     let origin = options.origin.unwrap_or_else(|| options.floor.centre());
     let check_options = CheckOptions {
@@ -702,6 +709,22 @@ mod tests {
             plan_stack(&part, &options(0, 0.5, FloorVolume::rectangle(0.0, 0.0, 1.0, 1.0, 1.0))),
             Err(PlanError::BadOption(_))
         ));
+    }
+
+    #[test]
+    fn a_cup_wider_than_every_upward_face_is_a_typed_error() {
+        // a 4 mm cube: every face is 4 x 4 mm, so a 10 mm cup fits on none of its 6 resting poses, a 3 mm cup on all
+        let part = block(4.0, 4.0, 4.0);
+        let floor = FloorVolume::rectangle(-20.0, -20.0, 20.0, 20.0, 20.0);
+        let error = plan_stack(&part, &options(2, 0.5, floor.clone())).err();
+        assert!(
+            matches!(error, Some(PlanError::NoGraspablePose { poses: 6, cup_diameter }) if cup_diameter == 10.0),
+            "{error:?}"
+        );
+        let message = error.map(|e| e.to_string()).unwrap_or_default();
+        assert!(message.contains("6 stable resting poses") && message.contains("10 mm"), "{message}");
+        let plan = plan_stack(&part, &PlanOptions { cup_diameter: 3.0, ..options(2, 0.5, floor) }).expect("plan");
+        assert_eq!(plan.parts.len(), 2);
     }
 
     #[test]
