@@ -134,6 +134,10 @@ pub(crate) fn vertical_arcs(
         });
     }
     out.clear();
+    // `s` depends on `|d.z|` alone (`d.z * d.z` is exact in sign), and every vertical edge of a z-prism has the same
+    // `|d.z|`: the square root and the division (long latency) are taken once per distinct `|d.z|` (bit for bit the
+    // same `s`)
+    let (mut last_abs, mut last_s) = (u64::MAX, f64::NAN);
     for (k, e) in p.edges().iter().enumerate() {
         let [f0, f1] = e.faces;
         let d = vertices[e.vertices[1]] - vertices[e.vertices[0]];
@@ -146,7 +150,11 @@ pub(crate) fn vertical_arcs(
                 // `s = 1 / sqrt((0 * 0 + 0 * 0) + dz * dz)`, whose x and y are `±0` exactly when `s` is finite (else
                 // NaN: refused); then `cz` is finite or NaN, and `w * cz` is the general route's test value up to
                 // exact zeros
-                let s = (d.z * d.z).sqrt().recip();
+                let abs = d.z.abs().to_bits();
+                if abs != last_abs {
+                    (last_abs, last_s) = (abs, (d.z * d.z).sqrt().recip());
+                }
+                let s = last_s;
                 if !s.is_finite() {
                     return false;
                 }
@@ -615,6 +623,36 @@ mod tests {
         let vertices = unit.vertices().iter().map(|v| *v * s).collect();
         let planes = unit.planes().map(|p| stackplan_geom::Plane { normal: p.normal, offset: p.offset * s }).collect();
         unit.with_geometry(vertices, planes).expect("same topology")
+    }
+
+    #[test]
+    fn vertical_arcs_reuse_the_circle_only_for_equal_heights() {
+        // every vertical arc's circle is the general route's (`d * (1 / sqrt(d.z * d.z))`, z component), whether its
+        // `1 / sqrt` was computed for this edge or reused from an earlier edge of the same `|d.z|`; the scaled boxes
+        // reach the edges of the exponent range
+        let hex = [(0.0, 0.0), (60.0, 0.0), (90.0, 30.0), (80.0, 70.0), (20.0, 80.0), (-10.0, 40.0)];
+        let shapes = [
+            prism(&hex, 0.0, 2.0, 2),
+            prism(&hex, -0.3, 0.1, 2),
+            ConvexPolytope::cuboid(DVec3::new(-1.0, 0.5, 0.0), DVec3::new(4.0, 5.0, 6.0)).expect("box"),
+            scaled(1e150),
+            scaled(1e-150),
+        ];
+        for r in [DMat3::IDENTITY, DMat3::from_rotation_z(0.3), DMat3::from_rotation_z(-2.0)] {
+            for p in &shapes {
+                let points: Vec<DVec3> = p.vertices().iter().map(|v| -(r * *v)).collect();
+                let normals: Vec<DVec3> = p.faces().iter().map(|f| -(r * f.plane.normal).normalize()).collect();
+                let (mut classes, mut arcs, mut wide) = (Vec::new(), Vec::new(), false);
+                assert!(super::vertical_arcs(p, &points, &normals, &mut classes, &mut arcs, &mut wide));
+                assert!(arcs.len() >= 4);
+                for arc in &arcs {
+                    let [v0, v1] = p.edges()[arc.edge].vertices;
+                    let d = points[v1] - points[v0];
+                    let cz = d.z * (d.z * d.z).sqrt().recip();
+                    assert!(arc.cz.to_bits() == cz.to_bits() || arc.cz.to_bits() == (-cz).to_bits(), "{p:?}");
+                }
+            }
+        }
     }
 
     #[test]
