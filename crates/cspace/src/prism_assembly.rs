@@ -57,24 +57,27 @@ const TWIN: usize = 1;
 const VERTICAL: usize = 2;
 
 /// The obstacle vertex of the vertex pair `[i, j]`, numbered on first appearance exactly as the general assembly
-/// (`minkowski::assemble`) numbers them: `b[j] - ra[i]`.
+/// (`minkowski::assemble`) numbers them (its coordinates, `b[j] - ra[i]`, are computed after the numbering pass).
 #[inline(always)]
-fn number(
-    [i, j]: [usize; 2],
-    index_of: &mut [u32],
-    nb: usize,
-    bv: &[DVec3],
-    ra: &[DVec3],
-    vertices: &mut Vec<DVec3>,
-    vertex_pairs: &mut Vec<[usize; 2]>,
-) -> usize {
+fn number([i, j]: [usize; 2], index_of: &mut [u32], nb: usize, vertex_pairs: &mut Vec<[usize; 2]>) -> usize {
     let slot = &mut index_of[i * nb + j];
     if *slot == u32::MAX {
-        *slot = vertices.len() as u32;
-        vertices.push(bv[j] - ra[i]);
+        *slot = vertex_pairs.len() as u32;
         vertex_pairs.push([i, j]);
     }
     *slot as usize
+}
+
+/// The largest `normal . v` over the corners `face` in cycle order (`f64::max` from `-inf`): the general assembly's
+/// offset, bit for bit; `None` when a corner is not a vertex. Kept out of line so that the running maximum stays in a
+/// register (inlined into [`assemble`] it was kept on the stack, a store-to-load chain per corner).
+#[inline(never)]
+fn face_offset(normal: DVec3, face: &[usize], vertices: &[DVec3]) -> Option<f64> {
+    let mut offset = f64::NEG_INFINITY;
+    for &v in face {
+        offset = offset.max(normal.dot(*vertices.get(v)?));
+    }
+    Some(offset)
 }
 
 /// The obstacle of a tame z-prism pair from the face cycles of `z_prism::derived_cycles` (face `s` is the vertex-pair
@@ -118,7 +121,6 @@ pub(crate) fn assemble(
     let (stars, prev) = (&mut stars[..nv], &mut prev[..nv]);
     stars.fill([EMPTY; 3]);
     prev.fill(u32::MAX);
-    let mut vertices: Vec<DVec3> = Vec::with_capacity(nv);
     let mut vertex_pairs: Vec<[usize; 2]> = Vec::with_capacity(nv);
     let mut faces: Vec<Face> = Vec::with_capacity(specs.len());
     let mut kinds: Vec<FaceKind> = Vec::with_capacity(specs.len());
@@ -130,7 +132,7 @@ pub(crate) fn assemble(
             // a pole face: every half-edge `a -> b` is filed under its source
             let mut face = Vec::with_capacity(corners.len());
             for &c in corners {
-                face.push(number(c, index_of, nb, bv, ra, &mut vertices, &mut vertex_pairs));
+                face.push(number(c, index_of, nb, &mut vertex_pairs));
             }
             let &last = face.last()?;
             let mut a = last;
@@ -151,7 +153,7 @@ pub(crate) fn assemble(
             let &[c0, c1, c2, c3] = corners else { return None };
             let mut v = [0; 4];
             for (v, c) in v.iter_mut().zip([c0, c1, c2, c3]) {
-                *v = number(c, index_of, nb, bv, ra, &mut vertices, &mut vertex_pairs);
+                *v = number(c, index_of, nb, &mut vertex_pairs);
             }
             let k = usize::from(b_levels[c0[1]] != b_levels[c1[1]]);
             for q in 0..4 {
@@ -166,19 +168,24 @@ pub(crate) fn assemble(
             }
             v.to_vec()
         };
-        if vertices.len() > nv || face.len() < 3 {
+        if vertex_pairs.len() > nv || face.len() < 3 {
             return None;
         }
-        // the offset exactly as the general assembly: the largest `n . v`, corners in cycle order
-        let mut offset = f64::NEG_INFINITY;
-        for &v in &face {
-            offset = offset.max(spec.normal.dot(vertices[v]));
-        }
-        faces.push(Face { vertices: face, plane: Plane { normal: spec.normal, offset } });
+        // (the offset is set below, once the vertices are known)
+        faces.push(Face { vertices: face, plane: Plane { normal: spec.normal, offset: f64::NEG_INFINITY } });
         kinds.push(FaceKind::from_features(spec.fixed, spec.moving).unwrap_or(FaceKind::Unclassified));
     }
-    if vertices.len() != nv {
+    if vertex_pairs.len() != nv {
         return None;
+    }
+    // the vertices `b[j] - ra[i]` and the offsets exactly as the general assembly (the largest `n . v`, corners in
+    // cycle order), in passes of their own (fewer live values in the numbering pass)
+    let mut vertices: Vec<DVec3> = Vec::with_capacity(nv);
+    for &[i, j] in &vertex_pairs {
+        vertices.push(*bv.get(j)? - *ra.get(i)?);
+    }
+    for face in &mut faces {
+        face.plane.offset = face_offset(face.plane.normal, &face.vertices, &vertices)?;
     }
     let (stars, prev) = (&*stars, &*prev);
     let mut edges: Vec<Edge> = Vec::with_capacity(total / 2);
