@@ -68,6 +68,49 @@ fn number([i, j]: [usize; 2], index_of: &mut [u32], nb: usize, vertex_pairs: &mu
     *slot as usize
 }
 
+/// geom's edge table from the half-edges filed under every vertex (`stars`, `prev` as in [`Scratch`]; `total`
+/// half-edges, `face_count` faces): one pass over the vertices in increasing order emitting each vertex's edges to
+/// larger vertices, with the checks of the module documentation (else `None`). Kept out of line (fewer live values,
+/// fewer spills in [`assemble`]).
+#[inline(never)]
+fn edge_table(stars: &[[Half; 3]], prev: &[u32], total: usize, face_count: usize) -> Option<(Vec<Edge>, Vec<usize>)> {
+    let mut edges: Vec<Edge> = Vec::with_capacity(total / 2);
+    // (with room for the faces' starts, which geom keeps in the same buffer)
+    let mut face_edges = Vec::with_capacity(total + face_count + 1);
+    face_edges.resize(total, 0usize);
+    for (lo, (&[p, t, d], &pp)) in stars.iter().zip(prev).enumerate() {
+        // `prev` is a permutation (`pole` filled for every vertex), so `pp` is a vertex
+        let (pn, vt, me) = (p.other, d.other, lo as u32);
+        let (Some(&[pp_pole, pp_twin, _]), Some(&[_, _, down])) = (stars.get(pp as usize), stars.get(vt as usize))
+        else {
+            return None;
+        };
+        if t.other != pn || pp_twin.other != me || down.other != me || pn == pp || pn == vt || pp == vt || pn == me {
+            return None;
+        }
+        // (larger vertex, forward half-edge, reverse half-edge); the side half-edge `lo -> pp` is filed under `pp`
+        let mut up = [(pn, p, t), (pp, pp_twin, pp_pole), (vt, d, down)];
+        if up[0].0 > up[1].0 {
+            up.swap(0, 1);
+        }
+        if up[1].0 > up[2].0 {
+            up.swap(1, 2);
+        }
+        if up[0].0 > up[1].0 {
+            up.swap(0, 1);
+        }
+        for (hi, forward, reverse) in up {
+            if hi > me {
+                let e = edges.len();
+                edges.push(Edge { vertices: [lo, hi as usize], faces: [forward.face as usize, reverse.face as usize] });
+                face_edges[forward.index as usize] = e;
+                face_edges[reverse.index as usize] = e;
+            }
+        }
+    }
+    Some((edges, face_edges))
+}
+
 /// The largest `normal . v` over the corners `face` in cycle order (`f64::max` from `-inf`): the general assembly's
 /// offset, bit for bit; `None` when a corner is not a vertex. Kept out of line so that the running maximum stays in a
 /// register (inlined into [`assemble`] it was kept on the stack, a store-to-load chain per corner).
@@ -187,41 +230,7 @@ pub(crate) fn assemble(
     for face in &mut faces {
         face.plane.offset = face_offset(face.plane.normal, &face.vertices, &vertices)?;
     }
-    let (stars, prev) = (&*stars, &*prev);
-    let mut edges: Vec<Edge> = Vec::with_capacity(total / 2);
-    // (with room for the faces' starts, which geom keeps in the same buffer)
-    let mut face_edges = Vec::with_capacity(total + faces.len() + 1);
-    face_edges.resize(total, 0usize);
-    for (lo, (&[p, t, d], &pp)) in stars.iter().zip(prev).enumerate() {
-        // `prev` is a permutation (`pole` filled for every vertex), so `pp` is a vertex
-        let (pn, vt, me) = (p.other, d.other, lo as u32);
-        let (Some(&[pp_pole, pp_twin, _]), Some(&[_, _, down])) = (stars.get(pp as usize), stars.get(vt as usize))
-        else {
-            return None;
-        };
-        if t.other != pn || pp_twin.other != me || down.other != me || pn == pp || pn == vt || pp == vt || pn == me {
-            return None;
-        }
-        // (larger vertex, forward half-edge, reverse half-edge); the side half-edge `lo -> pp` is filed under `pp`
-        let mut up = [(pn, p, t), (pp, pp_twin, pp_pole), (vt, d, down)];
-        if up[0].0 > up[1].0 {
-            up.swap(0, 1);
-        }
-        if up[1].0 > up[2].0 {
-            up.swap(1, 2);
-        }
-        if up[0].0 > up[1].0 {
-            up.swap(0, 1);
-        }
-        for (hi, forward, reverse) in up {
-            if hi > me {
-                let e = edges.len();
-                edges.push(Edge { vertices: [lo, hi as usize], faces: [forward.face as usize, reverse.face as usize] });
-                face_edges[forward.index as usize] = e;
-                face_edges[reverse.index as usize] = e;
-            }
-        }
-    }
+    let (edges, face_edges) = edge_table(stars, prev, total, faces.len())?;
     let f = faces.len();
     if nv + f != edges.len() + 2 {
         return None;
