@@ -209,7 +209,7 @@ pub(crate) fn assemble(
                 }
                 *slot = Half { other: other as u32, index, face: face_index };
             }
-            v.to_vec()
+            vec![v[0], v[1], v[2], v[3]]
         };
         if vertex_pairs.len() > nv || face.len() < 3 {
             return None;
