@@ -11,8 +11,9 @@
 //! * **from its pole's predecessor**: `prev(v) -> v` likewise (the same kind of edge, seen from its other end);
 //! * **vertical**: `v -> partner(v)` in one side face, `partner(v) -> v` in the adjacent one.
 //!
-//! So one pass over the faces (in the general route's order, numbering the vertex pairs on first appearance and taking
-//! every face's offset as the general assembly does) files each half-edge under the vertex that names it: a pole
+//! So one pass over the faces (in the general route's order, numbering the vertex pairs on first appearance as the
+//! general assembly does; the vertices and every face's offset, the general assembly's arithmetic in its order, follow
+//! in passes of their own) files each half-edge under the vertex that names it: a pole
 //! face's half-edge under its source (`pole`), a side face's horizontal half-edge under its *target* (`twin`: its
 //! reverse is that vertex's pole half-edge), a side face's vertical half-edge under its source (`vertical`). Then one
 //! pass over the vertices in increasing order emits each vertex's edges to larger vertices (at most three, sorted):
