@@ -80,6 +80,15 @@ fn request_for<'a>(sc: &'a Scenario, part: &'a Part, stack: &[Pose], rest: DMat3
     req
 }
 
+impl Scenario {
+    /// The scenario's placement request: its part onto its stack in its resting pose, 1-degree steps of theta, the
+    /// cost of distance to its target, its fixed height if any (the request [`run`] searches; callers change `k`,
+    /// partitions and the like on it).
+    pub fn request(&self) -> PlacementRequest<'_> {
+        request_for(self, &self.part, &self.stack, self.rest)
+    }
+}
+
 /// Builds the named scenario (one of [`SCENARIOS`]) with its stack. `None` for an unknown name.
 pub fn scenario(name: &str) -> Result<Option<Scenario>, PlacementError> {
     let (ex, stack_len, alternate, fixed) = match name {
@@ -128,8 +137,7 @@ pub fn scenario(name: &str) -> Result<Option<Scenario>, PlacementError> {
 
 /// Runs a prepared scenario.
 pub fn run(sc: &Scenario) -> Result<(PlacementResult, ScenarioReport), PlacementError> {
-    let req = request_for(sc, &sc.part, &sc.stack, sc.rest);
-    let result = place(&req)?;
+    let result = place(&sc.request())?;
     let placement = result.placements.first().cloned();
     let part_height = {
         let zs: Vec<f64> = sc.part.all_vertices().map(|v| (sc.rest * v).z).collect();

@@ -11,17 +11,11 @@ use stackplan_geom::sheet_metal::Decomposition;
 use stackplan_planner::regress::{SCENARIOS, Scenario, scenario};
 use stackplan_planner::search::{PlacementSearch, SearchCaches, place_with_caches};
 use stackplan_planner::{
-    Cost, FloorVolume, NoPlacement, PlacementError, PlacementRequest, PlacementResult, PlanOptions, StackPart,
-    plan_stack, uniform_thetas,
+    FloorVolume, NoPlacement, PlacementError, PlacementRequest, PlacementResult, PlanOptions, plan_stack,
 };
 
 fn request<'a>(sc: &'a Scenario, k: usize, partitions: usize, extrapolate: bool) -> PlacementRequest<'a> {
-    let stack: Vec<StackPart<'a>> = sc.stack.iter().map(|p| StackPart { part: &sc.part, pose: *p }).collect();
-    let mut req = PlacementRequest::new(&sc.part, stack, sc.floor.clone());
-    req.resting_rotations = vec![sc.rest];
-    req.thetas = uniform_thetas(360);
-    req.cost = Cost::Target { target: sc.target };
-    req.fixed_z = sc.fixed_z;
+    let mut req = sc.request();
     req.k = k;
     req.partitions = partitions;
     req.extrapolate = extrapolate;

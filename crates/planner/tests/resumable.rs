@@ -5,15 +5,10 @@
 use stackplan_cspace::ObstacleCache;
 use stackplan_planner::regress::{Scenario, scenario};
 use stackplan_planner::search::{PlacementSearch, SearchCaches, place_with_caches};
-use stackplan_planner::{Cost, NoPlacement, PlacementRequest, StackPart, uniform_thetas};
+use stackplan_planner::{NoPlacement, PlacementRequest};
 
 fn request<'a>(sc: &'a Scenario, k: usize) -> PlacementRequest<'a> {
-    let stack: Vec<StackPart<'a>> = sc.stack.iter().map(|p| StackPart { part: &sc.part, pose: *p }).collect();
-    let mut req = PlacementRequest::new(&sc.part, stack, sc.floor.clone());
-    req.resting_rotations = vec![sc.rest];
-    req.thetas = uniform_thetas(360);
-    req.cost = Cost::Target { target: sc.target };
-    req.fixed_z = sc.fixed_z;
+    let mut req = sc.request();
     req.k = k;
     req
 }
