@@ -289,6 +289,13 @@ pub fn plan_stack_with_progress(
     if !(options.nest_allowance >= 0.0 && options.nest_allowance.is_finite()) {
         return Err(PlanError::BadOption("the nesting allowance must be non-negative and finite".into()));
     }
+    if !(1..=crate::request::MAX_PARTITIONS).contains(&options.partitions) {
+        return Err(PlanError::BadOption(format!(
+            "the number of search partitions must lie in 1..={}, got {}",
+            crate::request::MAX_PARTITIONS,
+            options.partitions
+        )));
+    }
     let thetas = thetas_with_step(options.dtheta);
     let poses =
         stackplan_stability::resting_poses::resting_poses(part).map_err(|e| PlanError::NoRestingPose(e.to_string()))?;
@@ -709,6 +716,14 @@ mod tests {
             plan_stack(&part, &options(0, 0.5, FloorVolume::rectangle(0.0, 0.0, 1.0, 1.0, 1.0))),
             Err(PlanError::BadOption(_))
         ));
+        for partitions in [0, crate::request::MAX_PARTITIONS + 1] {
+            let bad = PlanOptions { partitions, ..options(1, 0.5, FloorVolume::rectangle(0.0, 0.0, 50.0, 50.0, 50.0)) };
+            let error = plan_stack(&part, &bad);
+            assert!(
+                matches!(&error, Err(PlanError::BadOption(m)) if m.contains("partitions")),
+                "{partitions} partitions: {error:?}"
+            );
+        }
     }
 
     #[test]
