@@ -6,8 +6,9 @@
 //!   then `cmp` the two files;
 //! * `... --example obstacle_identity -- profile box|prism|quarter|general|random [CALLS]` builds and drops `CALLS`
 //!   (default 10 000) obstacles of the benchmark's box or prism pair (`quarter`: the boxes at a quarter turn about
-//!   `z`, `general`: the boxes under a general rotation, `random`: two hulls of 20 and 24 points) in `build_and_drop`, for `valgrind --tool=callgrind
-//!   --toggle-collect='*build_and_drop*'` or `perf stat -e task-clock`.
+//!   `z`, `general`: the boxes under a general rotation, `random`: two hulls of 20 and 24 points) in
+//!   `build_and_drop`, for `valgrind --tool=callgrind --toggle-collect='*build_and_drop*'` or
+//!   `perf stat -e task-clock`.
 
 #![allow(clippy::print_stdout, clippy::print_stderr)] // a command-line tool reports its counts
 
@@ -214,7 +215,8 @@ fn main() {
         }
         _ => {
             eprintln!(
-                "usage: obstacle_identity dump FILE | obstacle_identity profile box|prism|quarter|general|random [CALLS]"
+                "usage: obstacle_identity dump FILE | obstacle_identity profile \
+                 box|prism|quarter|general|random [CALLS]"
             );
             std::process::exit(2);
         }

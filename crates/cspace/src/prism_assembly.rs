@@ -258,7 +258,8 @@ mod tests {
         convex_hull(&points).expect("prism").polytope
     }
 
-    /// The inputs of [`assemble`] recovered from an obstacle of a tame pair: its face specs, vertex-pair cycles, starts.
+    /// The inputs of [`assemble`] recovered from an obstacle of a tame pair: its face specs, vertex-pair cycles and
+    /// starts.
     fn inputs(o: &Obstacle) -> (Vec<FaceSpec>, Vec<[usize; 2]>, Vec<usize>) {
         let p = o.polytope();
         let mut specs = Vec::new();

@@ -210,13 +210,14 @@ pub(crate) fn parallel_faces(
 
 /// The parallel faces among the poles only, exactly as [`parallel_faces`] finds them (the same pairs in the same
 /// order) when no side normal of one summand is parallel to one of the other; `false` (nothing written) when some pole
-/// is not far from the sides (as [`parallel_faces`]) or a summand has more than two poles. The caller confirms that no side normals are parallel by
-/// [`face_specs`] run on these merges: when every side normal of `B` lies strictly inside a vertical arc of `-RA` with
-/// both its support tests above [`MARGIN`] (the sines of its angles to the arc's two end normals, up to the circle's
-/// `|cz|`, 1 within rounding), it is at least about `MARGIN` away from the arc's ends, and the ends are the side
-/// normals of `-RA` angularly next to it (the arcs of a convex prism's vertical edges lie between angularly adjacent
-/// side normals), so farther still from all others: no pair of side normals is within `sqrt(PARALLEL_SQ)` (half the
-/// angular tolerance, 5e-10) of each other, and [`parallel_faces`] would merge the poles alone. O(FA + FB).
+/// is not far from the sides (as [`parallel_faces`]) or a summand has more than two poles. The caller confirms that
+/// no side normals are parallel by [`face_specs`] run on these merges: when every side normal of `B` lies strictly
+/// inside a vertical arc of `-RA` with both its support tests above [`MARGIN`] (the sines of its angles to the arc's
+/// two end normals, up to the circle's `|cz|`, 1 within rounding), it is at least about `MARGIN` away from the arc's
+/// ends, and the ends are the side normals of `-RA` angularly next to it (the arcs of a convex prism's vertical edges
+/// lie between angularly adjacent side normals), so farther still from all others: no pair of side normals is within
+/// `sqrt(PARALLEL_SQ)` (half the angular tolerance, 5e-10) of each other, and [`parallel_faces`] would merge the poles
+/// alone. O(FA + FB).
 pub(crate) fn pole_merges(
     am: &[DVec3],
     bn: &[DVec3],
