@@ -16,6 +16,7 @@ pub mod interference;
 pub mod minkowski;
 pub mod offset;
 mod prism_assembly;
+mod prism_merge;
 mod z_prism;
 
 pub use cache::{CacheStats, ObstacleCache};

@@ -66,7 +66,7 @@ use stackplan_geom::tolerance::{RELATIVE, Tolerance};
 use stackplan_geom::{HullError, convex_hull};
 
 use crate::edge_table::{self, EdgeScratch};
-use crate::{prism_assembly, z_prism};
+use crate::{prism_assembly, prism_merge, z_prism};
 
 /// Angular tolerance (radians) of the Gauss-map decisions: a face normal within this of an arc's circle lies on it;
 /// two face normals within half of it are the same direction.
@@ -466,6 +466,7 @@ struct Scratch {
     edges: EdgeScratch,
     prism: z_prism::Scratch,
     direct: prism_assembly::Scratch,
+    merge: prism_merge::Scratch,
 }
 
 thread_local! {
@@ -486,6 +487,9 @@ thread_local! {
     pub(crate) static NO_POLE_MERGES_FIRST: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
     /// Tests: assemble the derived cycles of a tame z-prism pair by the general assembly (`prism_assembly.rs`).
     pub(crate) static NO_DIRECT_ASSEMBLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// Tests: build a tame z-prism pair from its derived cycles (`z_prism::derived_cycles`, `prism_assembly.rs`), not
+    /// from the merged chains (`prism_merge.rs`).
+    pub(crate) static NO_MERGED_CHAINS: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
 /// Whether the test switch `$switch` (a thread-local above) is on; always `false` outside the tests.
@@ -542,6 +546,7 @@ fn overlay(
         edges,
         prism,
         direct,
+        merge,
     } = scratch;
     ra.clear();
     ra.extend(moving.vertices().iter().map(|a| rotation * *a));
@@ -619,11 +624,19 @@ fn overlay(
                 false,
             )?;
         }
-        // a tame pair: every cycle without the polygon merges (`z_prism::derived_cycles`)
-        let derived = by_class
-            && margin > z_prism::MARGIN
-            && !test_switch!(NO_DERIVED_CYCLES)
-            && z_prism::derived_cycles(moving, fixed, neg_ra, am, bn, faces, prism);
+        // a tame pair: every cycle without the polygon merges, in one pass over the merged pole chains
+        // (`prism_merge.rs`), else from the derived cycles (`z_prism::derived_cycles`)
+        let tame = by_class && margin > z_prism::MARGIN && !test_switch!(NO_DERIVED_CYCLES);
+        if tame
+            && !test_switch!(NO_MERGED_CHAINS)
+            && let Some(result) =
+                prism_merge::obstacle(moving, fixed, rotation, ra, neg_ra, am, bn, faces, prism, merge)
+        {
+            #[cfg(test)]
+            z_prism::MERGED.with(|c| c.set(c.get() + 1));
+            return result;
+        }
+        let derived = tame && z_prism::derived_cycles(moving, fixed, neg_ra, am, bn, faces, prism);
         #[cfg(test)]
         if derived {
             z_prism::DERIVED.with(|c| c.set(c.get() + 1));

@@ -35,13 +35,13 @@ use crate::minkowski::{FaceKind, FaceSpec, Feature, Obstacle, OverlayFailure, Ro
 
 /// A half-edge filed under a vertex: the vertex at its other end, its index (in the faces' corner order) and its face.
 #[derive(Clone, Copy)]
-struct Half {
-    other: u32,
-    index: u32,
-    face: u32,
+pub(crate) struct Half {
+    pub(crate) other: u32,
+    pub(crate) index: u32,
+    pub(crate) face: u32,
 }
 
-const EMPTY: Half = Half { other: u32::MAX, index: u32::MAX, face: u32::MAX };
+pub(crate) const EMPTY: Half = Half { other: u32::MAX, index: u32::MAX, face: u32::MAX };
 
 /// Working buffers, kept per thread with the overlay's.
 #[derive(Default)]
@@ -53,9 +53,9 @@ pub(crate) struct Scratch {
     prev: Vec<u32>,
 }
 
-const POLE: usize = 0;
-const TWIN: usize = 1;
-const VERTICAL: usize = 2;
+pub(crate) const POLE: usize = 0;
+pub(crate) const TWIN: usize = 1;
+pub(crate) const VERTICAL: usize = 2;
 
 /// The obstacle vertex of the vertex pair `[i, j]`, numbered on first appearance exactly as the general assembly
 /// (`minkowski::assemble`) numbers them (its coordinates, `b[j] - ra[i]`, are computed after the numbering pass).
@@ -74,8 +74,15 @@ fn number([i, j]: [usize; 2], index_of: &mut [u32], nb: usize, vertex_pairs: &mu
 /// larger vertices, with the checks of the module documentation (else `None`). Kept out of line (fewer live values,
 /// fewer spills in [`assemble`]).
 #[inline(never)]
-fn edge_table(stars: &[[Half; 3]], prev: &[u32], total: usize, face_count: usize) -> Option<(Vec<Edge>, Vec<usize>)> {
-    let mut edges: Vec<Edge> = Vec::with_capacity(total / 2);
+pub(crate) fn edge_table(
+    stars: &[[Half; 3]],
+    prev: &[u32],
+    total: usize,
+    face_count: usize,
+    mut edges: Vec<Edge>,
+) -> Option<(Vec<Edge>, Vec<usize>)> {
+    edges.clear();
+    edges.reserve(total / 2);
     // (with room for the faces' starts, which geom keeps in the same buffer)
     let mut face_edges = Vec::with_capacity(total + face_count + 1);
     face_edges.resize(total, 0usize);
@@ -231,7 +238,7 @@ pub(crate) fn assemble(
     for face in &mut faces {
         face.plane.offset = face_offset(face.plane.normal, &face.vertices, &vertices)?;
     }
-    let (edges, face_edges) = edge_table(stars, prev, total, faces.len())?;
+    let (edges, face_edges) = edge_table(stars, prev, total, faces.len(), Vec::with_capacity(total / 2))?;
     let f = faces.len();
     if nv + f != edges.len() + 2 {
         return None;

@@ -360,6 +360,92 @@ pub(crate) fn face_specs(
     Ok(())
 }
 
+/// The two poles of each summand of a z-prism pair, indexed by level (`[bottom, top]`, faces of `-RA` and of `B`).
+pub(crate) struct Poles {
+    pub(crate) a: [usize; 2],
+    pub(crate) b: [usize; 2],
+}
+
+/// The first conditions of [`derived_cycles`] (and of `prism_merge.rs`): each summand has exactly two poles, a top
+/// (`+z`) and a bottom one, every vertex on one of them (its level into `scratch.a_levels` / `b_levels`), fewer than
+/// `2^16` vertices, and a height (the length of every vertical edge) whose square is in `[TAME_LO, TAME_HI]`. `None`
+/// (levels garbage) otherwise. O(V + F).
+pub(crate) fn poles(
+    moving: &ConvexPolytope,
+    fixed: &ConvexPolytope,
+    neg_ra: &[DVec3],
+    am: &[DVec3],
+    bn: &[DVec3],
+    scratch: &mut Scratch,
+) -> Option<Poles> {
+    let Scratch { a_classes, b_classes, a_levels, b_levels, .. } = scratch;
+    let bv = fixed.vertices();
+    let (na, nb) = (neg_ra.len(), bv.len());
+    // the two poles of each summand: (top face, bottom face)
+    let poles = |normals: &[DVec3], classes: &[u8]| {
+        let (mut top, mut bottom, mut count) = (usize::MAX, usize::MAX, 0);
+        for (f, (n, &c)) in normals.iter().zip(classes.iter()).enumerate() {
+            if c == POLE {
+                count += 1;
+                if n.z > 0.0 { top = f } else { bottom = f }
+            }
+        }
+        (count == 2 && top != usize::MAX && bottom != usize::MAX).then_some((top, bottom))
+    };
+    let (Some((a_top, a_bottom)), Some((b_top, b_bottom))) = (poles(am, a_classes), poles(bn, b_classes)) else {
+        return None;
+    };
+    // every vertex's pole (TOP, BOTTOM; else `None`)
+    // (and the height `hi - lo`, exactly the difference of the z of any top and any bottom vertex)
+    let levels = |p: &ConvexPolytope, points: &[DVec3], top: usize, bottom: usize, out: &mut Vec<u8>| {
+        let (Some(&t), Some(&b)) = (p.faces()[top].vertices.first(), p.faces()[bottom].vertices.first()) else {
+            return None;
+        };
+        let (hi, lo) = (points[t].z, points[b].z);
+        out.clear();
+        out.resize(points.len(), BOTTOM);
+        let mut on_poles = hi > lo;
+        for (level, v) in out.iter_mut().zip(points) {
+            *level = u8::from(v.z == hi);
+            on_poles &= (v.z == hi) | (v.z == lo);
+        }
+        on_poles.then_some(hi - lo)
+    };
+    let (Some(a_height), Some(b_height)) =
+        (levels(moving, neg_ra, a_top, a_bottom, a_levels), levels(fixed, bv, b_top, b_bottom, b_levels))
+    else {
+        return None;
+    };
+    // tame: the vertical edges (all of length `hi - lo`, exactly) far from under- and overflow
+    if na >= 1 << 16
+        || nb >= 1 << 16
+        || !(TAME_LO..=TAME_HI).contains(&(a_height * a_height))
+        || !(TAME_LO..=TAME_HI).contains(&(b_height * b_height))
+    {
+        return None;
+    }
+    Some(Poles { a: [a_bottom, a_top], b: [b_bottom, b_top] })
+}
+
+/// Tame (see [`derived_cycles`]): a side face's horizontal edge `p -> q` far from under- and overflow, its normal
+/// `n` a unit vector orthogonal to the edge within 1e-12 rad.
+#[inline]
+pub(crate) fn tame_side(n: DVec3, p: DVec3, q: DVec3) -> bool {
+    let d = q - p;
+    let (len2, nn, dot) = (d.x * d.x + d.y * d.y, n.x * n.x + n.y * n.y, n.x * d.x + n.y * d.y);
+    (TAME_LO..=TAME_HI).contains(&len2) && (nn - 1.0).abs() <= 1e-9 && dot * dot <= 1e-24 * len2
+}
+
+/// The two ends of a vertical edge as `[bottom, top]` (indexed by the level), else `None`.
+#[inline]
+pub(crate) fn ends([v0, v1]: [usize; 2], levels: &[u8]) -> Option<[usize; 2]> {
+    match (levels[v0], levels[v1]) {
+        (BOTTOM, TOP) => Some([v0, v1]),
+        (TOP, BOTTOM) => Some([v1, v0]),
+        _ => None,
+    }
+}
+
 /// The vertex-pair cycles of every face of the obstacle of a *tame* z-prism pair, in the order of `specs` (from
 /// [`face_specs`]), without the general assembly's polygon merges (`minkowski::face_plus_segment`,
 /// `minkowski::planar_merge`), into `cycles` / `starts`; `false` (buffers garbage) when the pair is not one this
@@ -395,69 +481,14 @@ pub(crate) fn derived_cycles(
     specs: &[FaceSpec],
     scratch: &mut Scratch,
 ) -> bool {
-    let Scratch { next, cycles, starts, a_classes, b_classes, a_levels, b_levels, .. } = scratch;
+    let Some(Poles { a: [a_bottom, a_top], b: [b_bottom, b_top] }) = poles(moving, fixed, neg_ra, am, bn, scratch)
+    else {
+        return false;
+    };
+    let Scratch { next, cycles, starts, a_levels, b_levels, .. } = scratch;
     let bv = fixed.vertices();
     let (na, nb) = (neg_ra.len(), bv.len());
-    // the two poles of each summand: (top face, bottom face)
-    let poles = |normals: &[DVec3], classes: &[u8]| {
-        let (mut top, mut bottom, mut count) = (usize::MAX, usize::MAX, 0);
-        for (f, (n, &c)) in normals.iter().zip(classes).enumerate() {
-            if c == POLE {
-                count += 1;
-                if n.z > 0.0 { top = f } else { bottom = f }
-            }
-        }
-        (count == 2 && top != usize::MAX && bottom != usize::MAX).then_some((top, bottom))
-    };
-    let (Some((a_top, a_bottom)), Some((b_top, b_bottom))) = (poles(am, a_classes), poles(bn, b_classes)) else {
-        return false;
-    };
-    // every vertex's pole (TOP, BOTTOM; else `false`)
-    let levels = |p: &ConvexPolytope, points: &[DVec3], top: usize, bottom: usize, out: &mut Vec<u8>| {
-        let (Some(&t), Some(&b)) = (p.faces()[top].vertices.first(), p.faces()[bottom].vertices.first()) else {
-            return false;
-        };
-        let (hi, lo) = (points[t].z, points[b].z);
-        out.clear();
-        out.resize(points.len(), BOTTOM);
-        let mut on_poles = hi > lo;
-        for (level, v) in out.iter_mut().zip(points) {
-            *level = u8::from(v.z == hi);
-            on_poles &= (v.z == hi) | (v.z == lo);
-        }
-        on_poles
-    };
-    if !(levels(moving, neg_ra, a_top, a_bottom, a_levels) && levels(fixed, bv, b_top, b_bottom, b_levels))
-        || na >= 1 << 16
-        || nb >= 1 << 16
-    {
-        return false;
-    }
     let (a_levels, b_levels) = (&a_levels[..], &b_levels[..]);
-    // tame: the vertical edges (all of length `hi - lo`, exactly) and, per side face, its horizontal edges (the two
-    // have the same `x`, `y`) far from under- and overflow, a unit normal, the edges orthogonal to it within 1e-12 rad
-    let tame_height = |levels: &[u8], points: &[DVec3]| {
-        let (Some(t), Some(b)) = (levels.iter().position(|&l| l == TOP), levels.iter().position(|&l| l == BOTTOM))
-        else {
-            return false;
-        };
-        let dz = points[t].z - points[b].z;
-        (TAME_LO..=TAME_HI).contains(&(dz * dz))
-    };
-    if !(tame_height(a_levels, neg_ra) && tame_height(b_levels, bv)) {
-        return false;
-    }
-    let tame_side = |n: DVec3, p: DVec3, q: DVec3| {
-        let d = q - p;
-        let (len2, nn, dot) = (d.x * d.x + d.y * d.y, n.x * n.x + n.y * n.y, n.x * d.x + n.y * d.y);
-        (TAME_LO..=TAME_HI).contains(&len2) && (nn - 1.0).abs() <= 1e-9 && dot * dot <= 1e-24 * len2
-    };
-    // the two ends of a vertical edge as [bottom, top] (indexed by the level)
-    let ends = |[v0, v1]: [usize; 2], levels: &[u8]| match (levels[v0], levels[v1]) {
-        (BOTTOM, TOP) => Some([v0, v1]),
-        (TOP, BOTTOM) => Some([v1, v0]),
-        _ => None,
-    };
     // (the buffers only grow: every entry used below is written first, or filled here)
     if next.len() < na * nb {
         next.resize(na * nb, u32::MAX);
@@ -599,12 +630,15 @@ thread_local! {
     pub(crate) static DERIVED: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
     /// Tests: how many of those were assembled directly (`prism_assembly.rs`).
     pub(crate) static DIRECT: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+    /// Tests: how many overlays were built from the merged pole chains (`prism_merge.rs`).
+    pub(crate) static MERGED: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
 }
 
 #[cfg(test)]
 mod tests {
     use crate::minkowski::{
-        ALL_ARCS, GENERAL_ROUTE_ONLY, NO_DERIVED_CYCLES, NO_DIRECT_ASSEMBLY, NO_POLE_MERGES_FIRST, gauss_map_obstacle,
+        ALL_ARCS, GENERAL_ROUTE_ONLY, NO_DERIVED_CYCLES, NO_DIRECT_ASSEMBLY, NO_MERGED_CHAINS, NO_POLE_MERGES_FIRST,
+        gauss_map_obstacle,
     };
     use glam::{DMat3, DVec3};
     use stackplan_geom::{ConvexPolytope, convex_hull};
@@ -708,14 +742,22 @@ mod tests {
         let taken_before = super::TAKEN.with(std::cell::Cell::get);
         let derived_before = super::DERIVED.with(std::cell::Cell::get);
         let direct_before = super::DIRECT.with(std::cell::Cell::get);
+        let merged_before = super::MERGED.with(std::cell::Cell::get);
         let (mut cases, mut merged) = (0, 0);
         for a in &shapes {
             for b in &shapes {
                 for &r in &rotations {
                     let fast = format!("{:?}", gauss_map_obstacle(a, r, b));
+                    // the derived cycles assembled directly (`prism_assembly.rs`), not the merged chains (`prism_merge.rs`)
+                    NO_MERGED_CHAINS.with(|c| c.set(true));
+                    let derived_direct = format!("{:?}", gauss_map_obstacle(a, r, b));
+                    NO_MERGED_CHAINS.with(|c| c.set(false));
+                    assert_eq!(fast, derived_direct, "{a:?} {r:?} {b:?}");
                     // the derived cycles through the general assembly (no direct assembly, `prism_assembly.rs`)
                     NO_DIRECT_ASSEMBLY.with(|c| c.set(true));
+                    NO_MERGED_CHAINS.with(|c| c.set(true));
                     let assembled = format!("{:?}", gauss_map_obstacle(a, r, b));
+                    NO_MERGED_CHAINS.with(|c| c.set(false));
                     NO_DIRECT_ASSEMBLY.with(|c| c.set(false));
                     assert_eq!(fast, assembled, "{a:?} {r:?} {b:?}");
                     // all parallel pairs first (not the poles alone, confirmed by the supports' margin)
@@ -744,13 +786,16 @@ mod tests {
                 }
             }
         }
-        // (each z-prism case ran the z-prism route five times: with everything, without the direct assembly, without
-        // the poles merged first, with all arcs searched, without the derived cycles; the first four derive the
-        // cycles of a tame pair and all but the second assemble them directly)
-        let taken = (super::TAKEN.with(std::cell::Cell::get) - taken_before) / 5;
-        let derived = (super::DERIVED.with(std::cell::Cell::get) - derived_before) / 4;
-        let direct = (super::DIRECT.with(std::cell::Cell::get) - direct_before) / 3;
-        // every tame pair assembled directly
+        // (each z-prism case ran the z-prism route six times: with everything, without the merged chains, without the
+        // direct assembly, without the poles merged first, with all arcs searched, without the derived cycles; a tame
+        // pair is built from the merged chains in the first and the fourth and fifth, from its derived cycles assembled
+        // directly in the second, from its derived cycles through the general assembly in the third)
+        let taken = (super::TAKEN.with(std::cell::Cell::get) - taken_before) / 6;
+        let chains = (super::MERGED.with(std::cell::Cell::get) - merged_before) / 3;
+        let derived = (super::DERIVED.with(std::cell::Cell::get) - derived_before) / 2;
+        let direct = super::DIRECT.with(std::cell::Cell::get) - direct_before;
+        // every tame pair built from the merged chains, and assembled directly from its derived cycles
+        assert_eq!(chains, derived, "{chains} of {derived} derived pairs built from the merged chains");
         assert_eq!(direct, derived, "{direct} of {derived} derived pairs assembled directly");
         // the tame pairs (most pairs at generic angles; not the quarter turns, not within 1e-6 of one, not the huge
         // box) assembled without the polygon merges, bit for bit as the general route
