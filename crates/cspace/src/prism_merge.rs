@@ -227,6 +227,7 @@ pub(crate) fn obstacle(
             }
         }};
     }
+    let (spread, mut class) = (k > 6, 0);
     let mut poles_seen = [false; 2];
     let mut start = 0usize;
     for (s, spec) in specs.iter().enumerate() {
@@ -329,7 +330,27 @@ pub(crate) fn obstacle(
             }
         }
         start += 4;
-        faces.push(Face { vertices: vec![v[0], v[1], v[2], v[3]], plane: Plane { normal, offset } });
+        // (with more than 6 side faces, capacities 4, 6 and 8 in turn: their vectors spread over three size classes of
+        // the allocator's per-thread cache, which keeps 7 blocks of each; more blocks of one class than that, freed
+        // with the obstacle, cost the next obstacle's allocations the slow path)
+        let [a, b, c, d] = v;
+        let face = match class {
+            1 => {
+                let mut face = vec![a, b, c, d, 0, 0];
+                face.truncate(4);
+                face
+            }
+            2 => {
+                let mut face = vec![a, b, c, d, 0, 0, 0, 0];
+                face.truncate(4);
+                face
+            }
+            _ => vec![a, b, c, d],
+        };
+        if spread {
+            class = if class == 2 { 0 } else { class + 1 };
+        }
+        faces.push(Face { vertices: face, plane: Plane { normal, offset } });
         kinds.push(kind);
     }
     if poles_seen != [true; 2] || count != nv || start != 3 * nv {
