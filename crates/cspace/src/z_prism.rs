@@ -429,7 +429,7 @@ pub(crate) fn poles(
 
 /// Tame (see [`derived_cycles`]): a side face's horizontal edge `p -> q` far from under- and overflow, its normal
 /// `n` a unit vector orthogonal to the edge within 1e-12 rad.
-#[inline]
+#[inline(always)]
 pub(crate) fn tame_side(n: DVec3, p: DVec3, q: DVec3) -> bool {
     let d = q - p;
     let (len2, nn, dot) = (d.x * d.x + d.y * d.y, n.x * n.x + n.y * n.y, n.x * d.x + n.y * d.y);
