@@ -86,14 +86,14 @@ pub(crate) fn obstacle(
     prism: &mut z_prism::Scratch,
     scratch: &mut Scratch,
 ) -> Option<Result<Obstacle, OverlayFailure>> {
-    let Poles { a: a_poles, b: b_poles } = z_prism::poles(moving, fixed, neg_ra, am, bn, prism)?;
-    let (a_levels, b_levels) = (prism.a_levels.as_slice(), prism.b_levels.as_slice());
     let (bv, fb) = (fixed.vertices(), fixed.faces().len());
-    // every face of B and every face of -RA but its two poles; `k` side faces
+    // every face of B and every face of -RA but its two poles (no side face merged); `k` side faces
     let k = specs.len().checked_sub(2)?;
     if specs.len() + 2 != moving.faces().len() + fb || k < 3 {
         return None;
     }
+    let Poles { a: a_poles, b: b_poles } = z_prism::poles(moving, fixed, neg_ra, am, bn, prism)?;
+    let (a_levels, b_levels) = (prism.a_levels.as_slice(), prism.b_levels.as_slice());
     let Scratch { prev_a, sides, pairs, ids, pos, stars, prev, numbered, coords } = scratch;
     prev_a.clear();
     prev_a.resize(neg_ra.len(), [NONE; 2]);
