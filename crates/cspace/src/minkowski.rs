@@ -55,9 +55,11 @@
 //! Two z-prisms turned about `z` (sheet-metal plates under the planner's rotations) skip the sign tables and the
 //! crossing pass: for them those numbers are exact zeros by the data, and `z_prism.rs` builds the same face list
 //! (bit for bit the same obstacle) in O(FA FB + FB EA + FA EB) with far fewer products; for a *tame* such pair (the
-//! usual one, away from quarter turns) it also reads every face cycle off the features (`z_prism::derived_cycles`)
-//! instead of merging polygons, and numbers, offsets and links them from the prism structure (`prism_assembly.rs`)
-//! instead of the general assembly's half-edge table, with the same result.
+//! usual one, away from quarter turns) it builds the obstacle in one pass over the merged pole chains of the two
+//! cross-sections (`prism_merge.rs`: face cycles, numbering, offsets and edge table from the chain positions) instead
+//! of merging polygons and the general assembly's half-edge table, with the same result; when that pass refuses, it
+//! reads every face cycle off the features (`z_prism::derived_cycles`) and numbers, offsets and links them from the
+//! prism structure (`prism_assembly.rs`).
 
 use glam::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
