@@ -1277,7 +1277,7 @@ impl Search<'_, '_> {
     /// `Omega_new(theta) \ Omega_old(theta)` of every orientation is added as new roots, split as a subtraction
     /// (\[A\] VI-A-3 with `Omega_old` as the convex set taken away): child `j` is `Omega_new` with `Omega_old`'s
     /// half-space `j` reversed and those before it kept (tagged as cuts, not as floor sides). Sides the two sets
-    /// share give no child. O(orientations x sides) cells and QPs, in parallel.
+    /// share give no child. O(orientations x sides) cells and QPs, in parallel (one boundedness check in all).
     fn widen<const D: usize>(
         &mut self,
         mut state: RunState<D>,
@@ -1289,6 +1289,18 @@ impl Search<'_, '_> {
         let t_roots = Instant::now();
         let fixed_z = state.fixed_z;
         let tol = self.tol;
+        // every added cell lies in `Omega_new(theta)`, whose normals (the floor's sides, the floor and the ceiling)
+        // are the same at every orientation: the first non-empty one's boundedness check (as `Cell::new` makes it)
+        // answers for all of them, as in `Search::start`, and the cells are built without their own (`2 D` LPs each)
+        for o in self.orientations.iter().filter(|o| self.owns(o.index)) {
+            let Some(new_hs) = self.omega::<D>(o, &self.request.floor, fixed_z) else {
+                continue;
+            };
+            let fs_err = |reason: String| PlacementError::FreeSpace { orientation: o.index, reason };
+            if !Cell::new(new_hs, tol).map_err(|e| fs_err(e.to_string()))?.is_empty() {
+                break;
+            }
+        }
         let added: Vec<Result<Vec<(Cell<D>, QpOptimum<D>)>, PlacementError>> = self
             .orientations
             .par_iter()
@@ -1302,7 +1314,7 @@ impl Search<'_, '_> {
                 };
                 let q = restrict_quadratic::<D>(&o.quadratic, fixed_z);
                 let solve = |hs: Vec<Halfspace<D>>| -> Result<Option<(Cell<D>, QpOptimum<D>)>, PlacementError> {
-                    let cell = Cell::new(hs, tol).map_err(|e| fs_err(e.to_string()))?;
+                    let cell = Cell::new_unchecked_bounds(hs, tol).map_err(|e| fs_err(e.to_string()))?;
                     if cell.is_empty() {
                         return Ok(None);
                     }
