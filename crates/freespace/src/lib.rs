@@ -7,6 +7,8 @@
 //!
 //! * [`cell`]: convex H-polytopes in 2 or 3 variables with provenance tags; emptiness, Chebyshev centre,
 //!   redundancy removal, membership ([`vertices`] enumerates their vertices and faces);
+//! * [`outer_box`](mod@outer_box): a box around a cell by bound propagation, and the emptiness test it gives for a
+//!   cell cut by one more half-space (the placement search's children);
 //! * [`omega`](mod@omega): the permissible set Omega(R) of \[A\] eq. (3) and its 2-D variant at fixed `p_z`;
 //! * [`subtract`](mod@subtract): subtraction of a convex obstacle (optionally grown by a clearance) from a cell
 //!   (\[A\] Fig. 13);
@@ -19,6 +21,7 @@ pub mod active_set;
 pub mod cell;
 pub mod cost;
 pub mod omega;
+pub mod outer_box;
 pub mod qp;
 pub mod ranking;
 pub mod subtract;

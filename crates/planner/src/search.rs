@@ -19,12 +19,15 @@
 //!    optimality conditions give over the part of `K` beyond that plane ([`Quadratic::lower_bound_beyond`]: it grows
 //!    with the plane's distance from `p*`, which lies inside the obstacle; it halves the children solved in the
 //!    Channel and Triangle searches and leaves the solved nodes' order alone). When a pending child is popped its
-//!    emptiness is decided by a phase 1 from the parent's optimum (`Cell::is_empty_with`: the optimum violates
-//!    only `n_k . p >= d_k`, so this is usually one LP move); a non-empty child's cell is built from a second phase 1
-//!    on the exact cell (`Cell::with_halfspaces_from`, no Chebyshev LP) and its QP solved ([`crate::qp`]), and it is pushed back with its own cost — so children that never become
-//!    the cheapest are never solved. The keys only decide *when* a pending child is solved, never the order of the
-//!    solved nodes (a total order by (cost, orientation, id) that a valid lower bound cannot overtake), so the
-//!    search pops the same solved nodes in the same order as with the parent's cost as key;
+//!    emptiness is decided by a box around the parent cell (bound propagation, [`stackplan_freespace::outer_box`]: a
+//!    child whose outside half-space misses it is empty; about 95 % of the empty children, at a few dozen operations
+//!    each) or else by a phase 1 from the parent's optimum (`Cell::is_empty_with`: the optimum violates only
+//!    `n_k . p >= d_k`, so this is usually one LP move); a non-empty child's cell is built from a second phase 1 on
+//!    the exact cell (`Cell::with_halfspaces_from`, no Chebyshev LP) and its QP solved ([`crate::qp`]), and it is
+//!    pushed back with its own cost — so children that never become the cheapest are never solved. The keys only decide
+//!    *when* a pending child is solved, never the order of the solved nodes (a total order by (cost, orientation, id)
+//!    that a valid lower bound cannot overtake), so the search pops the same solved nodes in the same order as with the
+//!    parent's cost as key;
 //! 4. if there is none, `p*` is free: it is the next placement (one per cell, in cost order, \[A\] VI-A-4).
 //!
 //! **Exactness.** The children cover `K` minus the obstacle's interior and each lies in `K`, so no child costs less
@@ -92,6 +95,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use stackplan_cspace::ObstacleCache;
 use stackplan_freespace::cell::{Cell, Halfspace, Tag};
+use stackplan_freespace::outer_box::box_misses_halfspace;
 use stackplan_geom::{Pose, Tolerance};
 use std::collections::{HashMap, VecDeque};
 use std::sync::Arc;
@@ -261,6 +265,10 @@ struct Family<const D: usize> {
     applied: Arc<[u32]>,
     obstacle: u32,
     start: [f64; D],
+    /// A box around the parent cell grown by the tolerance ([`Cell::grown_outer_box`]), computed when the first
+    /// child is popped: a child whose outside half-space misses it is empty without its phase 1 (about 95 % of the
+    /// empty children of a plan's searches).
+    reach: Option<([f64; D], [f64; D])>,
     /// The family's children are `NodeHeap::children[first..first + left]` (`(key, id, face)`), the cheapest (by
     /// [`HeapKey`]'s order) last; popping one decrements `left`.
     first: usize,
@@ -1503,9 +1511,27 @@ impl Search<'_, '_> {
                 Popped::Pending { family, id, face } => {
                     // build and solve the child now; push it back with its true cost (>= its key)
                     let t_cells = Instant::now();
+                    let f = &mut heap.families[family as usize];
+                    if f.reach.is_none() {
+                        f.reach = Some(f.cell.grown_outer_box());
+                    }
                     let f = &heap.families[family as usize];
                     let orientation = f.orientation;
                     self.child_inequalities::<D>(f.obstacle, face, fixed_z, &mut buffers.extra);
+                    // the child's outside half-space (`-n . p <= -d`, last) missing the box around the parent cell
+                    // grown by the tolerance: empty, as its phase 1 would find (`box_misses_halfspace`; only when
+                    // every inequality is finite, which the phase 1 would reject with an error)
+                    let misses = f.reach.as_ref().zip(buffers.extra.last()).is_some_and(|(reach, outside)| {
+                        box_misses_halfspace(reach, &outside.normal.map(|c| -c), -outside.offset, tol)
+                    }) && buffers
+                        .extra
+                        .iter()
+                        .all(|h| h.offset.is_finite() && h.normal.iter().all(|c| c.is_finite()));
+                    if misses {
+                        self.stats.cells_empty += 1;
+                        self.stats.time_cells_ms += ms(t_cells);
+                        continue;
+                    }
                     let solved = self.solve_child::<D>(orientation, &f.cell, &buffers.extra, &f.start, fixed_z)?;
                     if let Some((cell, optimum)) = solved {
                         // the path is shared by the family's children: one more reference for a non-empty one
@@ -1632,6 +1658,7 @@ impl Search<'_, '_> {
                 applied,
                 obstacle: id,
                 start: optimum.point,
+                reach: None,
                 first: 0,
                 left: 0,
             };
