@@ -96,7 +96,7 @@ impl SweepAxes {
         let axes = part
             .components
             .iter()
-            .zip(&orientation.components)
+            .zip(orientation.components.iter())
             .map(|(c, placed)| {
                 let mut normals = placed.normal_axes.clone();
                 let mut edges = placed.edge_directions.clone();

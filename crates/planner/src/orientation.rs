@@ -16,6 +16,12 @@ use glam::{DMat3, DVec3};
 use stackplan_cspace::PlacedConvex;
 use stackplan_freespace::cell::{Halfspace, Tag};
 use stackplan_geom::Part;
+use std::sync::Arc;
+
+/// The components of `part` rotated by `rotation`, at position zero.
+pub fn rotated_components(part: &Part, rotation: DMat3) -> Arc<[PlacedConvex]> {
+    part.components.iter().map(|c| PlacedConvex::new(c, rotation, DVec3::ZERO)).collect()
+}
 
 /// A separable convex quadratic `constant + sum_i h_i (p_i - c_i)^2` in three variables.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -73,7 +79,7 @@ pub struct Orientation {
     pub cg: DVec3,
     /// The components rotated, at position zero (empty until [`Orientation::build_components`]; [`Orientation::new`]
     /// builds them at once).
-    pub components: Vec<PlacedConvex>,
+    pub components: Arc<[PlacedConvex]>,
     /// The rotated vertices of every component, component by component (for `Omega`).
     vertices: Vec<DVec3>,
     /// The cost at this orientation.
@@ -120,14 +126,22 @@ impl Orientation {
         }
         let cg = rotation * part.mass.center_of_gravity;
         let quadratic = SeparableQuadratic::of_cost(cost, lo, hi, cg);
-        Self { index, rest, theta_index, theta, rotation, lo, hi, cg, components: Vec::new(), vertices, quadratic }
+        Self { index, rest, theta_index, theta, rotation, lo, hi, cg, components: Arc::new([]), vertices, quadratic }
     }
 
     /// Builds the rotated components if they are missing. O(total size of the part).
     pub fn build_components(&mut self, part: &Part) {
         if self.components.is_empty() {
-            self.components =
-                part.components.iter().map(|c| PlacedConvex::new(c, self.rotation, DVec3::ZERO)).collect();
+            self.components = rotated_components(part, self.rotation);
+        }
+    }
+
+    /// Takes `components` (the part's components rotated by [`Orientation::rotation`], as
+    /// [`Orientation::build_components`] builds them, e.g. kept from an earlier search of the same part) if the
+    /// components are missing.
+    pub fn set_components(&mut self, components: Arc<[PlacedConvex]>) {
+        if self.components.is_empty() {
+            self.components = components;
         }
     }
 

@@ -86,7 +86,7 @@ use crate::dary_heap::DaryHeap;
 use crate::detect::{CandidateQueue, DetectCounts, DetectScratch, StackScene, SweepAxes};
 use crate::interval_obstacles::{IntervalObstacles, ObstacleRoute};
 use crate::obstacles::DerivedObstacle;
-use crate::orientation::{Orientation, SeparableQuadratic};
+use crate::orientation::{Orientation, SeparableQuadratic, rotated_components};
 use crate::qp::{QpOptimum, Quadratic, minimise};
 use crate::request::{FloorVolume, PlacementError, PlacementRequest};
 use crate::symmetry::{is_uniform_full_turn, period_length, rotational_order};
@@ -554,7 +554,7 @@ struct Search<'r, 'a> {
     lane: usize,
     lanes: usize,
     orientations: Vec<Orientation>,
-    sweeps: Vec<Option<SweepAxes>>,
+    sweeps: Vec<Option<Arc<SweepAxes>>>,
     scene: Arc<StackScene>,
     tol: Tolerance,
     cache: &'r ObstacleCache,
@@ -566,6 +566,7 @@ struct Search<'r, 'a> {
     /// Per orientation, the (moving, stack component) pairs whose derived obstacle an earlier search of the plan
     /// built (indexed once per search; taken when the orientation is first expanded).
     shared_pairs: Vec<Vec<(usize, usize)>>,
+    rotated: HashMap<[u64; 9], RotatedComponents>,
     detect_scratch: DetectScratch,
     intervals: IntervalObstacles,
     stats: PlacementStats,
@@ -613,10 +614,21 @@ pub struct SearchCaches {
 #[derive(Debug, Default)]
 struct LaneCaches {
     detect_scratch: DetectScratch,
+    /// The part's components rotated, and their sweep axes (with insertion), by rotation (bits of its matrix),
+    /// built at an orientation's first expansion in some search: every search of a plan expands many of the same
+    /// orientations (the values are those of building them again).
+    rotated: HashMap<[u64; 9], RotatedComponents>,
     derived: HashMap<(usize, usize, usize), Arc<DerivedObstacle>>,
     intervals: IntervalObstacles,
     /// The derived obstacles by id (the ids the carried cells' tags and paths name).
     table: ObstacleTable,
+}
+
+/// The part's components at one rotation ([`LaneCaches::rotated`]).
+#[derive(Debug, Clone)]
+struct RotatedComponents {
+    components: Arc<[stackplan_cspace::PlacedConvex]>,
+    sweep: Option<Arc<SweepAxes>>,
 }
 
 /// How many frontiers [`SearchCaches`] keeps: the stacking planner alternates a stage-1 search (a floor that grows
@@ -774,7 +786,7 @@ fn prepare<'r, 'a>(
     let stack_refs: Vec<(&stackplan_geom::Part, Pose)> = request.stack.iter().map(|s| (s.part, s.pose)).collect();
     let scene = Arc::new(StackScene::new(&stack_refs));
     // rotated components and sweep axes are built when an orientation is first expanded
-    let sweeps: Vec<Option<SweepAxes>> = vec![None; orientations.len()];
+    let sweeps: Vec<Option<Arc<SweepAxes>>> = vec![None; orientations.len()];
     let stats = PlacementStats {
         orientations_requested: request.resting_rotations.len() * n_theta,
         orientations_searched: orientations.len(),
@@ -828,6 +840,7 @@ fn prepare<'r, 'a>(
             by_orientation: table.by_orientation,
             shared_pairs,
             detect_scratch: std::mem::take(&mut lane_caches.detect_scratch),
+            rotated: std::mem::take(&mut lane_caches.rotated),
             derived: std::mem::take(&mut lane_caches.derived),
             intervals: std::mem::take(&mut lane_caches.intervals),
             stats: stats.clone(),
@@ -1260,6 +1273,7 @@ impl Search<'_, '_> {
     /// Moves the shared caches' contents back into `caches` (this partition's).
     fn give_back(&mut self, caches: &mut LaneCaches) {
         caches.detect_scratch = std::mem::take(&mut self.detect_scratch);
+        caches.rotated = std::mem::take(&mut self.rotated);
         caches.derived = std::mem::take(&mut self.derived);
         caches.intervals = std::mem::take(&mut self.intervals);
     }
@@ -1556,9 +1570,16 @@ impl Search<'_, '_> {
                 considered[node.orientation] = true;
                 let t_setup = Instant::now();
                 let o = &mut self.orientations[node.orientation];
-                o.build_components(self.request.part);
+                let key = o.rotation.to_cols_array().map(f64::to_bits);
+                let part = self.request.part;
+                let rotated = self.rotated.entry(key).or_insert_with(|| RotatedComponents {
+                    components: rotated_components(part, o.rotation),
+                    sweep: None,
+                });
+                o.set_components(Arc::clone(&rotated.components));
                 if self.request.insertion {
-                    self.sweeps[node.orientation] = Some(SweepAxes::new(self.request.part, o.rotation, o));
+                    let sweep = rotated.sweep.get_or_insert_with(|| Arc::new(SweepAxes::new(part, o.rotation, o)));
+                    self.sweeps[node.orientation] = Some(Arc::clone(sweep));
                 }
                 // the obstacles earlier searches of the plan built at this orientation are known at once (their
                 // stack parts have not moved), in a fixed order
@@ -1595,7 +1616,7 @@ impl Search<'_, '_> {
                 let mut queue = CandidateQueue::new(
                     &self.scene,
                     &self.orientations[node.orientation],
-                    self.sweeps[node.orientation].as_ref(),
+                    self.sweeps[node.orientation].as_deref(),
                     p,
                     clearance,
                     self.request.horizontal_clearance,
@@ -1613,7 +1634,7 @@ impl Search<'_, '_> {
                     let next = queue.next(
                         &self.scene,
                         &self.orientations[node.orientation],
-                        self.sweeps[node.orientation].as_ref(),
+                        self.sweeps[node.orientation].as_deref(),
                     );
                     self.stats.time_interference_ms += ms(t_det);
                     let Some(c) = next else { break };
