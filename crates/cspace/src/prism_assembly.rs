@@ -238,9 +238,22 @@ pub(crate) fn assemble(
     for face in &mut faces {
         face.plane.offset = face_offset(face.plane.normal, &face.vertices, &vertices)?;
     }
-    let (edges, face_edges) = edge_table(stars, prev, total, faces.len(), Vec::with_capacity(total / 2))?;
-    let f = faces.len();
-    if nv + f != edges.len() + 2 {
+    let table = edge_table(stars, prev, total, faces.len(), Vec::with_capacity(total / 2))?;
+    finish(vertices, faces, table, vertex_pairs, kinds, rotation)
+}
+
+/// The obstacle from its assembled parts (shared with [`crate::prism_merge`]): Euler's `V + F = E + 2` first
+/// (`None`: the caller falls back to the general route), then geom's polytope and the obstacle with its provenance.
+#[inline(always)]
+pub(crate) fn finish(
+    vertices: Vec<DVec3>,
+    faces: Vec<Face>,
+    (edges, face_edges): (Vec<Edge>, Vec<usize>),
+    vertex_pairs: Vec<[usize; 2]>,
+    kinds: Vec<FaceKind>,
+    rotation: DMat3,
+) -> Option<Result<Obstacle, OverlayFailure>> {
+    if vertices.len() + faces.len() != edges.len() + 2 {
         return None;
     }
     let polytope = ConvexPolytope::from_faces_and_edges(vertices, faces, edges, face_edges);

@@ -39,8 +39,8 @@
 use glam::{DMat3, DVec3};
 use stackplan_geom::polytope::{ConvexPolytope, Face, Plane};
 
-use crate::minkowski::{FaceKind, FaceSpec, Feature, Obstacle, OverlayFailure, Route};
-use crate::prism_assembly::{EMPTY, Half, POLE, TWIN, VERTICAL, edge_table};
+use crate::minkowski::{FaceKind, FaceSpec, Feature, Obstacle, OverlayFailure};
+use crate::prism_assembly::{EMPTY, Half, POLE, TWIN, VERTICAL, edge_table, finish};
 use crate::z_prism::{self, Poles};
 
 /// Working buffers, kept per thread with the overlay's.
@@ -358,17 +358,8 @@ pub(crate) fn obstacle(
     }
     vertex_pairs.extend_from_slice(numbered);
     let vertices = coords.to_vec();
-    let (edges, face_edges) = edge_table(stars, prev, start, faces.len(), Vec::with_capacity(3 * k))?;
-    if nv + faces.len() != edges.len() + 2 {
-        return None;
-    }
-    let polytope = ConvexPolytope::from_faces_and_edges(vertices, faces, edges, face_edges);
-    Some(match polytope {
-        Ok(polytope) => {
-            Obstacle::from_parts(polytope, vertex_pairs, kinds, rotation, Route::GaussMap).ok_or(OverlayFailure::Euler)
-        }
-        Err(e) => Err(OverlayFailure::Assembly(e)),
-    })
+    let table = edge_table(stars, prev, start, faces.len(), Vec::with_capacity(3 * k))?;
+    finish(vertices, faces, table, vertex_pairs, kinds, rotation)
 }
 
 #[cfg(test)]
