@@ -182,14 +182,14 @@ mod tests {
             for (x, y, z, d) in cuts {
                 list.push(hs([x, y, z], d));
             }
-            let cell = Cell::new(list, tol).unwrap();
+            let cell = Cell::new(list, tol).expect("finite inequalities inside a box: a bounded cell");
             prop_assume!(!cell.is_empty());
             let b = cell.grown_outer_box();
             for i in 0..3 {
                 for sign in [1.0, -1.0] {
                     let mut e = [0.0; 3];
                     e[i] = sign;
-                    let (h, _) = cell.support(&e).unwrap().unwrap();
+                    let (h, _) = cell.support(&e).expect("support LP").expect("non-empty cell");
                     let bound = if sign > 0.0 { b.1[i] } else { -b.0[i] };
                     prop_assert!(h <= bound + 1e-12, "support {h} beyond the box {bound} on axis {i} sign {sign}");
                 }
@@ -197,8 +197,9 @@ mod tests {
             let normal = [probe.0, probe.1, probe.2];
             if box_misses_halfspace(&b, &normal, probe.3, tol.linear) {
                 let outside = hs(normal, probe.3).flipped(Tag::User(1));
-                prop_assert!(cell.is_empty_with([outside], &cell.interior_point().unwrap()).unwrap());
-                let (h, _) = cell.support(&normal).unwrap().unwrap();
+                let start = cell.interior_point().expect("non-empty cell");
+                prop_assert!(cell.is_empty_with([outside], &start).expect("phase 1"));
+                let (h, _) = cell.support(&normal).expect("support LP").expect("non-empty cell");
                 prop_assert!(h < probe.3);
             }
         }

@@ -1312,14 +1312,12 @@ impl Search<'_, '_> {
         let fixed_z = state.fixed_z;
         let tol = self.tol;
         // every added cell lies in `Omega_new(theta)`, whose normals (the floor's sides, the floor and the ceiling)
-        // are the same at every orientation: the first non-empty one's boundedness check (as `Cell::new` makes it)
-        // answers for all of them, as in `Search::start`, and the cells are built without their own (`2 D` LPs each)
+        // are the same at every orientation: the first non-empty root's boundedness check answers for all of them,
+        // as in `Search::start`, and the cells are built without their own (`2 D` LPs each)
         for o in self.orientations.iter().filter(|o| self.owns(o.index)) {
-            let Some(new_hs) = self.omega::<D>(o, &self.request.floor, fixed_z) else {
-                continue;
-            };
-            let fs_err = |reason: String| PlacementError::FreeSpace { orientation: o.index, reason };
-            if !Cell::new(new_hs, tol).map_err(|e| fs_err(e.to_string()))?.is_empty() {
+            if let Some(root) = self.root_cell::<D>(o, fixed_z)? {
+                root.check_bounded()
+                    .map_err(|e| PlacementError::FreeSpace { orientation: o.index, reason: e.to_string() })?;
                 break;
             }
         }
@@ -1526,17 +1524,15 @@ impl Search<'_, '_> {
                     // build and solve the child now; push it back with its true cost (>= its key)
                     let t_cells = Instant::now();
                     let f = &mut heap.families[family as usize];
-                    if f.reach.is_none() {
-                        f.reach = Some(f.cell.grown_outer_box());
-                    }
+                    let reach = *f.reach.get_or_insert_with(|| f.cell.grown_outer_box());
                     let f = &heap.families[family as usize];
                     let orientation = f.orientation;
                     self.child_inequalities::<D>(f.obstacle, face, fixed_z, &mut buffers.extra);
                     // the child's outside half-space (`-n . p <= -d`, last) missing the box around the parent cell
                     // grown by the tolerance: empty, as its phase 1 would find (`box_misses_halfspace`; only when
                     // every inequality is finite, which the phase 1 would reject with an error)
-                    let misses = f.reach.as_ref().zip(buffers.extra.last()).is_some_and(|(reach, outside)| {
-                        box_misses_halfspace(reach, &outside.normal.map(|c| -c), -outside.offset, tol)
+                    let misses = buffers.extra.last().is_some_and(|outside| {
+                        box_misses_halfspace(&reach, &outside.normal.map(|c| -c), -outside.offset, tol)
                     }) && buffers
                         .extra
                         .iter()
