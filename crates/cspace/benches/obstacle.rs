@@ -48,7 +48,7 @@ fn bench(c: &mut Criterion) {
         g.bench_function("exact_hull", |bn| bn.iter(|| obstacle_by_hull(black_box(a), *r, black_box(b))));
         // the share of the assembly into a checked geom::ConvexPolytope (edge table, planes) in the gauss_map figure
         let verts = o.polytope().vertices().to_vec();
-        let faces: Vec<Vec<usize>> = o.polytope().faces().iter().map(|f| f.vertices.clone()).collect();
+        let faces: Vec<Vec<usize>> = o.polytope().faces().iter().map(|f| f.vertices.to_vec()).collect();
         let planes: Vec<stackplan_geom::Plane> = o.polytope().planes().copied().collect();
         g.bench_function("polytope_assembly_only", |bn| {
             bn.iter(|| ConvexPolytope::with_planes(verts.clone(), faces.clone(), planes.clone()))

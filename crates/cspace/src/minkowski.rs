@@ -65,7 +65,7 @@ use glam::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
 use stackplan_geom::polytope::{Containment, ConvexPolytope, Face, Plane, PolytopeError};
 use stackplan_geom::tolerance::{RELATIVE, Tolerance};
-use stackplan_geom::{HullError, convex_hull};
+use stackplan_geom::{HullError, VertexCycle, convex_hull};
 
 use crate::edge_table::{self, EdgeScratch};
 use crate::{prism_assembly, prism_merge, z_prism};
@@ -954,7 +954,7 @@ fn assemble(
             if corners.len() < 3 {
                 return Err(OverlayFailure::FlatFace);
             }
-            let mut face = Vec::with_capacity(corners.len());
+            let mut face = VertexCycle::with_capacity(corners.len());
             let mut offset = f64::NEG_INFINITY;
             for &[i, j] in corners {
                 let slot = &mut index_of[i * nb + j];

@@ -29,6 +29,7 @@
 //! Complexity: O(V + F + sum of the face lengths), no allocation besides the result's own.
 
 use glam::{DMat3, DVec3};
+use stackplan_geom::VertexCycle;
 use stackplan_geom::polytope::{ConvexPolytope, Edge, Face, Plane};
 
 use crate::minkowski::{FaceKind, FaceSpec, Feature, Obstacle, OverlayFailure, Route};
@@ -179,9 +180,9 @@ pub(crate) fn assemble(
         let (start, end) = (range[0], range[1]);
         let corners = cycles.get(start..end)?;
         let face_index = s as u32;
-        let face: Vec<usize> = if let (Feature::Face(_), Feature::Face(_)) = (spec.fixed, spec.moving) {
+        let face: VertexCycle = if let (Feature::Face(_), Feature::Face(_)) = (spec.fixed, spec.moving) {
             // a pole face: every half-edge `a -> b` is filed under its source
-            let mut face = Vec::with_capacity(corners.len());
+            let mut face = VertexCycle::with_capacity(corners.len());
             for &c in corners {
                 face.push(number(c, index_of, nb, &mut vertex_pairs));
             }
@@ -217,7 +218,7 @@ pub(crate) fn assemble(
                 }
                 *slot = Half { other: other as u32, index, face: face_index };
             }
-            vec![v[0], v[1], v[2], v[3]]
+            VertexCycle::from(v)
         };
         if vertex_pairs.len() > nv || face.len() < 3 {
             return None;

@@ -37,6 +37,7 @@
 //! Complexity: O(V + F + k), no allocation besides the result's own.
 
 use glam::{DMat3, DVec3};
+use stackplan_geom::VertexCycle;
 use stackplan_geom::polytope::{ConvexPolytope, Face, Plane};
 
 use crate::minkowski::{FaceKind, FaceSpec, Feature, Obstacle, OverlayFailure};
@@ -227,7 +228,6 @@ pub(crate) fn obstacle(
             }
         }};
     }
-    let (spread, mut class) = (k > 6, 0);
     let mut poles_seen = [false; 2];
     let mut start = 0usize;
     for (s, spec) in specs.iter().enumerate() {
@@ -242,6 +242,8 @@ pub(crate) fn obstacle(
                     return None;
                 }
                 poles_seen[level] = true;
+                // (a `Vec` first: its pushes are cheaper than the inline cycle's, and `k >= 3` corners of a tame pole
+                // rarely fit inline; the conversion keeps the allocation when they do not)
                 let mut face = Vec::with_capacity(k);
                 for key in level * k..(level + 1) * k {
                     let v = number!(key);
@@ -256,7 +258,7 @@ pub(crate) fn obstacle(
                     a = b;
                 }
                 start += k;
-                faces.push(Face { vertices: face, plane: Plane { normal, offset } });
+                faces.push(Face { vertices: VertexCycle::from(face), plane: Plane { normal, offset } });
                 kinds.push(FaceKind::FaceFace { face_a: f, face_b: g });
                 continue;
             }
@@ -330,26 +332,8 @@ pub(crate) fn obstacle(
             }
         }
         start += 4;
-        // (with more than 6 side faces, capacities 4, 6 and 8 in turn: their vectors spread over three size classes of
-        // the allocator's per-thread cache, which keeps 7 blocks of each; more blocks of one class than that, freed
-        // with the obstacle, cost the next obstacle's allocations the slow path)
-        let [a, b, c, d] = v;
-        let face = match class {
-            1 => {
-                let mut face = vec![a, b, c, d, 0, 0];
-                face.truncate(4);
-                face
-            }
-            2 => {
-                let mut face = vec![a, b, c, d, 0, 0, 0, 0];
-                face.truncate(4);
-                face
-            }
-            _ => vec![a, b, c, d],
-        };
-        if spread {
-            class = if class == 2 { 0 } else { class + 1 };
-        }
+        // (a quadrilateral: stored inline in its face, no allocation)
+        let face = VertexCycle::from(v);
         faces.push(Face { vertices: face, plane: Plane { normal, offset } });
         kinds.push(kind);
     }

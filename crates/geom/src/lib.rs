@@ -24,6 +24,7 @@ pub mod predicates;
 pub mod sheet_metal;
 pub mod tolerance;
 pub mod triangulate;
+pub mod vertex_cycle;
 
 pub use glam::{DMat3, DVec2, DVec3};
 pub use hull::{ConvexHull, HullError, convex_hull};
@@ -34,3 +35,4 @@ pub use polytope::{Containment, ConvexPolytope, Edge, Face, Plane, PolytopeError
 pub use pose::{Pose, PoseError};
 pub use sheet_metal::{Decomposition, SheetFace, SheetMetal, SheetMetalError};
 pub use tolerance::Tolerance;
+pub use vertex_cycle::VertexCycle;

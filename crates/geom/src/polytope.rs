@@ -7,6 +7,7 @@
 
 use crate::predicates;
 use crate::tolerance::Tolerance;
+use crate::vertex_cycle::VertexCycle;
 use glam::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
 use std::cmp::Ordering;
@@ -31,8 +32,9 @@ impl Plane {
 /// A polygonal face: vertex indices counter-clockwise seen from outside, and its plane.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Face {
-    /// Indices into [`ConvexPolytope::vertices`], counter-clockwise seen from outside.
-    pub vertices: Vec<usize>,
+    /// Indices into [`ConvexPolytope::vertices`], counter-clockwise seen from outside (a quadrilateral or smaller
+    /// without a heap allocation).
+    pub vertices: VertexCycle,
     /// The face's plane with unit outward normal.
     pub plane: Plane,
 }
@@ -192,7 +194,7 @@ impl ConvexPolytope {
         let mut out = Vec::with_capacity(faces.len());
         for (f, face) in faces.into_iter().enumerate() {
             let plane = plane_of(&vertices, &face).ok_or(PolytopeError::DegenerateFace { face: f })?;
-            out.push(Face { vertices: face, plane });
+            out.push(Face { vertices: face.into(), plane });
         }
         Ok(Self { vertices, faces: out, edges, face_edges })
     }
@@ -248,7 +250,7 @@ impl ConvexPolytope {
                     given.unwrap_or(computed)
                 }
             };
-            out.push(Face { vertices: face, plane });
+            out.push(Face { vertices: face.into(), plane });
         }
         Ok(Self { vertices, faces: out, edges, face_edges })
     }
@@ -587,6 +589,13 @@ impl<'de> Deserialize<'de> for FaceEdgeTable {
 
 /// Finite coordinates and at most [`MAX_VERTICES`] vertices.
 fn check_vertices(vertices: &[DVec3]) -> Result<(), PolytopeError> {
+    // `x - x` is 0 for a finite `x` and NaN for an infinite or NaN one, so the sum is 0 exactly when every coordinate
+    // is finite: one branch-free pass (vectorised), and the scan below only to name the first offending vertex
+    #[expect(clippy::eq_op, reason = "`v - v` is the finiteness test: 0 for finite coordinates, NaN otherwise")]
+    let zero = vertices.iter().fold(DVec3::ZERO, |sum, &v| sum + (v - v));
+    if zero == DVec3::ZERO && vertices.len() <= MAX_VERTICES {
+        return Ok(());
+    }
     for (i, v) in vertices.iter().enumerate() {
         if !v.is_finite() {
             return Err(PolytopeError::NonFinite { vertex: i });
@@ -831,15 +840,33 @@ mod tests {
     fn rejects_bad_face_lists() {
         let c = unit_cube();
         let v = c.vertices().to_vec();
-        let mut faces: Vec<Vec<usize>> = c.faces().iter().map(|f| f.vertices.clone()).collect();
+        let mut faces: Vec<Vec<usize>> = c.faces().iter().map(|f| f.vertices.to_vec()).collect();
         faces.pop();
         assert!(matches!(ConvexPolytope::new(v.clone(), faces.clone()), Err(PolytopeError::NotManifold { .. })));
         faces.push(vec![1, 3]);
         assert!(matches!(ConvexPolytope::new(v.clone(), faces), Err(PolytopeError::FaceTooSmall { .. })));
         let mut bad = v.clone();
         bad[3].x = f64::NAN;
-        let faces: Vec<Vec<usize>> = c.faces().iter().map(|f| f.vertices.clone()).collect();
+        let faces: Vec<Vec<usize>> = c.faces().iter().map(|f| f.vertices.to_vec()).collect();
         assert!(matches!(ConvexPolytope::new(bad, faces.clone()), Err(PolytopeError::NonFinite { vertex: 3 })));
+        // every vertex and coordinate, every kind of non-finite value, also with a second bad vertex after it
+        for (i, axis, value) in
+            (0..8).flat_map(|i| (0..3).flat_map(move |a| [f64::NAN, f64::INFINITY, -f64::INFINITY].map(|x| (i, a, x))))
+        {
+            let mut bad = v.clone();
+            bad[i][axis] = value;
+            if i < 7 {
+                bad[7].z = f64::NAN;
+            }
+            let got = ConvexPolytope::new(bad, faces.clone());
+            assert!(
+                matches!(got, Err(PolytopeError::NonFinite { vertex }) if vertex == i),
+                "{i} {axis} {value}: {got:?}"
+            );
+        }
+        // huge but finite coordinates whose sum overflows are accepted
+        let huge: Vec<DVec3> = v.iter().map(|&p| p * f64::MAX).collect();
+        assert!(!matches!(ConvexPolytope::new(huge, faces.clone()), Err(PolytopeError::NonFinite { .. })));
         // a dented cube: vertex 7 pushed inwards makes the polytope non-convex
         let mut dented = v;
         dented[7] = DVec3::splat(0.6);
@@ -879,7 +906,7 @@ mod tests {
         let keys: Vec<[usize; 2]> = c.edges().iter().map(|e| e.vertices).collect();
         assert!(keys.windows(2).all(|w| w[0] < w[1]));
         assert!(keys.iter().all(|k| k[0] < k[1]));
-        let mut faces: Vec<Vec<usize>> = c.faces().iter().map(|f| f.vertices.clone()).collect();
+        let mut faces: Vec<Vec<usize>> = c.faces().iter().map(|f| f.vertices.to_vec()).collect();
         faces.reverse();
         let r = ConvexPolytope::new(c.vertices().to_vec(), faces).expect("cube");
         assert_eq!(r.edges().iter().map(|e| e.vertices).collect::<Vec<_>>(), keys);
@@ -906,10 +933,10 @@ mod tests {
     fn from_faces_equals_with_planes() {
         let c = unit_cube();
         let planes: Vec<Plane> = c.planes().map(|p| Plane { normal: p.normal, offset: p.offset + 0.5 }).collect();
-        let faces: Vec<Vec<usize>> = c.faces().iter().map(|f| f.vertices.clone()).collect();
+        let faces: Vec<Vec<usize>> = c.faces().iter().map(|f| f.vertices.to_vec()).collect();
         let a = ConvexPolytope::with_planes(c.vertices().to_vec(), faces.clone(), planes.clone()).expect("cube");
         let given: Vec<Face> =
-            faces.iter().zip(&planes).map(|(v, p)| Face { vertices: v.clone(), plane: *p }).collect();
+            faces.iter().zip(&planes).map(|(v, p)| Face { vertices: v.as_slice().into(), plane: *p }).collect();
         let b = ConvexPolytope::from_faces(c.vertices().to_vec(), given.clone()).expect("cube");
         assert_eq!(a, b);
         // fewer planes than faces: the rest are computed, as `new` does

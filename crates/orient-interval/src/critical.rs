@@ -608,7 +608,7 @@ fn feature_vertices(p: &ConvexPolytope, f: Feature) -> Vec<usize> {
     match f {
         Feature::Vertex(v) => vec![v],
         Feature::Edge(e) => p.edges()[e].vertices.to_vec(),
-        Feature::Face(f) => p.faces()[f].vertices.clone(),
+        Feature::Face(f) => p.faces()[f].vertices.to_vec(),
     }
 }
 

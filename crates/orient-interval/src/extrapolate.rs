@@ -15,6 +15,7 @@
 use crate::critical::{Interval, NormalRecipe, PairEvents};
 use glam::{DMat3, DVec3};
 use stackplan_cspace::minkowski::{Obstacle, ObstacleError, Route, obstacle};
+use stackplan_geom::VertexCycle;
 use stackplan_geom::polytope::{ConvexPolytope, Plane, PolytopeError};
 
 /// Why an obstacle could not be extrapolated.
@@ -66,7 +67,7 @@ pub struct ObstacleStructure {
     built_at: f64,
     interval: Interval,
     template: Obstacle,
-    faces: Vec<Vec<usize>>,
+    faces: Vec<VertexCycle>,
     recipes: Vec<NormalRecipe>,
 }
 

@@ -198,7 +198,7 @@ fn pair_json(args: &Args, pair: &PairObstacle) -> PairJson {
         .map(|(f, k): (_, &FaceKind)| FaceJson {
             normal: f.plane.normal.to_array(),
             offset: f.plane.offset,
-            vertices: f.vertices.clone(),
+            vertices: f.vertices.to_vec(),
             kind: k.name(),
             fixed_feature: k.fixed_feature(),
             moving_feature: k.moving_feature(),

@@ -142,7 +142,7 @@ pub fn part_info(part: &Part, with_pieces: bool) -> PartInfo {
                         .faces()
                         .iter()
                         .map(|f| FaceJson {
-                            vertices: f.vertices.clone(),
+                            vertices: f.vertices.to_vec(),
                             normal: arr(f.plane.normal),
                             offset: f.plane.offset,
                         })
