@@ -17,7 +17,9 @@
 //!   projection onto its own face normals is precomputed ([`PlacedConvex::normal_extents`]), and a cross axis
 //!   parallel to a face normal of either polytope is not tested again ([`cross_axis`]; the two gaps differ only by
 //!   rounding). For parts turned about z most cross axes are such duplicates (box x box: all 8 non-zero ones), so
-//!   the box pair costs 6 half-projections instead of 15 full ones.
+//!   the box pair costs 6 half-projections instead of 15 full ones. For two *upright prisms*
+//!   ([`PlacedConvex::upright_prism`]: sheet metal turned about z) every cross axis is such a duplicate, provably
+//!   from the flag's conditions, and the cross products are not even formed.
 //! * **Clearance** `delta > 0`: pairs whose Euclidean distance is below `delta` are reported too. The SAT gap is only a
 //!   lower bound on the distance of separated polytopes, so candidates with `tol < gap < delta` get their exact
 //!   distance from parry3d-f64's GJK (`query::distance`) on the two polyhedra.
@@ -46,6 +48,34 @@ pub struct PlacedConvex {
     pub edge_normal_masks: Vec<u64>,
     /// World AABB `(min, max)`.
     pub aabb: (DVec3, DVec3),
+    /// Whether every cross axis of this polytope's edge directions with those of another upright prism duplicates
+    /// a normal axis ([`cross_axis`] returns `None` for every pair), so that [`sat_gap`] can skip them all with the
+    /// same result. Computed exactly from the axes ([`is_upright_prism`]): some normal axis among the first 64 is
+    /// vertical (`x == y == 0`), and every edge direction is either vertical or horizontal (`z == 0`) with a
+    /// horizontal normal axis among the first 64 perpendicular to it to within `1e-13` of its length. A z-prism
+    /// turned about z (the planner's sheet metal) is one.
+    pub upright_prism: bool,
+}
+
+/// The conditions of [`PlacedConvex::upright_prism`]. For two polytopes that meet them, each pair of edge directions
+/// `da`, `db` gives one of (exact arithmetic on exact zeros): both vertical, `da x db = 0`, parallel; both
+/// horizontal, `da x db = (0, 0, c)`, exactly parallel to the vertical normal axis (perpendicular to every
+/// horizontal edge, so named in its mask); one horizontal (`d`, with its witness normal `n`: `n.z = 0`, in the
+/// mask since `|n . d| <= 1e-13 |d| <= 1e-9`) and one vertical (`s z`): `c = d x (s z)` is horizontal, and
+/// `c x n = (0, 0, s (n . d))` up to an ulp, so `|c x n|^2 <= 1.01e-26 s^2 |d|^2 <= 1e-24 |c|^2`: a duplicate.
+pub fn is_upright_prism(normal_axes: &[DVec3], edge_directions: &[DVec3]) -> bool {
+    let normals = &normal_axes[..normal_axes.len().min(64)];
+    let vertical = |u: &DVec3| u.x == 0.0 && u.y == 0.0 && u.z != 0.0;
+    normals.iter().any(vertical)
+        && edge_directions.iter().all(|d| {
+            vertical(d)
+                || (d.z == 0.0
+                    && d.is_finite()
+                    && normals.iter().any(|n| {
+                        let dot = n.dot(*d);
+                        n.z == 0.0 && dot.abs() <= PERPENDICULAR && dot * dot <= 1e-26 * d.length_squared()
+                    }))
+        })
 }
 
 /// Adds `d` to `set` unless a parallel (or antiparallel) direction is already there.
@@ -80,13 +110,16 @@ pub fn perpendicular_masks(normal_axes: &[DVec3], edge_directions: &[DVec3]) -> 
         .collect()
 }
 
-/// Whether unit axis `c` is parallel to one of the normal axes that `mask` names.
+/// Whether the axis `c` (of squared length `len2 > 0`) is parallel to one of the unit normal axes that `mask` names:
+/// `|c x n|^2 <= PARALLEL_AXIS |c|^2`, the test on the unit axis `c / |c|` without normalising `c` first (most cross
+/// axes of sheet-metal pairs are such duplicates, and the square root and the divisions were most of their cost).
 #[inline]
-fn parallel_to_any(c: DVec3, normals: &[DVec3], mut mask: u64) -> bool {
+fn parallel_to_any(c: DVec3, len2: f64, normals: &[DVec3], mut mask: u64) -> bool {
+    let bound = PARALLEL_AXIS * len2;
     while mask != 0 {
         let k = mask.trailing_zeros() as usize;
         mask &= mask - 1;
-        if c.cross(normals[k]).length_squared() <= PARALLEL_AXIS {
+        if c.cross(normals[k]).length_squared() <= bound {
             return true;
         }
     }
@@ -113,11 +146,21 @@ pub fn cross_axis(
     if len2 <= 1e-18 {
         return None;
     }
-    let c = c / len2.sqrt();
-    if parallel_to_any(c, a_normals, mask_a) || parallel_to_any(c, b_normals, mask_b) {
+    // (B's list first when A's names three normals or more: the answer is the same, and a vertical edge of a z-prism
+    // is perpendicular to every side normal while the cross axes it forms are duplicates of the other prism's normals)
+    let at_least_three = |m: u64| {
+        let rest = m & m.wrapping_sub(1);
+        rest & rest.wrapping_sub(1) != 0
+    };
+    let (first, second) = if at_least_three(mask_a) {
+        ((b_normals, mask_b), (a_normals, mask_a))
+    } else {
+        ((a_normals, mask_a), (b_normals, mask_b))
+    };
+    if parallel_to_any(c, len2, first.0, first.1) || parallel_to_any(c, len2, second.0, second.1) {
         return None;
     }
-    Some(c)
+    Some(c / len2.sqrt())
 }
 
 impl PlacedConvex {
@@ -148,7 +191,8 @@ impl PlacedConvex {
     ) -> Self {
         let normal_extents = normal_axes.iter().map(|u| project(&vertices, *u)).collect();
         let edge_normal_masks = perpendicular_masks(&normal_axes, &edge_directions);
-        Self { vertices, normal_axes, normal_extents, edge_directions, edge_normal_masks, aabb }
+        let upright_prism = is_upright_prism(&normal_axes, &edge_directions);
+        Self { vertices, normal_axes, normal_extents, edge_directions, edge_normal_masks, aabb, upright_prism }
     }
 
     /// The polytope moved by `p`: vertices `v + p`, extents `[lo + u . p, hi + u . p]`.
@@ -168,6 +212,7 @@ impl PlacedConvex {
             edge_directions: self.edge_directions.clone(),
             edge_normal_masks: self.edge_normal_masks.clone(),
             aabb: (self.aabb.0 + p, self.aabb.1 + p),
+            upright_prism: self.upright_prism,
         }
     }
 }
@@ -228,6 +273,10 @@ pub fn sat_gap(a: &PlacedConvex, b: &PlacedConvex, stop_above: f64) -> f64 {
         if gap_of(project(&a.vertices, u), eb) {
             return best;
         }
+    }
+    if a.upright_prism && b.upright_prism {
+        // every cross axis duplicates a normal axis (`is_upright_prism`)
+        return best;
     }
     for (&da, &ma) in a.edge_directions.iter().zip(&a.edge_normal_masks) {
         for (&db, &mb) in b.edge_directions.iter().zip(&b.edge_normal_masks) {

@@ -75,8 +75,13 @@ proptest! {
                         (-1, Some(PairContact::Separated { gap })) => {
                             prop_assert!(clearance > 0.0 && gap < clearance);
                             let d = distance_between(a, r, p, &world_b);
+                            // (the QP oracle solves for the squared distance to about 1e-8 relative on an objective
+                            // of order |p|^2 <= 20: a distance of a few micrometres is only resolved to its square)
                             if let Some(d) = d {
-                                prop_assert!((d - gap).abs() < 1e-6, "GJK gap {} vs QP distance {}", gap, d);
+                                prop_assert!(
+                                    (d - gap).abs() < 1e-6 || (d * d - gap * gap).abs() < 1e-6,
+                                    "GJK gap {} vs QP distance {}", gap, d
+                                );
                             }
                         }
                         (e, h) => prop_assert!(false, "pair ({}, {}, {}): LP says {} (slack {}), found {:?}", mi, fp, fi, e, t, h),

@@ -9,7 +9,8 @@ use common::*;
 use glam::{DMat3, DVec3};
 use proptest::prelude::*;
 use stackplan_cspace::interference::{
-    PairContact, PlacedConvex, classify_pair, classify_pair_all_axes, cross_axis, project, sat_gap, sat_gap_all_axes,
+    PairContact, PlacedConvex, classify_pair, classify_pair_all_axes, cross_axis, is_upright_prism, project, sat_gap,
+    sat_gap_all_axes,
 };
 use stackplan_geom::ConvexPolytope;
 
@@ -82,6 +83,42 @@ proptest! {
         }
     }
 
+    /// Two upright prisms (the flag): every cross axis is a duplicate, as `is_upright_prism` proves, so skipping them
+    /// all gives the gap of the scan that forms each one, bit for bit; z-prisms turned about z are always flagged.
+    #[test]
+    fn upright_prisms_have_only_duplicate_cross_axes(
+        (a, b) in pair(),
+        ra in z_or_general_rotation(),
+        rb in z_or_general_rotation(),
+        pa in grid_position(),
+    ) {
+        let placed_a = PlacedConvex::new(&a, ra, pa);
+        let placed_b = PlacedConvex::new(&b, rb, DVec3::ZERO);
+        for placed in [&placed_a, &placed_b] {
+            prop_assert_eq!(placed.upright_prism, is_upright_prism(&placed.normal_axes, &placed.edge_directions));
+            prop_assert_eq!(placed.translated(pa).upright_prism, placed.upright_prism);
+        }
+        let z_prism = |p: &ConvexPolytope| p.faces().iter().filter(|f| f.plane.normal.z != 0.0).count() == 2
+            && p.faces().iter().all(|f| f.plane.normal.z == 0.0 || (f.plane.normal.x == 0.0 && f.plane.normal.y == 0.0));
+        let about_z = |r: &DMat3| r.z_axis == DVec3::Z && r.x_axis.z == 0.0 && r.y_axis.z == 0.0;
+        if z_prism(&a) && about_z(&ra) {
+            prop_assert!(placed_a.upright_prism);
+        }
+        if placed_a.upright_prism && placed_b.upright_prism {
+            for (&da, &ma) in placed_a.edge_directions.iter().zip(&placed_a.edge_normal_masks) {
+                for (&db, &mb) in placed_b.edge_directions.iter().zip(&placed_b.edge_normal_masks) {
+                    prop_assert!(cross_axis(da, ma, &placed_a.normal_axes, db, mb, &placed_b.normal_axes).is_none());
+                }
+            }
+        }
+        let (mut plain_a, mut plain_b) = (placed_a.clone(), placed_b.clone());
+        plain_a.upright_prism = false;
+        plain_b.upright_prism = false;
+        for stop in [f64::INFINITY, -0.3, 0.0, TOL] {
+            prop_assert_eq!(sat_gap(&placed_a, &placed_b, stop).to_bits(), sat_gap(&plain_a, &plain_b, stop).to_bits());
+        }
+    }
+
     /// `translated` shifts the extents by `u . p`: equal to projecting the moved vertices up to rounding.
     #[test]
     fn translated_extents_match_projections((a, _b) in pair(), r in z_or_general_rotation(), p in grid_position()) {
@@ -120,6 +157,26 @@ fn boxes_turned_about_z_need_no_cross_axes() {
             other => panic!("theta {theta}: {other:?}"),
         }
     }
+}
+
+/// The flag's conditions on hand-made axes: an exactly vertical normal axis is needed, a horizontal edge needs a
+/// horizontal normal perpendicular to it within `1e-13`, a tilted edge or a witness beyond the first 64 normals fails.
+#[test]
+fn upright_prism_conditions() {
+    let (x, y, z) = (DVec3::X, DVec3::Y, DVec3::Z);
+    assert!(is_upright_prism(&[z, x, y], &[x, y, z]));
+    assert!(!is_upright_prism(&[x, y], &[x, y, z]), "no vertical normal axis");
+    assert!(!is_upright_prism(&[z, x], &[x, y, z]), "no horizontal normal perpendicular to x");
+    assert!(!is_upright_prism(&[z, x, y], &[x, y, DVec3::new(0.0, 1e-20, 1.0)]), "a tilted edge");
+    let off = DVec3::new(1e-12, 1.0, 0.0).normalize();
+    assert!(!is_upright_prism(&[z, off], &[x]), "perpendicular only within 1e-12");
+    let near = DVec3::new(1e-14, 1.0, 0.0).normalize();
+    assert!(is_upright_prism(&[z, near], &[x]));
+    let mut many: Vec<DVec3> = (0..64).map(|k| DVec3::new((k as f64).cos(), (k as f64).sin(), 0.0)).collect();
+    many[0] = z;
+    many.push(y);
+    assert!(!is_upright_prism(&many, &[x]), "the witness is normal 64, beyond the masks");
+    assert!(!is_upright_prism(&[z, y], &[DVec3::new(f64::NAN, 0.0, 0.0)]));
 }
 
 /// Edge-on-edge contact of two tilted boxes (the separating axis is a genuine cross product, which is kept):
