@@ -32,6 +32,11 @@ fn pair() -> impl Strategy<Value = (ConvexPolytope, ConvexPolytope)> {
     prop_oneof![prism_pair(), (any_box(), any_box()), (dyadic_cloud(4..12), dyadic_cloud(4..12))]
 }
 
+/// A pair, its rotations and the first one's position (the second stays at the origin).
+fn case() -> impl Strategy<Value = ((ConvexPolytope, ConvexPolytope), DMat3, DMat3, DVec3)> {
+    (pair(), z_or_general_rotation(), z_or_general_rotation(), grid_position())
+}
+
 /// The decision of a gap with tolerance `TOL`: -1 separated, 0 touching, 1 penetrating.
 fn decision(gap: f64) -> i8 {
     if gap < -TOL {
@@ -50,13 +55,9 @@ proptest! {
     /// the LP's decision where it is clear.
     #[test]
     fn pruned_gap_equals_the_complete_axis_set(
-        (a, b) in pair(),
-        ra in z_or_general_rotation(),
-        rb in z_or_general_rotation(),
-        pa in grid_position(),
+        ((a, b), ra, rb, pa) in case(),
     ) {
-        let placed_a = PlacedConvex::new(&a, ra, pa);
-        let placed_b = PlacedConvex::new(&b, rb, DVec3::ZERO);
+        let (placed_a, placed_b) = (PlacedConvex::new(&a, ra, pa), PlacedConvex::new(&b, rb, DVec3::ZERO));
         let full = sat_gap_all_axes(&placed_a, &placed_b, f64::INFINITY);
         let pruned = sat_gap(&placed_a, &placed_b, f64::INFINITY);
         prop_assert!((full - pruned).abs() <= 1e-11, "full {} pruned {}", full, pruned);
@@ -87,13 +88,9 @@ proptest! {
     /// all gives the gap of the scan that forms each one, bit for bit; z-prisms turned about z are always flagged.
     #[test]
     fn upright_prisms_have_only_duplicate_cross_axes(
-        (a, b) in pair(),
-        ra in z_or_general_rotation(),
-        rb in z_or_general_rotation(),
-        pa in grid_position(),
+        ((a, b), ra, rb, pa) in case(),
     ) {
-        let placed_a = PlacedConvex::new(&a, ra, pa);
-        let placed_b = PlacedConvex::new(&b, rb, DVec3::ZERO);
+        let (placed_a, placed_b) = (PlacedConvex::new(&a, ra, pa), PlacedConvex::new(&b, rb, DVec3::ZERO));
         for placed in [&placed_a, &placed_b] {
             prop_assert_eq!(placed.upright_prism, is_upright_prism(&placed.normal_axes, &placed.edge_directions));
             prop_assert_eq!(placed.translated(pa).upright_prism, placed.upright_prism);
