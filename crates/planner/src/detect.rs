@@ -18,6 +18,7 @@
 
 use crate::orientation::Orientation;
 use glam::{DMat3, DVec3};
+use std::collections::BinaryHeap;
 use stackplan_cspace::PlacedConvex;
 use stackplan_cspace::interference::{PairContact, gjk_distance, project};
 use stackplan_geom::polytope::ConvexPolytope;
@@ -269,7 +270,42 @@ struct OpenPair {
     moving: usize,
     fixed: usize,
     best: f64,
+    /// [`CandidateQueue::bound`] of `best`, kept for the heap's order.
+    bound: f64,
 }
+
+impl OpenPair {
+    fn key(&self) -> (f64, usize, usize) {
+        (self.bound, self.moving, self.fixed)
+    }
+}
+
+/// The queue's order: the greatest open pair is the one whose bound precedes every other's ([`precedes`]).
+impl Ord for OpenPair {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        if precedes(self.key(), other.key()) {
+            std::cmp::Ordering::Greater
+        } else if precedes(other.key(), self.key()) {
+            std::cmp::Ordering::Less
+        } else {
+            std::cmp::Ordering::Equal
+        }
+    }
+}
+
+impl PartialOrd for OpenPair {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl PartialEq for OpenPair {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == std::cmp::Ordering::Equal
+    }
+}
+
+impl Eq for OpenPair {}
 
 /// A value at most the largest per-axis value of the complete scan of a pair whose boxes are `a` and `b` (so that
 /// [`CandidateQueue::bound`] of it bounds the pair's violation from above), from the boxes alone.
@@ -305,7 +341,8 @@ pub struct CandidateQueue {
     tol: f64,
     rule: Rule,
     moved: Vec<MovedComponent>,
-    open: Vec<OpenPair>,
+    /// The open pairs, a max-heap in the order of their bounds (each bound is fixed until the pair is scanned).
+    open: BinaryHeap<OpenPair>,
     exact: Vec<Candidate>,
 }
 
@@ -335,14 +372,14 @@ impl CandidateQueue {
         } else {
             Rule { weight: 0.0, stop: tol.max(clearance), inclusive: false }
         };
-        let QueueLists { mut moved, mut near, open, exact } = std::mem::take(&mut scratch.spare);
+        let QueueLists { mut moved, mut near, open: mut pending, exact } = std::mem::take(&mut scratch.spare);
+        pending.clear();
         for m in &mut moved {
             m.vertices.clear();
             m.own.clear();
         }
         moved.resize_with(orientation.components.len(), MovedComponent::default);
-        let mut queue = Self { p, clearance, horizontal, tol, rule, moved, open, exact };
-        queue.open.clear();
+        let mut queue = Self { p, clearance, horizontal, tol, rule, moved, open: BinaryHeap::new(), exact };
         queue.exact.clear();
         let margin = clearance + tol;
         // broad phase in two levels: the stack components near the whole part's box (a superset of each
@@ -376,10 +413,12 @@ impl CandidateQueue {
                 counts.narrow_phase += 1;
                 // (not scanned yet: the boxes bound its violation; `next` scans it when that bound matters)
                 let best = box_bound(&moved_box, &fixed.placed.aabb, rule.weight, tol);
-                queue.open.push(OpenPair { moving: mi, fixed: fi, best });
+                pending.push(OpenPair { moving: mi, fixed: fi, best, bound: queue.bound(best) });
             }
         }
         scratch.spare.near = near;
+        // (heapified in O(n): most detections take only the first few pairs)
+        queue.open = BinaryHeap::from(pending);
         queue
     }
 
@@ -387,19 +426,19 @@ impl CandidateQueue {
     /// the allocations of the next one).
     pub fn recycle(self, scratch: &mut DetectScratch) {
         let near = std::mem::take(&mut scratch.spare.near);
-        scratch.spare = QueueLists { moved: self.moved, near, open: self.open, exact: self.exact };
+        scratch.spare = QueueLists { moved: self.moved, near, open: self.open.into_vec(), exact: self.exact };
     }
 
     /// Upper bound of an open pair's violation: from the running maximum, plus (with a clearance, where
     /// `classify_pair` replaces the gap by parry's GJK distance, which is the true distance only up to GJK's own
     /// accuracy) a margin of `1e-3 clearance + tol` covering GJK's error.
-    fn bound(&self, o: &OpenPair) -> f64 {
+    fn bound(&self, best: f64) -> f64 {
         if self.horizontal {
-            -o.best
+            -best
         } else if self.clearance > self.tol {
-            self.clearance - o.best + 1e-3 * self.clearance + self.tol
+            self.clearance - best + 1e-3 * self.clearance + self.tol
         } else {
-            self.clearance - o.best
+            self.clearance - best
         }
     }
 
@@ -415,24 +454,18 @@ impl CandidateQueue {
                 let (x, y) = (&self.exact[a], &self.exact[b]);
                 if precedes((y.violation, y.moving, y.fixed), (x.violation, x.moving, x.fixed)) { b } else { a }
             });
-            let best_open = (0..self.open.len()).reduce(|a, b| {
-                let (x, y) = (&self.open[a], &self.open[b]);
-                if precedes((self.bound(y), y.moving, y.fixed), (self.bound(x), x.moving, x.fixed)) { b } else { a }
-            });
-            let refine = match (best_exact, best_open) {
+            match (best_exact, self.open.peek()) {
                 (None, None) => return None,
                 (Some(e), None) => return Some(self.exact.swap_remove(e)),
-                (None, Some(o)) => o,
-                (Some(e), Some(o)) => {
-                    let (x, y) = (&self.exact[e], &self.open[o]);
-                    if precedes((self.bound(y), y.moving, y.fixed), (x.violation, x.moving, x.fixed)) {
-                        o
-                    } else {
+                (None, Some(_)) => {}
+                (Some(e), Some(y)) => {
+                    let x = &self.exact[e];
+                    if !precedes(y.key(), (x.violation, x.moving, x.fixed)) {
                         return Some(self.exact.swap_remove(e));
                     }
                 }
-            };
-            let open = self.open.swap_remove(refine);
+            }
+            let Some(open) = self.open.pop() else { return None };
             if let Some(c) = self.finish(open, scene, orientation, sweep) {
                 self.exact.push(c);
             }
@@ -692,7 +725,7 @@ mod tests {
                     );
                     for c in &expected {
                         let open = queue.open.iter().find(|x| (x.moving, x.fixed) == (c.moving, c.fixed));
-                        let bound = open.map(|x| queue.bound(x));
+                        let bound = open.map(|x| x.bound);
                         assert!(bound.is_some_and(|b| b >= c.violation), "{c:?}: bound {bound:?}, p {p}");
                         bounds_checked += 1;
                     }
