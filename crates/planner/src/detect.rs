@@ -18,11 +18,11 @@
 
 use crate::orientation::Orientation;
 use glam::{DMat3, DVec3};
-use std::collections::BinaryHeap;
 use stackplan_cspace::PlacedConvex;
 use stackplan_cspace::interference::{PairContact, gjk_distance, project};
 use stackplan_geom::polytope::ConvexPolytope;
 use stackplan_geom::{Part, Pose};
+use std::collections::BinaryHeap;
 
 /// A component of a stack part, placed in the world.
 #[derive(Debug, Clone)]
@@ -465,7 +465,7 @@ impl CandidateQueue {
                     }
                 }
             }
-            let Some(open) = self.open.pop() else { return None };
+            let open = self.open.pop()?;
             if let Some(c) = self.finish(open, scene, orientation, sweep) {
                 self.exact.push(c);
             }
@@ -711,18 +711,9 @@ mod tests {
                     let expected = reference(&scene, &o, sweep.as_ref(), p, clearance, horizontal, tol);
                     // every violation is within its pair's bound from the boxes alone (what lets the queue leave
                     // pairs unscanned)
+                    let (sw, c, h) = (sweep.as_ref(), clearance, horizontal);
                     let mut counts = DetectCounts::default();
-                    let queue = CandidateQueue::new(
-                        &scene,
-                        &o,
-                        sweep.as_ref(),
-                        p,
-                        clearance,
-                        horizontal,
-                        tol,
-                        &mut scratch,
-                        &mut counts,
-                    );
+                    let queue = CandidateQueue::new(&scene, &o, sw, p, c, h, tol, &mut scratch, &mut counts);
                     for c in &expected {
                         let open = queue.open.iter().find(|x| (x.moving, x.fixed) == (c.moving, c.fixed));
                         let bound = open.map(|x| x.bound);
@@ -730,19 +721,9 @@ mod tests {
                         bounds_checked += 1;
                     }
                     queue.recycle(&mut scratch);
+                    // twice, the second time with the lists the first one recycled
                     for _ in 0..2 {
-                        let mut counts = DetectCounts::default();
-                        let got = candidates(
-                            &scene,
-                            &o,
-                            sweep.as_ref(),
-                            p,
-                            clearance,
-                            horizontal,
-                            tol,
-                            &mut scratch,
-                            &mut counts,
-                        );
+                        let got = candidates(&scene, &o, sw, p, c, h, tol, &mut scratch, &mut counts);
                         assert_eq!(got, expected, "p {p}, theta {theta}, clearance {clearance}, {horizontal}");
                     }
                     total += expected.len();
