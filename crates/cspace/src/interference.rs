@@ -146,18 +146,7 @@ pub fn cross_axis(
     if len2 <= 1e-18 {
         return None;
     }
-    // (B's list first when A's names three normals or more: the answer is the same, and a vertical edge of a z-prism
-    // is perpendicular to every side normal while the cross axes it forms are duplicates of the other prism's normals)
-    let at_least_three = |m: u64| {
-        let rest = m & m.wrapping_sub(1);
-        rest & rest.wrapping_sub(1) != 0
-    };
-    let (first, second) = if at_least_three(mask_a) {
-        ((b_normals, mask_b), (a_normals, mask_a))
-    } else {
-        ((a_normals, mask_a), (b_normals, mask_b))
-    };
-    if parallel_to_any(c, len2, first.0, first.1) || parallel_to_any(c, len2, second.0, second.1) {
+    if parallel_to_any(c, len2, a_normals, mask_a) || parallel_to_any(c, len2, b_normals, mask_b) {
         return None;
     }
     Some(c / len2.sqrt())

@@ -242,8 +242,8 @@ pub(crate) fn obstacle(
                     return None;
                 }
                 poles_seen[level] = true;
-                // (a `Vec` first: its pushes are cheaper than the inline cycle's, and `k >= 3` corners of a tame pole
-                // rarely fit inline; the conversion keeps the allocation when they do not)
+                // (a `Vec` first: its pushes are cheaper than the inline cycle's, and the `k = kA + kB >= 6` corners
+                // of a tame pole never fit inline; the conversion keeps the allocation)
                 let mut face = Vec::with_capacity(k);
                 for key in level * k..(level + 1) * k {
                     let v = number!(key);

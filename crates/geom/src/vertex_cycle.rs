@@ -47,26 +47,6 @@ impl VertexCycle {
         self.0.insert(at, index);
     }
 
-    /// Removes and returns the index at position `at`. Panics if `at >= len`, as `Vec::remove` does.
-    pub fn remove(&mut self, at: usize) -> usize {
-        self.0.remove(at)
-    }
-
-    /// Removes and returns the last index.
-    pub fn pop(&mut self) -> Option<usize> {
-        self.0.pop()
-    }
-
-    /// Keeps the first `len` indices.
-    pub fn truncate(&mut self, len: usize) {
-        self.0.truncate(len);
-    }
-
-    /// Removes every index (keeps the storage).
-    pub fn clear(&mut self) {
-        self.0.clear();
-    }
-
     /// Whether the indices are stored inline (no heap allocation).
     pub fn is_inline(&self) -> bool {
         !self.0.spilled()
@@ -135,12 +115,6 @@ impl<const N: usize> From<[usize; N]> for VertexCycle {
 impl FromIterator<usize> for VertexCycle {
     fn from_iter<I: IntoIterator<Item = usize>>(iter: I) -> Self {
         Self(iter.into_iter().collect())
-    }
-}
-
-impl Extend<usize> for VertexCycle {
-    fn extend<I: IntoIterator<Item = usize>>(&mut self, iter: I) {
-        self.0.extend(iter);
     }
 }
 
@@ -231,8 +205,9 @@ mod tests {
         let b = VertexCycle::from(&[5usize, 6, 7][..]);
         let c: VertexCycle = (5..8).collect();
         let mut d = VertexCycle::with_capacity(3);
-        d.extend([5, 6]);
+        d.push(6);
         d.push(7);
+        d.insert(0, 5);
         assert!(a == b && b == c && c == d);
         assert_eq!(d.iter().rev().copied().collect::<Vec<_>>(), vec![7, 6, 5]);
         let mut e = d.clone();

@@ -121,19 +121,35 @@ pub fn translated(placed: &PlacedConvex, p: DVec3) -> PlacedConvex {
 
 /// `placed` moved by `p` and swept up to `top` (see the module documentation).
 fn swept(placed: &PlacedConvex, axes: &(Vec<DVec3>, Vec<DVec3>), p: DVec3, top: f64) -> PlacedConvex {
-    let lift = (top - (placed.aabb.0.z + p.z)).max(0.0) + 1.0;
-    let mut vertices: Vec<DVec3> = placed.vertices.iter().map(|v| *v + p).collect();
-    let n = vertices.len();
-    for k in 0..n {
-        vertices.push(vertices[k] + DVec3::new(0.0, 0.0, lift));
-    }
-    let aabb = (placed.aabb.0 + p, placed.aabb.1 + p + DVec3::new(0.0, 0.0, lift));
-    PlacedConvex::from_parts(vertices, axes.0.clone(), axes.1.clone(), aabb)
+    let lift = Some(sweep_lift(top, placed, p));
+    let mut vertices = Vec::with_capacity(2 * placed.vertices.len());
+    moved_vertices(placed, p, lift, &mut vertices);
+    PlacedConvex::from_parts(vertices, axes.0.clone(), axes.1.clone(), moved_box(placed, p, lift))
 }
 
-/// How far a sweep reaches above its component at `p`: to the stack's top, and 1 mm more.
-fn sweep_lift(scene: &StackScene, placed: &PlacedConvex, p: DVec3) -> f64 {
-    (scene.top - (placed.aabb.0.z + p.z)).max(0.0) + 1.0
+/// How far a sweep reaches above its component at `p`: to the stack's top `top`, and 1 mm more.
+fn sweep_lift(top: f64, placed: &PlacedConvex, p: DVec3) -> f64 {
+    (top - (placed.aabb.0.z + p.z)).max(0.0) + 1.0
+}
+
+/// The vertices of `placed` moved by `p` into `out`, and with a `lift`, each of them lifted by it after them (the
+/// sweep): the sums of [`translated`] and [`swept`] everywhere, so every projection is bit for bit theirs.
+fn moved_vertices(placed: &PlacedConvex, p: DVec3, lift: Option<f64>, out: &mut Vec<DVec3>) {
+    out.extend(placed.vertices.iter().map(|v| *v + p));
+    if let Some(lift) = lift {
+        let n = out.len();
+        for k in 0..n {
+            out.push(out[k] + DVec3::new(0.0, 0.0, lift));
+        }
+    }
+}
+
+/// The box of [`moved_vertices`].
+fn moved_box(placed: &PlacedConvex, p: DVec3, lift: Option<f64>) -> (DVec3, DVec3) {
+    match lift {
+        Some(lift) => (placed.aabb.0 + p, placed.aabb.1 + p + DVec3::new(0.0, 0.0, lift)),
+        None => (placed.aabb.0 + p, placed.aabb.1 + p),
+    }
 }
 
 fn boxes_overlap(a: &(DVec3, DVec3), b: &(DVec3, DVec3), margin: f64) -> bool {
@@ -263,14 +279,12 @@ struct QueueLists {
     exact: Vec<Candidate>,
 }
 
-/// A pair that passed the boxes and is not scanned yet: `best` is a lower bound of its scan's largest value, from
-/// its boxes ([`box_bound`]); an upper bound of its violation follows from it ([`CandidateQueue::bound`]).
+/// A pair that passed the boxes and is not scanned yet, with an upper bound of its violation
+/// ([`CandidateQueue::bound`] of its [`box_bound`]), the heap's key.
 #[derive(Debug, Clone, Copy)]
 struct OpenPair {
     moving: usize,
     fixed: usize,
-    best: f64,
-    /// [`CandidateQueue::bound`] of `best`, kept for the heap's order.
     bound: f64,
 }
 
@@ -313,8 +327,7 @@ impl Eq for OpenPair {}
 /// On the complete axis set the largest gap of a polytope pair is `-MTD` when they overlap (the minimum translation
 /// distance is attained on one of the axes) and positive otherwise; `MTD` is at most the distance that pushes the
 /// projections apart on any direction, `min(a_hi - b_lo, b_hi - a_lo)`, and on `x`, `y` and `z` those projections are
-/// the boxes (the boxes are the vertices' extents,
-/// moved by the same sums as the vertices). So the largest gap is at least `-max(min overlap, 0)`; the horizontal
+/// the boxes (the boxes are the vertices' extents, moved by the same sums as the vertices). So the largest gap is at least `-max(min overlap, 0)`; the horizontal
 /// rule subtracts at most `weight` per axis (`sqrt(1 - u_z^2) <= 1`). `slack` covers the projections' rounding.
 fn box_bound(a: &(DVec3, DVec3), b: &(DVec3, DVec3), weight: f64, slack: f64) -> f64 {
     // the distance to push the projections apart along each axis (not their intersection: one may contain the other)
@@ -330,9 +343,7 @@ fn box_bound(a: &(DVec3, DVec3), b: &(DVec3, DVec3), weight: f64, slack: f64) ->
 /// GJK's accuracy, for which the bound keeps a margin). [`CandidateQueue::next`] returns a pair only when its exact
 /// violation is at least every open bound (ties by the same index order), scanning open pairs (normal axes, then
 /// cross axes) in the order of their bounds: the sequence is the one of sorting the exact violations, but the pairs
-/// whose bounds lie below the violation the search cuts with are never scanned. (Until session 20 every pair's
-/// normal axes were scanned here at once: 32 % of a 15-part Complex plan's instructions; the lazy scan runs
-/// 18 % fewer in that plan with the same result.)
+/// whose bounds lie below the violation the search cuts with are never scanned.
 #[derive(Debug)]
 pub struct CandidateQueue {
     p: DVec3,
@@ -401,10 +412,7 @@ impl CandidateQueue {
             if near.is_empty() {
                 break;
             }
-            let moved_box = match sweep {
-                Some(_) => (placed.aabb.0 + p, placed.aabb.1 + p + DVec3::new(0.0, 0.0, sweep_lift(scene, placed, p))),
-                None => (placed.aabb.0 + p, placed.aabb.1 + p),
-            };
+            let moved_box = moved_box(placed, p, sweep.map(|_| sweep_lift(scene.top, placed, p)));
             for &fi in &near {
                 let fixed = &scene.components[fi];
                 if !boxes_overlap(&moved_box, &fixed.placed.aabb, margin) {
@@ -412,8 +420,8 @@ impl CandidateQueue {
                 }
                 counts.narrow_phase += 1;
                 // (not scanned yet: the boxes bound its violation; `next` scans it when that bound matters)
-                let best = box_bound(&moved_box, &fixed.placed.aabb, rule.weight, tol);
-                pending.push(OpenPair { moving: mi, fixed: fi, best, bound: queue.bound(best) });
+                let bound = queue.bound(box_bound(&moved_box, &fixed.placed.aabb, rule.weight, tol));
+                pending.push(OpenPair { moving: mi, fixed: fi, bound });
             }
         }
         scratch.spare.near = near;
@@ -429,9 +437,9 @@ impl CandidateQueue {
         scratch.spare = QueueLists { moved: self.moved, near, open: self.open.into_vec(), exact: self.exact };
     }
 
-    /// Upper bound of an open pair's violation: from the running maximum, plus (with a clearance, where
-    /// `classify_pair` replaces the gap by parry's GJK distance, which is the true distance only up to GJK's own
-    /// accuracy) a margin of `1e-3 clearance + tol` covering GJK's error.
+    /// Upper bound of a pair's violation from a lower bound `best` of its scan's largest value, plus (with a
+    /// clearance, where `classify_pair` replaces the gap by parry's GJK distance, which is the true distance only up
+    /// to GJK's own accuracy) a margin of `1e-3 clearance + tol` covering GJK's error.
     fn bound(&self, best: f64) -> f64 {
         if self.horizontal {
             -best
@@ -475,7 +483,7 @@ impl CandidateQueue {
     /// Scans an open pair's remaining axes and classifies it as `classify_pair` / [`horizontal_slack`] would.
     fn finish(
         &mut self,
-        mut open: OpenPair,
+        open: OpenPair,
         scene: &StackScene,
         orientation: &Orientation,
         sweep: Option<&SweepAxes>,
@@ -489,34 +497,25 @@ impl CandidateQueue {
             None => (&placed.normal_axes, &placed.edge_directions),
         };
         if moving.vertices.is_empty() {
-            // the same sums as `translated` / `swept`
-            let p = self.p;
-            let vertices = &mut moving.vertices;
-            vertices.extend(placed.vertices.iter().map(|v| *v + p));
-            if sweep.is_some() {
-                let lift = sweep_lift(scene, placed, p);
-                let n = vertices.len();
-                for k in 0..n {
-                    vertices.push(vertices[k] + DVec3::new(0.0, 0.0, lift));
-                }
-            }
+            let lift = sweep.map(|_| sweep_lift(scene.top, placed, self.p));
+            moved_vertices(placed, self.p, lift, &mut moving.vertices);
             moving.own.clear();
             moving.own.resize(normals.len(), (f64::NAN, f64::NAN));
         }
         // the normal axes (a pair they decide is not violating), then the cross axes, as one running maximum
-        open.best = f64::NEG_INFINITY;
-        if scan_direct(normals, edges, &fixed.placed, moving, &self.rule, true, &mut open.best) {
+        let mut best = f64::NEG_INFINITY;
+        if scan_direct(normals, edges, &fixed.placed, moving, &self.rule, true, &mut best) {
             return None;
         }
-        let decided = scan_direct(normals, edges, &fixed.placed, moving, &self.rule, false, &mut open.best);
+        let decided = scan_direct(normals, edges, &fixed.placed, moving, &self.rule, false, &mut best);
         let tol = self.tol;
         let clearance = self.clearance;
         if self.horizontal {
-            let slack = open.best;
+            let slack = best;
             return (!decided && slack < -tol).then_some(Candidate { moving: mi, fixed: fi, violation: -slack });
         }
         // `classify_pair`'s decisions on the same gap
-        let gap = open.best;
+        let gap = best;
         let contact = if gap < -tol {
             PairContact::Penetrating { depth: -gap }
         } else if gap <= tol {
