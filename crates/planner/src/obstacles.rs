@@ -33,6 +33,9 @@ pub enum PlaneOrigin {
     },
     /// A vertical side of the insertion obstacle (through a silhouette edge).
     InsertionSide,
+    /// A side of the region another search covers ([`crate::PlacementRequest::searched_elsewhere`]): a boundary of
+    /// the search, never a contact.
+    SearchedElsewhere,
 }
 
 impl PlaneOrigin {
@@ -41,6 +44,7 @@ impl PlaneOrigin {
         match self {
             PlaneOrigin::Face { face } => face.name(),
             PlaneOrigin::InsertionSide => "insertion_side",
+            PlaneOrigin::SearchedElsewhere => "searched_elsewhere",
         }
     }
 }
@@ -50,9 +54,10 @@ impl PlaneOrigin {
 pub struct DerivedObstacle {
     /// Orientation index.
     pub orientation: usize,
-    /// Moving component.
+    /// Moving component (`usize::MAX` for [`DerivedObstacle::searched_elsewhere`]'s region, which is no pair's).
     pub moving: usize,
-    /// Stack component (index into the scene).
+    /// Stack component (index into the scene; `usize::MAX` for the region of
+    /// [`DerivedObstacle::searched_elsewhere`]).
     pub fixed: usize,
     /// `p` is in the obstacle iff `normal . p <= offset` for all planes.
     pub planes: Vec<Plane>,
@@ -119,6 +124,30 @@ impl DerivedObstacle {
             }
         }
         Self { orientation, moving, fixed, planes, origins }
+    }
+
+    /// The region of positions at which the part, at `orientation`, lies inside the convex polygon `polygon`
+    /// (counter-clockwise seen from above) in the plan view: one vertical plane per side, `n . (p_x, p_y) <= d -
+    /// h(n)` with `h` the rotated part's support function (the sides of `Omega(theta)` of that polygon). Subtracted
+    /// like an obstacle, it leaves the region to another search ([`crate::PlacementRequest::searched_elsewhere`]).
+    /// O(sides x part vertices).
+    pub fn searched_elsewhere(orientation: &Orientation, polygon: &[glam::DVec2]) -> Self {
+        let floor = crate::request::FloorVolume { polygon: polygon.to_vec(), height: 0.0 };
+        let planes: Vec<Plane> = floor
+            .side_planes()
+            .into_iter()
+            .map(|(n, d)| {
+                let normal = glam::DVec3::new(n.x, n.y, 0.0);
+                Plane { normal, offset: d - orientation.support(normal) }
+            })
+            .collect();
+        let origins = vec![PlaneOrigin::SearchedElsewhere; planes.len()];
+        Self { orientation: orientation.index, moving: usize::MAX, fixed: usize::MAX, planes, origins }
+    }
+
+    /// Whether this is the region of [`DerivedObstacle::searched_elsewhere`] (no pair's obstacle).
+    pub fn is_searched_elsewhere(&self) -> bool {
+        self.origins.first() == Some(&PlaneOrigin::SearchedElsewhere)
     }
 
     /// How deep `p` lies in the interior (the smallest slack `d_k - n_k . p`, its distance to the boundary), when

@@ -89,6 +89,12 @@ pub struct PlacementRequest<'a> {
     pub stack: Vec<StackPart<'a>>,
     /// The floor volume `Sigma`.
     pub floor: FloorVolume,
+    /// A region another search covers: a convex polygon (counter-clockwise seen from above). Positions at which the
+    /// part's shadow lies inside it by more than the tolerance (the interior of the permissible set `Omega(theta)`
+    /// of this polygon's prism, which has the floor volume's height) are not searched; positions on its boundary
+    /// and outside are. `None` (the default): the whole floor volume. The stacking planner's stage 2 leaves stage
+    /// 1's region to stage 1 ([`crate::stack_plan`]).
+    pub searched_elsewhere: Option<Vec<DVec2>>,
     /// `Some(z)`: the 2-D permissible set at `p_z = z` (\[A\] VII-A-2); `None`: the 3-D one.
     pub fixed_z: Option<f64>,
     /// Minimum distance between the new part's components and the stack's (mm); obstacles grown by it (\[A\] eq.
@@ -141,6 +147,33 @@ pub fn thetas_with_step(step: f64) -> Vec<f64> {
     (0..n).map(|k| k as f64 * step).collect()
 }
 
+/// Checks that `poly` (named `what` in the message) is a convex polygon, counter-clockwise seen from above, with at
+/// least 3 finite corners, no two consecutive ones equal, and some area.
+fn check_convex_polygon(poly: &[DVec2], what: &str) -> Result<(), String> {
+    if poly.len() < 3 {
+        return Err(format!("the {what} polygon has {} corners, needs at least 3", poly.len()));
+    }
+    if let Some(i) = poly.iter().position(|c| !c.is_finite()) {
+        return Err(format!("{what} corner {i} is not finite"));
+    }
+    let n = poly.len();
+    let mut area2 = 0.0;
+    for k in 0..n {
+        let (a, b, c) = (poly[k], poly[(k + 1) % n], poly[(k + 2) % n]);
+        area2 += a.perp_dot(b);
+        if (b - a).length() == 0.0 {
+            return Err(format!("{what} corners {k} and {} coincide", (k + 1) % n));
+        }
+        if (b - a).perp_dot(c - b) < 0.0 {
+            return Err(format!("the {what} polygon is not convex and counter-clockwise at corner {}", (k + 1) % n));
+        }
+    }
+    if area2.is_nan() || area2 <= 0.0 {
+        return Err(format!("the {what} polygon has no area (or is clockwise)"));
+    }
+    Ok(())
+}
+
 impl<'a> PlacementRequest<'a> {
     /// Defaults: the part as it lies, 1-degree steps, no clearance, cost (1) with `w = 0.5` about the floor centre,
     /// no insertion, `k = 1`, symmetry on, extrapolation on, 3-D permissible set.
@@ -152,6 +185,7 @@ impl<'a> PlacementRequest<'a> {
             thetas: uniform_thetas(360),
             stack,
             floor,
+            searched_elsewhere: None,
             fixed_z: None,
             clearance: 0.0,
             horizontal_clearance: false,
@@ -167,33 +201,9 @@ impl<'a> PlacementRequest<'a> {
 
     /// Checks every option; see [`PlacementError`].
     pub fn validate(&self) -> Result<(), PlacementError> {
-        let poly = &self.floor.polygon;
-        if poly.len() < 3 {
-            return Err(PlacementError::BadFloor(format!(
-                "the floor polygon has {} corners, needs at least 3",
-                poly.len()
-            )));
-        }
-        if let Some(i) = poly.iter().position(|c| !c.is_finite()) {
-            return Err(PlacementError::BadFloor(format!("floor corner {i} is not finite")));
-        }
-        let n = poly.len();
-        let mut area2 = 0.0;
-        for k in 0..n {
-            let (a, b, c) = (poly[k], poly[(k + 1) % n], poly[(k + 2) % n]);
-            area2 += a.perp_dot(b);
-            if (b - a).length() == 0.0 {
-                return Err(PlacementError::BadFloor(format!("floor corners {k} and {} coincide", (k + 1) % n)));
-            }
-            if (b - a).perp_dot(c - b) < 0.0 {
-                return Err(PlacementError::BadFloor(format!(
-                    "the floor polygon is not convex and counter-clockwise at corner {}",
-                    (k + 1) % n
-                )));
-            }
-        }
-        if area2.is_nan() || area2 <= 0.0 {
-            return Err(PlacementError::BadFloor("the floor polygon has no area (or is clockwise)".into()));
+        check_convex_polygon(&self.floor.polygon, "floor").map_err(PlacementError::BadFloor)?;
+        if let Some(region) = &self.searched_elsewhere {
+            check_convex_polygon(region, "searched-elsewhere").map_err(PlacementError::BadOption)?;
         }
         if !(self.floor.height > 0.0 && self.floor.height.is_finite()) {
             return Err(PlacementError::BadFloor(format!(

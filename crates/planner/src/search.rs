@@ -6,11 +6,13 @@
 //!
 //! 1. pop the cheapest node (costs compared rounded to about `1e-12` relative, so that exact ties do not depend
 //!    on the optima's last bits; ties: lower orientation index, then lower cell id — deterministic);
-//! 2. if an obstacle of `theta_k` built earlier holds `p*` in its interior by more than the tolerance (not one
-//!    applied on the node's path), take the deepest such (any obstacle holding `p*` gives a valid split; this one
-//!    needs no detection, which halves the detections of the Triangle scenario; in a plan the obstacles earlier
-//!    searches built at `theta_k` are known from the orientation's first expansion); otherwise detect the interfering
-//!    component pairs at `(theta_k, p*)` ([`crate::detect`]);
+//! 2. if the request leaves a region to another search ([`PlacementRequest::searched_elsewhere`]) and `p*` lies in
+//!    its interior at `theta_k` (not applied on the node's path), take that region as the obstacle
+//!    ([`DerivedObstacle::searched_elsewhere`]); else if an obstacle of `theta_k` built earlier holds `p*` in its
+//!    interior by more than the tolerance (not one applied on the node's path), take the deepest such (any obstacle
+//!    holding `p*` gives a valid split; this one needs no detection, which halves the detections of the Triangle
+//!    scenario; in a plan the obstacles earlier searches built at `theta_k` are known from the orientation's first
+//!    expansion); otherwise detect the interfering component pairs at `(theta_k, p*)` ([`crate::detect`]);
 //! 3. take the first of them (deepest violation first) whose obstacle ([`crate::obstacles`]) contains `p*` in its
 //!    interior by more than the tolerance, and split `K` into the children
 //!    `K n {n_k . p >= d_k} n {n_j . p <= d_j, j < k}` (\[A\] VI-A-3). Children are pushed *lazily* keyed by a lower
@@ -18,10 +20,11 @@
 //!    `n_k . p >= d_k` alone (closed form, [`Quadratic::halfspace_lower_bound`]) and the bound that the parent's
 //!    optimality conditions give over the part of `K` beyond that plane ([`Quadratic::lower_bound_beyond`]: it grows
 //!    with the plane's distance from `p*`, which lies inside the obstacle; it halves the children solved in the
-//!    Channel and Triangle searches and leaves the solved nodes' order alone). When a pending child is popped its
-//!    emptiness is decided by a box around the parent cell (bound propagation, [`stackplan_freespace::outer_box`]: a
-//!    child whose outside half-space misses it is empty; about 95 % of the empty children, at a few dozen operations
-//!    each) or else by a phase 1 from the parent's optimum (`Cell::is_empty_with`: the optimum violates only
+//!    Channel and Triangle searches and leaves the solved nodes' order alone). A box around the parent cell (bound
+//!    propagation, [`stackplan_freespace::outer_box`]) is computed at the split: a child whose outside half-space
+//!    misses it is empty and is not pushed (about 95 % of the empty children; its id is still taken, so the others'
+//!    ids and order are unchanged). When a pushed child is popped its emptiness is decided by a phase 1 from the
+//!    parent's optimum (`Cell::is_empty_with`: the optimum violates only
 //!    `n_k . p >= d_k`, so this is usually one LP move); a non-empty child's cell is built from a second phase 1 on
 //!    the exact cell (`Cell::with_halfspaces_from`, no Chebyshev LP) and its QP solved ([`crate::qp`]), and it is
 //!    pushed back with its own cost — so children that never become the cheapest are never solved. The keys only decide
@@ -242,6 +245,7 @@ pub struct PlacementResult {
 }
 
 /// A solved node: an orientation, a cell, its optimum and the obstacles applied on its path.
+#[derive(Clone)]
 struct Node<const D: usize> {
     cost: f64,
     orientation: usize,
@@ -259,16 +263,15 @@ struct Node<const D: usize> {
 /// is the least of its children's, and a total order's least over a union is the least of the least ones), without
 /// holding the many children that are never popped. The children live in one arena of the heap
 /// ([`NodeHeap::children`]: no allocation per family).
+#[derive(Clone)]
 struct Family<const D: usize> {
     orientation: usize,
-    cell: Arc<Cell<D>>,
+    /// The parent cell; released (`None`) once the last child has been popped, so that a long search (and the
+    /// frontiers carried through a plan) holds only the cells of families with children still pending.
+    cell: Option<Arc<Cell<D>>>,
     applied: Arc<[u32]>,
     obstacle: u32,
     start: [f64; D],
-    /// A box around the parent cell grown by the tolerance ([`Cell::grown_outer_box`]), computed when the first
-    /// child is popped: a child whose outside half-space misses it is empty without its phase 1 (about 95 % of the
-    /// empty children of a plan's searches).
-    reach: Option<([f64; D], [f64; D])>,
     /// The family's children are `NodeHeap::children[first..first + left]` (`(key, id, face)`), the cheapest (by
     /// [`HeapKey`]'s order) last; popping one decrements `left`.
     first: usize,
@@ -277,6 +280,7 @@ struct Family<const D: usize> {
 
 /// The state of the search's loop between calls ([`Search::advance`]): the open nodes, the next node id, the
 /// orientations expanded so far, the placements found so far (orientation, position) and the pops so far.
+#[derive(Clone)]
 struct RunState<const D: usize> {
     fixed_z: f64,
     heap: NodeHeap<D>,
@@ -298,6 +302,7 @@ struct RunState<const D: usize> {
 }
 
 /// The loop's reusable lists: a child's extra inequalities, a split's outside half-spaces and its children's keys.
+#[derive(Clone)]
 struct Buffers<const D: usize> {
     extra: Vec<Halfspace<D>>,
     outside: Vec<Outside<D>>,
@@ -394,6 +399,7 @@ const FAMILY: u32 = 1 << 31;
 /// The open nodes: a 4-ary heap ([`DaryHeap`]) of small keys (cost, orientation, id) over a slab of the solved nodes
 /// (whose cells, optima and paths would otherwise be moved at every sift) and the families of pending children (one
 /// entry each, see [`Family`]). Pops in the order (cost, orientation, id).
+#[derive(Clone)]
 struct NodeHeap<const D: usize> {
     keys: DaryHeap<HeapKey>,
     slab: Vec<Option<Node<D>>>,
@@ -566,6 +572,10 @@ struct Search<'r, 'a> {
     /// Per orientation, the (moving, stack component) pairs whose derived obstacle an earlier search of the plan
     /// built (indexed once per search; taken when the orientation is first expanded).
     shared_pairs: Vec<Vec<(usize, usize)>>,
+    /// Per orientation, the id of this search's region searched elsewhere
+    /// ([`PlacementRequest::searched_elsewhere`], [`DerivedObstacle::searched_elsewhere`]), added to the obstacle
+    /// table when the orientation is first expanded; it cuts before any known obstacle.
+    elsewhere: Vec<Option<u32>>,
     rotated: HashMap<[u64; 9], RotatedComponents>,
     detect_scratch: DetectScratch,
     intervals: IntervalObstacles,
@@ -647,6 +657,7 @@ struct ObstacleTable {
 #[derive(Debug, Clone, PartialEq)]
 struct FrontierSignature {
     floor: FloorVolume,
+    searched_elsewhere: Option<Vec<glam::DVec2>>,
     fixed_z: Option<u64>,
     cost: String,
 }
@@ -655,22 +666,34 @@ impl FrontierSignature {
     fn of(request: &PlacementRequest<'_>) -> Self {
         Self {
             floor: request.floor.clone(),
+            searched_elsewhere: request.searched_elsewhere.clone(),
             fixed_z: request.fixed_z.map(f64::to_bits),
             // `Debug` of an f64 round-trips: equal strings iff equal values
             cost: format!("{:?}", request.cost),
         }
     }
 
-    /// Whether a frontier searched under `self` can be continued under `next`: the same cost and fixed height, and
+    /// Whether a frontier searched under `self` can be continued under `next`: the same cost and fixed height,
     /// `self`'s floor volume inside `next`'s (the same height; every corner of the old polygon inside the new one),
     /// so every old cell lies in the new permissible set and only the difference needs new cells
-    /// (`Search::widen`).
+    /// (`Search::widen`), and `self`'s region searched elsewhere (if any) inside `next`'s (so the old cells cover
+    /// everything `next` searches; `next` cuts its larger region out of them as they pop).
     fn continues_into(&self, next: &Self) -> bool {
+        let inside = |a: &[glam::DVec2], b: &[glam::DVec2]| {
+            a == b || {
+                let sides = FloorVolume { polygon: b.to_vec(), height: 0.0 }.side_planes();
+                a.iter().all(|&c| sides.iter().all(|&(n, d)| n.dot(c) <= d))
+            }
+        };
         self.fixed_z == next.fixed_z
             && self.cost == next.cost
             && self.floor.height.to_bits() == next.floor.height.to_bits()
-            && (self.floor == next.floor
-                || self.floor.polygon.iter().all(|&c| next.floor.side_planes().into_iter().all(|(n, d)| n.dot(c) <= d)))
+            && inside(&self.floor.polygon, &next.floor.polygon)
+            && match (&self.searched_elsewhere, &next.searched_elsewhere) {
+                (None, _) => true,
+                (Some(_), None) => false,
+                (Some(old), Some(new)) => inside(old, new),
+            }
     }
 }
 
@@ -839,6 +862,7 @@ fn prepare<'r, 'a>(
             obstacle_ids: table.ids,
             by_orientation: table.by_orientation,
             shared_pairs,
+            elsewhere: vec![None; n_orientations],
             detect_scratch: std::mem::take(&mut lane_caches.detect_scratch),
             rotated: std::mem::take(&mut lane_caches.rotated),
             derived: std::mem::take(&mut lane_caches.derived),
@@ -914,6 +938,7 @@ pub fn place_with_caches(
 }
 
 /// The search's state in 2 or 3 variables, one per partition of the orientations.
+#[derive(Clone)]
 enum States {
     Two(Vec<RunState<2>>),
     Three(Vec<RunState<3>>),
@@ -1007,16 +1032,24 @@ impl<'r, 'a, 'c> PlacementSearch<'r, 'a, 'c> {
         if let Some(first) = searches.first_mut() {
             first.stats.time_setup_ms = ms(start);
         }
-        // the state of the last search with this floor, else of the newest one whose floor lies inside it
+        // the state of the newest search with this floor that this one continues, else of the newest one whose
+        // floor lies inside this one's (widened); a state widened right after it was searched (the stacking
+        // planner's stage 2 continuing its stage 1 when that accepted nothing) is copied, the original kept for the
+        // next search of its own floor
         let signature = caches.carry.then(|| FrontierSignature::of(request));
         let carried = signature.as_ref().and_then(|sig| {
             let at = caches
                 .frontiers
                 .iter()
-                .position(|(s, _)| s == sig)
+                .rposition(|(s, _)| s.floor == sig.floor && s.continues_into(sig))
                 .or_else(|| caches.frontiers.iter().rposition(|(s, _)| s.continues_into(sig)))?;
+            let widens = caches.frontiers[at].0.floor != request.floor;
+            if widens && at + 1 == caches.frontiers.len() {
+                let (old, state) = &caches.frontiers[at];
+                return Some((state.clone(), Some(old.floor.clone())));
+            }
             let (old, state) = caches.frontiers.remove(at);
-            Some((state, (old.floor != request.floor).then_some(old.floor)))
+            Some((state, widens.then_some(old.floor)))
         });
         let state = match (carried, request.fixed_z) {
             (Some((States::Three(s), old)), None) => {
@@ -1523,29 +1556,25 @@ impl Search<'_, '_> {
                 Popped::Pending { family, id, face } => {
                     // build and solve the child now; push it back with its true cost (>= its key)
                     let t_cells = Instant::now();
-                    let f = &mut heap.families[family as usize];
-                    let reach = *f.reach.get_or_insert_with(|| f.cell.grown_outer_box());
+                    // (the children that the box around the parent cell decides empty were never pushed, see the
+                    // split below)
                     let f = &heap.families[family as usize];
                     let orientation = f.orientation;
+                    let Some(parent) = f.cell.as_ref() else {
+                        return Err(PlacementError::FreeSpace {
+                            orientation,
+                            reason: "a pending child's family has no cell (inconsistent heap)".into(),
+                        });
+                    };
                     self.child_inequalities::<D>(f.obstacle, face, fixed_z, &mut buffers.extra);
-                    // the child's outside half-space (`-n . p <= -d`, last) missing the box around the parent cell
-                    // grown by the tolerance: empty, as its phase 1 would find (`box_misses_halfspace`; only when
-                    // every inequality is finite, which the phase 1 would reject with an error)
-                    let misses = buffers.extra.last().is_some_and(|outside| {
-                        box_misses_halfspace(&reach, &outside.normal.map(|c| -c), -outside.offset, tol)
-                    }) && buffers
-                        .extra
-                        .iter()
-                        .all(|h| h.offset.is_finite() && h.normal.iter().all(|c| c.is_finite()));
-                    if misses {
-                        self.stats.cells_empty += 1;
-                        self.stats.time_cells_ms += ms(t_cells);
-                        continue;
+                    let solved = self.solve_child::<D>(orientation, parent, &buffers.extra, &f.start, fixed_z)?;
+                    // the path is shared by the family's children: one more reference for a non-empty one
+                    let applied = solved.as_ref().map(|_| Arc::clone(&f.applied));
+                    if f.left == 0 {
+                        // the last child: the family's cell is not needed any more
+                        heap.families[family as usize].cell = None;
                     }
-                    let solved = self.solve_child::<D>(orientation, &f.cell, &buffers.extra, &f.start, fixed_z)?;
-                    if let Some((cell, optimum)) = solved {
-                        // the path is shared by the family's children: one more reference for a non-empty one
-                        let applied = Arc::clone(&f.applied);
+                    if let (Some((cell, optimum)), Some(applied)) = (solved, applied) {
                         heap.push(Node {
                             cost: optimum.value,
                             orientation,
@@ -1584,13 +1613,20 @@ impl Search<'_, '_> {
                 for (moving, fixed) in shared {
                     self.obstacle_id(node.orientation, moving, fixed)?;
                 }
+                if let Some(polygon) = &self.request.searched_elsewhere {
+                    let region = DerivedObstacle::searched_elsewhere(&self.orientations[node.orientation], polygon);
+                    self.elsewhere[node.orientation] = Some(self.obstacles.len() as u32);
+                    self.obstacles.push(Arc::new(region));
+                }
                 self.stats.time_setup_ms += ms(t_setup);
             }
             let p = lift(&optimum.point, fixed_z);
             // an obstacle of this orientation built earlier that holds p* in its interior cuts at once (the deepest
             // holding one, as the detection's order prefers the deepest violation): the exact interference detection
             // below runs only when none does
-            let mut cutting: Option<u32> = {
+            let elsewhere = self.elsewhere[node.orientation]
+                .filter(|&id| !node.applied.contains(&id) && self.obstacles[id as usize].interior_contains(p, tol));
+            let mut cutting: Option<u32> = elsewhere.or_else(|| {
                 let mut best: Option<(f64, u32)> = None;
                 let known = &self.by_orientation[node.orientation];
                 for (k, &id) in known.ids.iter().enumerate() {
@@ -1603,7 +1639,7 @@ impl Search<'_, '_> {
                     }
                 }
                 best.map(|(_, id)| id)
-            };
+            });
             if cutting.is_some() {
                 self.stats.known_obstacle_cuts += 1;
             } else {
@@ -1669,19 +1705,30 @@ impl Search<'_, '_> {
             // one allocation (an exact-size iterator collected into the shared slice)
             let applied: Arc<[u32]> = node.applied.iter().copied().chain(std::iter::once(id)).collect();
             let q = restrict_quadratic::<D>(&self.orientations[node.orientation].quadratic, fixed_z);
+            // the box around the cell grown by the tolerance decides most empty children here, while the cell is at
+            // hand: a child whose outside half-space misses the box is empty even with every offset grown by the
+            // tolerance, as its phase 1 would find (`box_misses_halfspace`), and is never pushed (only when every
+            // plane is finite: the phase 1 rejects the others with an error)
+            let finite = buffers.outside.iter().all(|((n, d), _)| d.is_finite() && n.iter().all(|c| c.is_finite()));
+            let reach = node.cell.grown_outer_box();
             let family = Family {
                 orientation: node.orientation,
-                cell: Arc::clone(&node.cell),
+                cell: Some(Arc::clone(&node.cell)),
                 applied,
                 obstacle: id,
                 start: optimum.point,
-                reach: None,
                 first: 0,
                 left: 0,
             };
             let children = &mut buffers.children;
             children.clear();
             for &(outside, face) in &buffers.outside {
+                if finite && box_misses_halfspace(&reach, &outside.0, outside.1, tol) {
+                    // the id is still taken: the other children's ids, hence the search's order, are unchanged
+                    self.stats.cells_empty += 1;
+                    *next_id += 1;
+                    continue;
+                }
                 self.stats.nodes_pushed += 1;
                 // key: a lower bound of the child's cost, the largest of the parent's cost, the cost's minimum over
                 // the child's half-space outside the obstacle face (slack: twice the cell tolerance) and the bound
@@ -1866,6 +1913,9 @@ impl Search<'_, '_> {
             let contact = match cell.halfspaces()[j].tag {
                 Tag::ObstacleFace { obstacle, face } => {
                     let ob = &self.obstacles[obstacle as usize];
+                    if ob.is_searched_elsewhere() {
+                        continue;
+                    }
                     let sc = &self.scene.components[ob.fixed];
                     Contact::Stack {
                         our_component: ob.moving,

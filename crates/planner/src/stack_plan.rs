@@ -20,7 +20,10 @@
 //!    suction face for the cup, insertable from above; the first that passes is taken;
 //! 4. the seed's two stages: stage 1 searches within the stack's current floor footprint (its bounding rectangle
 //!    grown by `nest_allowance`, clipped to the floor), so the stack's bounding box is not enlarged, or only
-//!    slightly to nest; stage 2 searches the whole floor. Stage 1's part is taken unless stage 2's is strictly
+//!    slightly to nest; stage 2 searches the whole floor, and when stage 1 accepted a part it searches only outside
+//!    stage 1's region ([`PlacementRequest::searched_elsewhere`]: the positions at which the part lies inside that
+//!    region were stage 1's, whose candidates cheaper than its part all failed the checks, so stage 2 does not search
+//!    the stack's footprint a second time). Stage 1's part is taken unless stage 2's is strictly
 //!    cheaper (the seed takes stage 1 whenever it succeeds; with `w = 0` that would stack parts on top of each other
 //!    instead of spreading them on the floor as its own Fig. 2 shows, so here the footprint limit breaks ties and
 //!    near-ties of cost (1) in favour of a compact stack, and never overrides the cost).
@@ -356,8 +359,14 @@ pub fn plan_stack_with_progress(
         // the first acceptable candidate of each stage: (stage, candidate, rejected before it, grasp radius)
         let mut accepted: Vec<(u8, (Placement, f64), usize, f64)> = Vec::new();
         let last_stage = stages.last().map_or(2, |s| s.0);
+        let mut stage_one_region: Option<Vec<DVec2>> = None;
         for (stage, floor) in stages {
+            let polygon = floor.polygon.clone();
             let mut request = PlacementRequest::new(part, stack.clone(), floor);
+            // stage 1 accepted a part: its region holds nothing cheaper that passes, so stage 2 searches outside it
+            if stage == 2 && !accepted.is_empty() {
+                request.searched_elsewhere = stage_one_region.take();
+            }
             request.resting_rotations = rests.clone();
             request.thetas = thetas.clone();
             request.clearance = options.clearance;
@@ -428,6 +437,9 @@ pub fn plan_stack_with_progress(
                     }
                     Err(reason) => last_reason = reason,
                 }
+            }
+            if stage == 1 {
+                stage_one_region = Some(polygon);
             }
             let searched = search.stats();
             stats.pairs_evaluated += searched.pairs_evaluated;
