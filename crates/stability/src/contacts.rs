@@ -5,7 +5,13 @@
 //!
 //! * `g < -tol`: interference, penetration depth `-g` (exact for convex polytopes);
 //! * `g > tol`: no contact;
-//! * otherwise the components touch. The supporting sets `S_A = {v in A : n.v >= max_A n.x - tol}` and
+//! * otherwise the components touch. Where they touch along an edge or at a vertex, several axes separate them equally
+//!   (a normal cone: an edge of one on an edge of the other, or the seam between two components of one part whose
+//!   faces are coplanar); the axis of the contact is then the most vertical of the face normals (of either component)
+//!   whose separation is within `tol` of the largest ([`contact_axis`]), whatever order the components list their
+//!   faces in. Gravity loads the stack, and a sideways normal at such a contact would let two opposite edge
+//!   contacts pinch a part along one line and hold it by friction (a part resting across the seam of two coplanar
+//!   tops was found "stable" that way, with its centre of gravity outside its supports). The supporting sets `S_A = {v in A : n.v >= max_A n.x - tol}` and
 //!   `S_B = {v in B : n.v <= min_B n.x + tol}` (a vertex, an edge or a face of each) are projected onto the contact
 //!   plane and intersected as planar convex sets ([`crate::polygon2d::intersect_convex`]): coplanar opposite faces give
 //!   the polygon of their overlap, an edge on a face a segment, crossing edges or a vertex on a face a point. The
@@ -18,7 +24,7 @@
 //! Cost: O(P^2) bounding-box tests over parts, then the separating-axis test per component pair whose boxes meet.
 
 use crate::polygon2d::{convex_hull_2d, intersect_convex};
-use crate::sat::{Shape, separation};
+use crate::sat::{Separation, Shape, separation};
 use crate::world::{WorldComponent, WorldPart, aabb_overlap};
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
@@ -139,6 +145,27 @@ pub fn touching_patch(a: &WorldComponent, b: &WorldComponent, axis: DVec3, tol: 
     Some((patch.iter().map(|p| u * p.x + w * p.y + n * mid).collect(), n))
 }
 
+/// The axis of the contact of two touching components (module documentation): among `sep`'s axis and the face
+/// normals of both components (oriented from `a` to `b`), those whose separation is within `tol` of `sep.distance`,
+/// the one with the largest `|z|` (the first found when that ties too, `sep`'s axis first). O(faces x vertices).
+pub fn contact_axis(a: &WorldComponent, b: &WorldComponent, sep: Separation, tol: f64) -> DVec3 {
+    let (sa, sb) = (Shape::of(a), Shape::of(b));
+    let mut best = sep.axis;
+    for &n in a.normals.iter().chain(&b.normals) {
+        if n.z.abs() <= best.z.abs() + 1e-12 {
+            continue;
+        }
+        let (alo, ahi) = sa.interval(n);
+        let (blo, bhi) = sb.interval(n);
+        let (forward, backward) = (blo - ahi, alo - bhi);
+        let (d, axis) = if forward >= backward { (forward, n) } else { (backward, -n) };
+        if d >= sep.distance - tol {
+            best = axis;
+        }
+    }
+    best
+}
+
 fn kind_of(points: &[DVec3]) -> PatchKind {
     match points.len() {
         0 | 1 => PatchKind::Point,
@@ -219,7 +246,7 @@ pub fn contacts_of_part(
                         depth: -sep.distance,
                     });
                 } else if sep.distance <= tol
-                    && let Some((points, normal)) = touching_patch(a, b, sep.axis, tol)
+                    && let Some((points, normal)) = touching_patch(a, b, contact_axis(a, b, sep, tol), tol)
                 {
                     out.patches.push(ContactPatch {
                         a: Body::Part(i),

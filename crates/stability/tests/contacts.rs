@@ -178,3 +178,37 @@ proptest! {
         }
     }
 }
+
+/// A part lying across the seam of two coplanar tops of one part below: an L-corner standing on its edge (rest pose
+/// 1 of the planner, its foot along +y) put on the top of another in the same pose, as the 15-part L-corner plan at
+/// w = 0.9 placed its ninth part. Each of the upper part's components touches the lower part's other component along
+/// the seam line only, where a horizontal and the vertical axis separate them equally. Those contacts are vertical
+/// (`contacts::contact_axis`) at every quarter turn of the pair about z (which reorders the faces the test meets
+/// first), and the part, whose centre of gravity lies beyond its supports, is unstable. With the first tied axis
+/// as the normal, two opposite sideways contacts on the seam line pinched it and held it by friction ("stable"),
+/// and `stackplan check` on the plan's file, whose re-hulled pieces list their faces in another order, disagreed
+/// with the planner.
+#[test]
+fn seam_contacts_are_vertical_and_do_not_pinch() {
+    use stackplan_geom::examples::part_by_name;
+    use stackplan_geom::sheet_metal::Decomposition;
+    use stackplan_stability::check::{CheckOptions, check_stack};
+    let part = part_by_name("l-corner", Decomposition::ConvexMerge).expect("example");
+    let rows = [[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]];
+    let rest = DMat3::from_cols_array_2d(&rows).transpose();
+    for quarter in 0..4 {
+        let turn = DMat3::from_rotation_z(f64::from(quarter) * std::f64::consts::FRAC_PI_2);
+        let stack = [
+            PlacedPart { part: &part, rotation: turn * rest, position: turn * DVec3::new(0.0, 65.0, 60.0) },
+            PlacedPart { part: &part, rotation: turn * rest, position: turn * DVec3::new(-75.0, 65.0, 210.0) },
+        ];
+        let analysis = analyse(&stack);
+        let between: Vec<_> = analysis.patches.iter().filter(|p| p.a == Body::Part(0) && p.b == 1).collect();
+        assert!(between.len() >= 3, "quarter {quarter}: {between:?}");
+        for p in &between {
+            assert!(p.normal.z > 1.0 - 1e-9, "quarter {quarter}: a sideways contact {p:?}");
+        }
+        let check = check_stack(&stack, &CheckOptions::default()).expect("check");
+        assert!(!check.parts[1].stable.is_stable(), "quarter {quarter}: the part across the seam held by a pinch");
+    }
+}
