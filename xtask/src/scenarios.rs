@@ -11,7 +11,8 @@
 //!   Optional assertions, checked in code (a failure is an error, whatever the golden holds): `"expect_shape"`
 //!   (`flat`, `column`, `pyramid`: the seed's Fig. 2; adds `layer_counts`, parts per layer bottom up), `"check": true`
 //!   (the finished plan passes `stackplan check` with the planner's mu, cup and clearance, the clearance checked at
-//!   each part's release position against the parts before it; adds `check_ok`) and
+//!   each part's release position against the parts before it, with the part as the plan file stores it and with the
+//!   planner's own; adds `check_ok`) and
 //!   `"expect_height_below"` (mm: the stack nests). These add `info_plan_seconds` (planning alone).
 //! * `obstacle`: the c-space obstacle of every convex pair of two parts (the fixed one placed by `"fixed_pose"`) at
 //!   each angle of `"theta_deg"` (`stackplan::cspace::obstacle`): per angle and pair the vertex and face counts and
@@ -319,6 +320,23 @@ fn expect_shape(shape: &str, count: usize, placed: &usize, counts: &[usize]) -> 
 /// Runs the stack check on a plan with the planner's friction, cup and (horizontal) clearance less 1e-6 mm; fails
 /// the scenario naming every part that does not pass.
 fn check_plan(
+    part: &Part,
+    poses: &[Pose],
+    release_drops: Vec<f64>,
+    options: &stackplan::planner::PlanOptions,
+) -> anyhow::Result<bool> {
+    // the part as the plan's file stores it (convex pieces, re-hulled when read, so its faces may come in another
+    // order), as `stackplan check PLAN` sees it, then the planner's own part
+    let as_filed = stackplan_geom::io::json::parse_part_json(
+        stackplan_geom::io::json::part_json_string(part).as_bytes(),
+        Path::new("plan.json"),
+        &stackplan_geom::io::ReadOptions::default(),
+    )?;
+    check_plan_with(&as_filed, poses, release_drops.clone(), options).context("the part as the plan file stores it")?;
+    check_plan_with(part, poses, release_drops, options)
+}
+
+fn check_plan_with(
     part: &Part,
     poses: &[Pose],
     release_drops: Vec<f64>,
