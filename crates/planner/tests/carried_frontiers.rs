@@ -2,14 +2,14 @@
 //! the stacking planner's caches): the first placement of every search is the exact optimum a fresh search finds,
 //! also on a floor that grew since the carried search (stage 1's footprint).
 
-use glam::DVec3;
+mod common;
+
+use common::growing_stack_request;
 use stackplan_cspace::ObstacleCache;
+use stackplan_geom::Pose;
 use stackplan_geom::examples::part_by_name;
 use stackplan_geom::sheet_metal::Decomposition;
-use stackplan_geom::{Part, Pose};
-use stackplan_planner::{
-    Cost, FloorVolume, PlacementRequest, PlacementSearch, SearchCaches, StackPart, place_with_caches, uniform_thetas,
-};
+use stackplan_planner::{FloorVolume, PlacementRequest, PlacementSearch, SearchCaches, StackPart, place_with_caches};
 
 /// Searches into a growing stack through caches that carry their frontiers (as the stacking planner's): at every
 /// step the first placement costs what a fresh search's does (the exact optimum), also on a floor that grew since the
@@ -31,7 +31,7 @@ fn carried_frontiers_find_the_exact_best_placement_into_a_growing_stack() {
         let floors = [FloorVolume::rectangle(-grow, -grow, grow, grow, 300.0), whole.clone()];
         let mut next_pose = None;
         for floor in floors {
-            let req = request(&part, stack.clone(), floor);
+            let req = growing_stack_request(&part, stack.clone(), floor);
             let fresh = place_with_caches(&req, &ObstacleCache::new(), &mut SearchCaches::new()).expect("search");
             let mut carried = Vec::new();
             {
@@ -64,16 +64,4 @@ fn carried_frontiers_find_the_exact_best_placement_into_a_growing_stack() {
         poses.push(next_pose.expect("room on the floor"));
     }
     assert!(widened > 0, "the growing floor was widened from a carried frontier");
-}
-
-/// The request of every search of the test: 30-degree steps, clearance, insertion, the four best.
-fn request<'a>(part: &'a Part, stack: Vec<StackPart<'a>>, floor: FloorVolume) -> PlacementRequest<'a> {
-    let mut req = PlacementRequest::new(part, stack, floor);
-    req.thetas = uniform_thetas(12);
-    req.cost = Cost::Stacking { w: 0.3, origin: DVec3::ZERO };
-    req.clearance = 2.0;
-    req.horizontal_clearance = true;
-    req.insertion = true;
-    req.k = 4;
-    req
 }

@@ -3,15 +3,18 @@
 //! region it finds the exact optimum of the whole floor; also when both carry their frontiers into a growing stack
 //! and a growing region, as the planner's searches do.
 
-use glam::{DVec2, DVec3};
+mod common;
+
+use common::growing_stack_request;
+use glam::DVec2;
 use stackplan_cspace::ObstacleCache;
 use stackplan_geom::examples::part_by_name;
 use stackplan_geom::sheet_metal::Decomposition;
 use stackplan_geom::{Part, Pose};
 use stackplan_planner::reference::violations;
 use stackplan_planner::{
-    Cost, FloorVolume, Placement, PlacementError, PlacementRequest, PlacementSearch, SearchCaches, StackPart,
-    place_with_caches, uniform_thetas,
+    FloorVolume, Placement, PlacementError, PlacementRequest, PlacementSearch, SearchCaches, StackPart,
+    place_with_caches,
 };
 
 /// Steps into a growing stack, each with a growing inner region `R` and the whole floor: a carried search of `R`
@@ -32,13 +35,14 @@ fn a_region_and_the_floor_outside_it_find_the_whole_floors_optimum() {
         let grow = 90.0 + 20.0 * step as f64;
         let region = FloorVolume::rectangle(-grow, -grow, grow, grow, 300.0);
         let fresh_whole = place_with_caches(
-            &request(&part, stack.clone(), whole.clone()),
+            &growing_stack_request(&part, stack.clone(), whole.clone()),
             &ObstacleCache::new(),
             &mut SearchCaches::new(),
         )
         .expect("search");
-        let inner = carried_placements(&request(&part, stack.clone(), region.clone()), &cache, &mut carrying);
-        let mut outer_request = request(&part, stack.clone(), whole.clone());
+        let inner =
+            carried_placements(&growing_stack_request(&part, stack.clone(), region.clone()), &cache, &mut carrying);
+        let mut outer_request = growing_stack_request(&part, stack.clone(), whole.clone());
         outer_request.searched_elsewhere = Some(region.polygon.clone());
         let outer = carried_placements(&outer_request, &cache, &mut carrying);
         outside_found += outer.len();
@@ -81,7 +85,7 @@ fn a_bad_region_is_a_typed_error() {
         vec![DVec2::ZERO, DVec2::Y, DVec2::X],
     ];
     for polygon in bad {
-        let mut req = request(&part, Vec::new(), floor.clone());
+        let mut req = growing_stack_request(&part, Vec::new(), floor.clone());
         req.searched_elsewhere = Some(polygon.clone());
         match place_with_caches(&req, &ObstacleCache::new(), &mut SearchCaches::new()) {
             Err(PlacementError::BadOption(msg)) => assert!(msg.contains("searched-elsewhere"), "{msg}"),
@@ -107,16 +111,4 @@ fn carried_placements(req: &PlacementRequest<'_>, cache: &ObstacleCache, caches:
 fn tolerance(part: &Part) -> f64 {
     let (lo, hi) = part.aabb();
     stackplan_geom::Tolerance::for_scale((hi - lo).length()).linear
-}
-
-/// The request of every search of the test: 30-degree steps, clearance, insertion, the four best.
-fn request<'a>(part: &'a Part, stack: Vec<StackPart<'a>>, floor: FloorVolume) -> PlacementRequest<'a> {
-    let mut req = PlacementRequest::new(part, stack, floor);
-    req.thetas = uniform_thetas(12);
-    req.cost = Cost::Stacking { w: 0.3, origin: DVec3::ZERO };
-    req.clearance = 2.0;
-    req.horizontal_clearance = true;
-    req.insertion = true;
-    req.k = 4;
-    req
 }

@@ -26,3 +26,20 @@ pub fn box_or_l(
         }
     })
 }
+
+/// The request of the searches into a growing stack (`carried_frontiers.rs`, `searched_elsewhere.rs`): 30-degree
+/// steps, 2 mm horizontal clearance, insertion, cost (1) with `w = 0.3` about the origin, the four best.
+pub fn growing_stack_request<'a>(
+    part: &'a Part,
+    stack: Vec<stackplan_planner::StackPart<'a>>,
+    floor: stackplan_planner::FloorVolume,
+) -> stackplan_planner::PlacementRequest<'a> {
+    let mut req = stackplan_planner::PlacementRequest::new(part, stack, floor);
+    req.thetas = stackplan_planner::uniform_thetas(12);
+    req.cost = stackplan_planner::Cost::Stacking { w: 0.3, origin: DVec3::ZERO };
+    req.clearance = 2.0;
+    req.horizontal_clearance = true;
+    req.insertion = true;
+    req.k = 4;
+    req
+}
