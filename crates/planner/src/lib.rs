@@ -34,7 +34,10 @@ pub mod settle;
 pub mod stack_plan;
 pub mod symmetry;
 
-pub use request::{Cost, FloorVolume, PlacementError, PlacementRequest, StackPart, thetas_with_step, uniform_thetas};
+pub use request::{
+    Cost, FloorVolume, PlacementError, PlacementRequest, StackPart, polygon_side_planes, thetas_with_step,
+    uniform_thetas,
+};
 pub use search::{
     Contact, NoPlacement, Placement, PlacementResult, PlacementSearch, PlacementStats, SearchCaches, place,
     place_with_cache, place_with_caches,

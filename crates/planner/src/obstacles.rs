@@ -127,19 +127,15 @@ impl DerivedObstacle {
     }
 
     /// The region of positions at which the part, at `orientation`, lies inside the convex polygon `polygon`
-    /// (counter-clockwise seen from above) in the plan view: one vertical plane per side, `n . (p_x, p_y) <= d -
-    /// h(n)` with `h` the rotated part's support function (the sides of `Omega(theta)` of that polygon). Subtracted
+    /// (counter-clockwise seen from above) in the plan view: one vertical plane per side, the sides of
+    /// `Omega(theta)` of that polygon ([`Orientation::sides_within`]). Subtracted
     /// like an obstacle, it leaves the region to another search ([`crate::PlacementRequest::searched_elsewhere`]).
     /// O(sides x part vertices).
     pub fn searched_elsewhere(orientation: &Orientation, polygon: &[glam::DVec2]) -> Self {
-        let floor = crate::request::FloorVolume { polygon: polygon.to_vec(), height: 0.0 };
-        let planes: Vec<Plane> = floor
-            .side_planes()
+        let planes: Vec<Plane> = orientation
+            .sides_within(polygon)
             .into_iter()
-            .map(|(n, d)| {
-                let normal = glam::DVec3::new(n.x, n.y, 0.0);
-                Plane { normal, offset: d - orientation.support(normal) }
-            })
+            .map(|(n, offset)| Plane { normal: glam::DVec3::new(n.x, n.y, 0.0), offset })
             .collect();
         let origins = vec![PlaneOrigin::SearchedElsewhere; planes.len()];
         Self { orientation: orientation.index, moving: usize::MAX, fixed: usize::MAX, planes, origins }

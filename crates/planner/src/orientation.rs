@@ -11,8 +11,8 @@
 //! with `c_x = x0 - (x_max + x_min) / 2`, so `h_x = 2 w`, likewise `y`, and `h_z = 4 (1 - w)`, `c_z = z0 - z_c`.
 //! For the target cost `h = (1, 1, 1)` and `c = target - R g`.
 
-use crate::request::{Cost, FloorVolume};
-use glam::{DMat3, DVec3};
+use crate::request::{Cost, FloorVolume, polygon_side_planes};
+use glam::{DMat3, DVec2, DVec3};
 use stackplan_cspace::PlacedConvex;
 use stackplan_freespace::cell::{Halfspace, Tag};
 use stackplan_geom::Part;
@@ -150,12 +150,21 @@ impl Orientation {
         self.vertices.iter().map(|v| d.dot(*v)).fold(f64::NEG_INFINITY, f64::max)
     }
 
+    /// The sides of the permissible set of the convex polygon `polygon` (counter-clockwise): per side `(n, d)`,
+    /// the positions `p` with `n . (p_x, p_y) <= d - h(n)`, `h` the rotated part's support function — those at which
+    /// the part's shadow lies inside the polygon. O(sides x vertices).
+    pub fn sides_within(&self, polygon: &[DVec2]) -> Vec<(DVec2, f64)> {
+        polygon_side_planes(polygon)
+            .into_iter()
+            .map(|(n, d)| (n, d - self.support(DVec3::new(n.x, n.y, 0.0))))
+            .collect()
+    }
+
     /// The 3-D permissible set's inequalities (sides, floor, ceiling) in that order.
     pub fn omega_3d(&self, floor: &FloorVolume) -> Vec<Halfspace<3>> {
         let mut out = Vec::with_capacity(floor.polygon.len() + 2);
-        for (side, (n, d)) in floor.side_planes().into_iter().enumerate() {
-            let dir = DVec3::new(n.x, n.y, 0.0);
-            out.push(Halfspace::new([n.x, n.y, 0.0], d - self.support(dir), Tag::FloorSide { side: side as u32 }));
+        for (side, (n, d)) in self.sides_within(&floor.polygon).into_iter().enumerate() {
+            out.push(Halfspace::new([n.x, n.y, 0.0], d, Tag::FloorSide { side: side as u32 }));
         }
         out.push(Halfspace::new([0.0, 0.0, -1.0], self.lo.z, Tag::Floor));
         out.push(Halfspace::new([0.0, 0.0, 1.0], floor.height - self.hi.z, Tag::Ceiling));
@@ -169,14 +178,10 @@ impl Orientation {
             return None;
         }
         Some(
-            floor
-                .side_planes()
+            self.sides_within(&floor.polygon)
                 .into_iter()
                 .enumerate()
-                .map(|(side, (n, d))| {
-                    let dir = DVec3::new(n.x, n.y, 0.0);
-                    Halfspace::new([n.x, n.y], d - self.support(dir), Tag::FloorSide { side: side as u32 })
-                })
+                .map(|(side, (n, d))| Halfspace::new([n.x, n.y], d, Tag::FloorSide { side: side as u32 }))
                 .collect(),
         )
     }

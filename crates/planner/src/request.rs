@@ -34,16 +34,22 @@ impl FloorVolume {
     /// Outward unit normals and offsets of the polygon's sides: `n . (x, y) <= d` inside; side `k` runs from corner
     /// `k` to corner `k + 1`.
     pub fn side_planes(&self) -> Vec<(DVec2, f64)> {
-        let n = self.polygon.len();
-        (0..n)
-            .map(|k| {
-                let (a, b) = (self.polygon[k], self.polygon[(k + 1) % n]);
-                let e = b - a;
-                let normal = DVec2::new(e.y, -e.x).normalize();
-                (normal, normal.dot(a))
-            })
-            .collect()
+        polygon_side_planes(&self.polygon)
     }
+}
+
+/// Outward unit normals and offsets of the sides of a convex polygon, counter-clockwise seen from above: `n . (x, y)
+/// <= d` inside; side `k` runs from corner `k` to corner `k + 1`. O(corners).
+pub fn polygon_side_planes(polygon: &[DVec2]) -> Vec<(DVec2, f64)> {
+    let n = polygon.len();
+    (0..n)
+        .map(|k| {
+            let (a, b) = (polygon[k], polygon[(k + 1) % n]);
+            let e = b - a;
+            let normal = DVec2::new(e.y, -e.x).normalize();
+            (normal, normal.dot(a))
+        })
+        .collect()
 }
 
 /// The cost minimised over positions at each orientation; both are separable convex quadratics in `p`.

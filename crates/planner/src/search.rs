@@ -91,7 +91,7 @@ use crate::interval_obstacles::{IntervalObstacles, ObstacleRoute};
 use crate::obstacles::DerivedObstacle;
 use crate::orientation::{Orientation, SeparableQuadratic, rotated_components};
 use crate::qp::{QpOptimum, Quadratic, minimise};
-use crate::request::{FloorVolume, PlacementError, PlacementRequest};
+use crate::request::{FloorVolume, PlacementError, PlacementRequest, polygon_side_planes};
 use crate::symmetry::{is_uniform_full_turn, period_length, rotational_order};
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
@@ -681,7 +681,7 @@ impl FrontierSignature {
     fn continues_into(&self, next: &Self) -> bool {
         let inside = |a: &[glam::DVec2], b: &[glam::DVec2]| {
             a == b || {
-                let sides = FloorVolume { polygon: b.to_vec(), height: 0.0 }.side_planes();
+                let sides = polygon_side_planes(b);
                 a.iter().all(|&c| sides.iter().all(|&(n, d)| n.dot(c) <= d))
             }
         };

@@ -361,7 +361,7 @@ pub fn plan_stack_with_progress(
         let last_stage = stages.last().map_or(2, |s| s.0);
         let mut stage_one_region: Option<Vec<DVec2>> = None;
         for (stage, floor) in stages {
-            let polygon = floor.polygon.clone();
+            let polygon = (stage == 1).then(|| floor.polygon.clone());
             let mut request = PlacementRequest::new(part, stack.clone(), floor);
             // stage 1 accepted a part: its region holds nothing cheaper that passes, so stage 2 searches outside it
             if stage == 2 && !accepted.is_empty() {
@@ -438,8 +438,8 @@ pub fn plan_stack_with_progress(
                     Err(reason) => last_reason = reason,
                 }
             }
-            if stage == 1 {
-                stage_one_region = Some(polygon);
+            if polygon.is_some() {
+                stage_one_region = polygon;
             }
             let searched = search.stats();
             stats.pairs_evaluated += searched.pairs_evaluated;

@@ -11,8 +11,8 @@
 //!   whose separation is within `tol` of the largest ([`contact_axis`]), whatever order the components list their
 //!   faces in. Gravity loads the stack, and a sideways normal at such a contact would let two opposite edge
 //!   contacts pinch a part along one line and hold it by friction (a part resting across the seam of two coplanar
-//!   tops was found "stable" that way, with its centre of gravity outside its supports). The supporting sets `S_A = {v in A : n.v >= max_A n.x - tol}` and
-//!   `S_B = {v in B : n.v <= min_B n.x + tol}` (a vertex, an edge or a face of each) are projected onto the contact
+//!   tops was found "stable" that way, with its centre of gravity outside its supports). The supporting sets
+//!   `S_A = {v in A : n.v >= max_A n.x - tol}` and `S_B = {v in B : n.v <= min_B n.x + tol}` (a vertex, an edge or a face of each) are projected onto the contact
 //!   plane and intersected as planar convex sets ([`crate::polygon2d::intersect_convex`]): coplanar opposite faces give
 //!   the polygon of their overlap, an edge on a face a segment, crossing edges or a vertex on a face a point. The
 //!   patch's points are the vertices of that set, lifted to the mid-plane between the two supporting planes.
@@ -24,7 +24,7 @@
 //! Cost: O(P^2) bounding-box tests over parts, then the separating-axis test per component pair whose boxes meet.
 
 use crate::polygon2d::{convex_hull_2d, intersect_convex};
-use crate::sat::{Separation, Shape, separation};
+use crate::sat::{Separation, Shape, separation, separation_along};
 use crate::world::{WorldComponent, WorldPart, aabb_overlap};
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
@@ -155,10 +155,7 @@ pub fn contact_axis(a: &WorldComponent, b: &WorldComponent, sep: Separation, tol
         if n.z.abs() <= best.z.abs() + 1e-12 {
             continue;
         }
-        let (alo, ahi) = sa.interval(n);
-        let (blo, bhi) = sb.interval(n);
-        let (forward, backward) = (blo - ahi, alo - bhi);
-        let (d, axis) = if forward >= backward { (forward, n) } else { (backward, -n) };
+        let (d, axis) = separation_along(&sa, &sb, n);
         if d >= sep.distance - tol {
             best = axis;
         }

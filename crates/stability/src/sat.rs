@@ -59,7 +59,7 @@ impl<'a> Shape<'a> {
 
 /// Signed separation of `a` and `b` along `n` (either orientation), with the oriented axis.
 #[inline]
-fn separation_along(a: &Shape<'_>, b: &Shape<'_>, n: DVec3) -> (f64, DVec3) {
+pub(crate) fn separation_along(a: &Shape<'_>, b: &Shape<'_>, n: DVec3) -> (f64, DVec3) {
     let (alo, ahi) = a.interval(n);
     let (blo, bhi) = b.interval(n);
     let forward = blo - ahi;
@@ -70,7 +70,8 @@ fn separation_along(a: &Shape<'_>, b: &Shape<'_>, n: DVec3) -> (f64, DVec3) {
 /// The separating-axis test of the module documentation.
 ///
 /// Ties between axes keep the first one found in the order: faces of `a`, faces of `b`, sweep faces, edge crosses —
-/// so a face contact is reported with the face's normal.
+/// so a face contact is reported with the face's normal. (A contact's normal is chosen again among the axes tied
+/// within the contact tolerance, [`crate::contacts::contact_axis`].)
 pub fn separation(a: &Shape<'_>, b: &Shape<'_>) -> Separation {
     let mut best = Separation { distance: f64::NEG_INFINITY, axis: DVec3::Z };
     // a tie within this relative amount keeps the earlier (face) axis
