@@ -555,6 +555,14 @@ impl<const D: usize> Cell<D> {
         Ok(Self { halfspaces: hs, lists, tolerance: self.tolerance, shape: self.shape, unit })
     }
 
+    /// This cell with only the inequalities `kept` (a sub-list of this cell's, in order, as the caller proved the
+    /// others redundant): the same set, so the same shape and interior point. Lists packed again; O(m).
+    pub(crate) fn with_only(&self, kept: Vec<Halfspace<D>>) -> Self {
+        let lists = pack(&kept);
+        let unit = self.unit || kept.iter().all(|h| length(&h.normal) == 1.0);
+        Self { halfspaces: kept, lists, tolerance: self.tolerance, shape: self.shape, unit }
+    }
+
     /// Maximum of `direction . p` over the cell with a maximiser (lowest z, y, x among maximisers); `None` if empty.
     pub fn support(&self, direction: &[f64; D]) -> Result<Option<(f64, [f64; D])>, CellError> {
         if self.is_empty() {
