@@ -34,6 +34,7 @@ use crate::world::WorldComponent;
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus};
 use glam::{DMat3, DVec2, DVec3};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use stackplan_geom::Part;
 
@@ -148,12 +149,14 @@ impl Region {
         }
         let (lo, hi) = self.bbox();
         let eps = (1e-7 * (hi - lo).length()).max(100.0 * self.tol);
-        let mut out = Vec::new();
-        for (i, &(a, b)) in segments.iter().enumerate() {
+        // each segment's pieces on the boundary, in parallel and collected in the segments' order (the same list as
+        // a sequential loop)
+        let per_segment = |(i, &(a, b)): (usize, &(DVec2, DVec2))| {
+            let mut out = Vec::new();
             let d = b - a;
             let len = d.length();
             if len <= self.tol {
-                continue;
+                return out;
             }
             let mut cuts = vec![0.0, 1.0];
             for (j, &(c, e)) in segments.iter().enumerate() {
@@ -188,35 +191,41 @@ impl Region {
                     out.push((a + d * w[0], a + d * w[1]));
                 }
             }
-        }
-        out
+            out
+        };
+        segments.par_iter().enumerate().flat_map_iter(per_segment).collect()
     }
 
-    /// Largest inscribed disc by grid sampling and compass refinement: `(centre, radius found, upper bound)`.
+    /// Largest inscribed disc by grid sampling and compass refinement: `(centre, radius found, upper bound)`. The
+    /// grid's columns and the eight refinements run in parallel; the samples and the refinements are taken in the
+    /// sequential order, so the result does not depend on the threads.
     pub fn largest_disc_sampled(&self, grid: usize) -> (DVec2, f64, f64) {
         let (lo, hi) = self.bbox();
         let n = grid.max(4);
         let h = (hi - lo).max_element() / n as f64;
-        let mut samples: Vec<(f64, DVec2)> = Vec::new();
         let nx = ((hi.x - lo.x) / h).ceil() as usize + 1;
         let ny = ((hi.y - lo.y) / h).ceil() as usize + 1;
-        for i in 0..nx {
-            for j in 0..ny {
-                let p = DVec2::new(lo.x + h * i as f64, lo.y + h * j as f64);
-                let d = self.clearance(p);
-                if d > 0.0 {
-                    samples.push((d, p));
-                }
-            }
-        }
+        let mut samples: Vec<(f64, DVec2)> = (0..nx)
+            .into_par_iter()
+            .flat_map_iter(|i| {
+                (0..ny).filter_map(move |j| {
+                    let p = DVec2::new(lo.x + h * i as f64, lo.y + h * j as f64);
+                    let d = self.clearance(p);
+                    (d > 0.0).then_some((d, p))
+                })
+            })
+            .collect();
         let grid_best = samples.iter().map(|s| s.0).fold(0.0, f64::max);
         samples.sort_by(|a, b| b.0.total_cmp(&a.0));
         let mut best = (DVec2::ZERO, 0.0);
         if let Some(first) = samples.first() {
             best = (first.1, first.0);
         }
-        for &(_, start) in samples.iter().take(8) {
-            let (p, d) = compass(|q| self.clearance(q), start, h, h * 1e-6);
+        let refined: Vec<(DVec2, f64)> = samples[..samples.len().min(8)]
+            .par_iter()
+            .map(|&(_, start)| compass(|q| self.clearance(q), start, h, h * 1e-6))
+            .collect();
+        for (p, d) in refined {
             if d > best.1 {
                 best = (p, d);
             }
