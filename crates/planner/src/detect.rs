@@ -37,29 +37,42 @@ pub struct StackComponent {
     pub placed: PlacedConvex,
 }
 
-/// The stationary stack, prepared once.
+/// The stationary stack, prepared once (and grown part by part, [`StackScene::push_part`]).
 #[derive(Debug, Clone)]
 pub struct StackScene {
     /// Every component of every stack part, in (part, piece) order.
     pub components: Vec<StackComponent>,
     /// Highest z of the stack (or 0 for an empty stack).
     pub top: f64,
+    /// Number of stack parts.
+    parts: usize,
 }
 
 impl StackScene {
     /// Places every component. O(total size).
     pub fn new(parts: &[(&Part, Pose)]) -> Self {
-        let mut components = Vec::new();
-        let mut top: f64 = 0.0;
-        for (pi, (part, pose)) in parts.iter().enumerate() {
-            for (ci, c) in part.components.iter().enumerate() {
-                let world = c.transformed(pose.rotation, pose.position);
-                let placed = PlacedConvex::new(c, pose.rotation, pose.position);
-                top = top.max(placed.aabb.1.z);
-                components.push(StackComponent { part: pi, piece: ci, world, placed });
-            }
+        let mut scene = Self { components: Vec::new(), top: 0.0, parts: 0 };
+        for &(part, pose) in parts {
+            scene.push_part(part, pose);
         }
-        Self { components, top }
+        scene
+    }
+
+    /// Places one more stack part's components (stack part index [`StackScene::parts`] before the call): the scene
+    /// of the longer list, as [`StackScene::new`] builds it. O(size of the part).
+    pub fn push_part(&mut self, part: &Part, pose: Pose) {
+        for (ci, c) in part.components.iter().enumerate() {
+            let world = c.transformed(pose.rotation, pose.position);
+            let placed = PlacedConvex::new(c, pose.rotation, pose.position);
+            self.top = self.top.max(placed.aabb.1.z);
+            self.components.push(StackComponent { part: self.parts, piece: ci, world, placed });
+        }
+        self.parts += 1;
+    }
+
+    /// Number of stack parts placed.
+    pub fn parts(&self) -> usize {
+        self.parts
     }
 }
 

@@ -624,6 +624,52 @@ pub struct SearchCaches {
     lanes: Vec<LaneCaches>,
     /// The states of the last searches, by floor and cost, newest last (at most [`CARRIED_FRONTIERS`]).
     frontiers: Vec<(FrontierSignature, States)>,
+    /// The last search's scene and its stack's keys: a search whose stack extends that stack places only its new
+    /// parts' components (a plan's stack only grows).
+    scene: Option<(Vec<SceneKey>, Arc<StackScene>)>,
+}
+
+/// A stack part as the caches compare it: a fingerprint of the part's geometry and the bits of its pose.
+type SceneKey = (u64, [u64; 12]);
+
+/// The [`SceneKey`]s of a stack (the fingerprint computed once per distinct part).
+fn scene_keys(stack: &[crate::request::StackPart<'_>]) -> Vec<SceneKey> {
+    let mut fingerprints: Vec<(*const stackplan_geom::Part, u64)> = Vec::new();
+    stack
+        .iter()
+        .map(|s| {
+            let at = std::ptr::from_ref(s.part);
+            let fingerprint = match fingerprints.iter().find(|(p, _)| *p == at) {
+                Some(&(_, f)) => f,
+                None => {
+                    let f = part_fingerprint(s.part);
+                    fingerprints.push((at, f));
+                    f
+                }
+            };
+            let mut pose = [0u64; 12];
+            for (slot, x) in
+                pose.iter_mut().zip(s.pose.rotation.to_cols_array().into_iter().chain(s.pose.position.to_array()))
+            {
+                *slot = x.to_bits();
+            }
+            (fingerprint, pose)
+        })
+        .collect()
+}
+
+/// A 64-bit hash of a part's component vertices (their bits, in order), which is all a scene takes from it.
+fn part_fingerprint(part: &stackplan_geom::Part) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    part.components.len().hash(&mut hasher);
+    for c in &part.components {
+        c.vertices().len().hash(&mut hasher);
+        for v in c.vertices() {
+            v.to_array().map(f64::to_bits).hash(&mut hasher);
+        }
+    }
+    hasher.finish()
 }
 
 /// What one partition of the orientations keeps from search to search ([`SearchCaches`]).
@@ -711,7 +757,7 @@ struct CacheSignature {
     horizontal: bool,
     extrapolate: bool,
     partitions: usize,
-    stack: Vec<Vec<DVec3>>,
+    stack: Vec<SceneKey>,
 }
 
 impl SearchCaches {
@@ -728,6 +774,24 @@ impl SearchCaches {
     /// counters (a carried search evaluates only pairs no earlier search did). The stacking planner uses these.
     pub fn carrying_frontiers() -> Self {
         Self { carry: true, ..Self::default() }
+    }
+
+    /// The scene of `request`'s stack (`keys`: its [`scene_keys`]): the last search's, with the components of the
+    /// parts added since, when the stack extends that search's; otherwise built afresh.
+    fn scene(&mut self, request: &PlacementRequest<'_>, keys: &[SceneKey]) -> Arc<StackScene> {
+        let mut scene = match self.scene.take() {
+            Some((old, scene)) if old.len() <= keys.len() && old[..] == keys[..old.len()] => scene,
+            _ => Arc::new(StackScene::new(&[])),
+        };
+        let placed = scene.parts();
+        if placed < request.stack.len() {
+            let grown = Arc::make_mut(&mut scene);
+            for s in &request.stack[placed..] {
+                grown.push_part(s.part, s.pose);
+            }
+        }
+        self.scene = Some((keys.to_vec(), Arc::clone(&scene)));
+        scene
     }
 
     /// Keeps the caches when `next` extends the signature they were built under, clears them otherwise.
@@ -812,8 +876,8 @@ fn prepare<'r, 'a>(
         .enumerate()
         .map(|(i, (rest, ti, theta, r))| Orientation::without_components(part, i, rest, ti, theta, r, &request.cost))
         .collect();
-    let stack_refs: Vec<(&stackplan_geom::Part, Pose)> = request.stack.iter().map(|s| (s.part, s.pose)).collect();
-    let scene = Arc::new(StackScene::new(&stack_refs));
+    let keys = scene_keys(&request.stack);
+    let scene = caches.scene(request, &keys);
     // rotated components and sweep axes are built when an orientation is first expanded
     let sweeps: Vec<Option<Arc<SweepAxes>>> = vec![None; orientations.len()];
     let stats = PlacementStats {
@@ -834,7 +898,7 @@ fn prepare<'r, 'a>(
         horizontal: request.horizontal_clearance,
         extrapolate: request.extrapolate,
         partitions: request.partitions,
-        stack: scene.components.iter().map(|c| c.placed.vertices.clone()).collect(),
+        stack: keys,
     });
     let n_orientations = orientations.len();
     let lanes = request.partitions;

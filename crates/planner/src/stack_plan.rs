@@ -338,12 +338,13 @@ pub fn plan_stack_with_progress(
     // tests, kept from candidate to candidate and from part to part
     let mut growing = GrowingStack::new(&check_options).map_err(|e| PlanError::Check(e.to_string()))?;
     let mut placed: Vec<Pose> = Vec::new();
+    // the placed parts' components for the candidates' drops (`settled`), grown part by part
+    let mut scene = StackScene::new(&[]);
     let mut planned: Vec<PlannedPart> = Vec::new();
     let mut stats = PlanStats::default();
     let mut stopped = None;
     'parts: for index in 0..options.count {
         let stack: Vec<StackPart<'_>> = placed.iter().map(|&pose| StackPart { part, pose }).collect();
-        let scene = StackScene::new(&placed.iter().map(|&pose| (part, pose)).collect::<Vec<_>>());
         // stage 1: within the stack's footprint (grown by the nesting allowance); stage 2: the whole floor
         let mut stages: Vec<(u8, FloorVolume)> = Vec::new();
         if !placed.is_empty() {
@@ -476,6 +477,7 @@ pub fn plan_stack_with_progress(
         if let Some((stage, (candidate, release_drop), rejected, grasp_radius)) = best.cloned() {
             let pose = candidate.pose();
             placed.push(pose);
+            scene.push_part(part, pose);
             growing
                 .push(PlacedPart { part, rotation: pose.rotation, position: pose.position })
                 .map_err(|e| PlanError::Check(e.to_string()))?;

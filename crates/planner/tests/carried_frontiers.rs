@@ -65,3 +65,29 @@ fn carried_frontiers_find_the_exact_best_placement_into_a_growing_stack() {
     }
     assert!(widened > 0, "the growing floor was widened from a carried frontier");
 }
+
+/// Search caches reused for a stack that does not extend the last search's (a part moved, a shorter stack) search
+/// that stack: the scene the caches keep is built again, and every search's placements are a fresh search's. With a
+/// scene kept by the number of parts alone, the moved part's old place would be searched around. (The obstacle cache
+/// is keyed by stack part index, so it is new for every stack, as its documentation asks.)
+#[test]
+fn caches_reused_for_another_stack_search_that_stack() {
+    let part = part_by_name("l-corner", Decomposition::ConvexMerge).expect("example");
+    let floor = FloorVolume::rectangle(-150.0, -150.0, 150.0, 150.0, 300.0);
+    let at = |x: f64, y: f64| Pose { rotation: glam::DMat3::IDENTITY, position: glam::DVec3::new(x, y, 0.0) };
+    let stacks = [vec![at(0.0, 0.0)], vec![at(40.0, -30.0)], vec![at(40.0, -30.0), at(-60.0, 50.0)], vec![]];
+    for mut caches in [SearchCaches::new(), SearchCaches::carrying_frontiers()] {
+        for poses in &stacks {
+            let stack: Vec<StackPart<'_>> = poses.iter().map(|&pose| StackPart { part: &part, pose }).collect();
+            let req = growing_stack_request(&part, stack, floor.clone());
+            let fresh = place_with_caches(&req, &ObstacleCache::new(), &mut SearchCaches::new()).expect("fresh");
+            let reused = place_with_caches(&req, &ObstacleCache::new(), &mut caches).expect("reused caches");
+            assert_eq!(reused.stats.stack_components, fresh.stats.stack_components);
+            let (Some(a), Some(b)) = (reused.placements.first(), fresh.placements.first()) else {
+                panic!("room on the floor for stack {poses:?}");
+            };
+            assert!((a.cost - b.cost).abs() <= 1e-9 * (1.0 + b.cost.abs()), "{poses:?}: {} vs {}", a.cost, b.cost);
+            assert!((a.pose().position - b.pose().position).length() <= 1e-6, "{poses:?}: {a:?} vs {b:?}");
+        }
+    }
+}
