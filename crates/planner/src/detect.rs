@@ -46,12 +46,14 @@ pub struct StackScene {
     pub top: f64,
     /// Number of stack parts.
     parts: usize,
+    /// The components' boxes (`placed.aabb`) in one compact list, for the broad phase.
+    boxes: Vec<(DVec3, DVec3)>,
 }
 
 impl StackScene {
     /// Places every component. O(total size).
     pub fn new(parts: &[(&Part, Pose)]) -> Self {
-        let mut scene = Self { components: Vec::new(), top: 0.0, parts: 0 };
+        let mut scene = Self { components: Vec::new(), top: 0.0, parts: 0, boxes: Vec::new() };
         for &(part, pose) in parts {
             scene.push_part(part, pose);
         }
@@ -65,6 +67,7 @@ impl StackScene {
             let world = c.transformed(pose.rotation, pose.position);
             let placed = PlacedConvex::new(c, pose.rotation, pose.position);
             self.top = self.top.max(placed.aabb.1.z);
+            self.boxes.push(placed.aabb);
             self.components.push(StackComponent { part: self.parts, piece: ci, world, placed });
         }
         self.parts += 1;
@@ -288,6 +291,8 @@ pub struct DetectScratch {
 struct QueueLists {
     moved: Vec<MovedComponent>,
     near: Vec<usize>,
+    /// The boxes of `near`, in its order (the inner loop of the broad phase reads one compact list).
+    near_boxes: Vec<(DVec3, DVec3)>,
     open: Vec<OpenPair>,
     exact: Vec<Candidate>,
 }
@@ -396,7 +401,8 @@ impl CandidateQueue {
         } else {
             Rule { weight: 0.0, stop: tol.max(clearance), inclusive: false }
         };
-        let QueueLists { mut moved, mut near, open: mut pending, exact } = std::mem::take(&mut scratch.spare);
+        let QueueLists { mut moved, mut near, mut near_boxes, open: mut pending, exact } =
+            std::mem::take(&mut scratch.spare);
         pending.clear();
         for m in &mut moved {
             m.vertices.clear();
@@ -414,30 +420,27 @@ impl CandidateQueue {
         };
         near.clear();
         near.extend(
-            scene
-                .components
-                .iter()
-                .enumerate()
-                .filter(|(_, f)| boxes_overlap(&part_box, &f.placed.aabb, margin))
-                .map(|(i, _)| i),
+            scene.boxes.iter().enumerate().filter(|(_, b)| boxes_overlap(&part_box, b, margin)).map(|(i, _)| i),
         );
+        near_boxes.clear();
+        near_boxes.extend(near.iter().map(|&i| scene.boxes[i]));
         for (mi, placed) in orientation.components.iter().enumerate() {
             if near.is_empty() {
                 break;
             }
             let moved_box = moved_box(placed, p, sweep.map(|_| sweep_lift(scene.top, placed, p)));
-            for &fi in &near {
-                let fixed = &scene.components[fi];
-                if !boxes_overlap(&moved_box, &fixed.placed.aabb, margin) {
+            for (&fi, fixed_box) in near.iter().zip(&near_boxes) {
+                if !boxes_overlap(&moved_box, fixed_box, margin) {
                     continue;
                 }
                 counts.narrow_phase += 1;
                 // (not scanned yet: the boxes bound its violation; `next` scans it when that bound matters)
-                let bound = queue.bound(box_bound(&moved_box, &fixed.placed.aabb, rule.weight, tol));
+                let bound = queue.bound(box_bound(&moved_box, fixed_box, rule.weight, tol));
                 pending.push(OpenPair { moving: mi, fixed: fi, bound });
             }
         }
         scratch.spare.near = near;
+        scratch.spare.near_boxes = near_boxes;
         // (heapified in O(n): most detections take only the first few pairs)
         queue.open = BinaryHeap::from(pending);
         queue
@@ -447,7 +450,9 @@ impl CandidateQueue {
     /// the allocations of the next one).
     pub fn recycle(self, scratch: &mut DetectScratch) {
         let near = std::mem::take(&mut scratch.spare.near);
-        scratch.spare = QueueLists { moved: self.moved, near, open: self.open.into_vec(), exact: self.exact };
+        let near_boxes = std::mem::take(&mut scratch.spare.near_boxes);
+        scratch.spare =
+            QueueLists { moved: self.moved, near, near_boxes, open: self.open.into_vec(), exact: self.exact };
     }
 
     /// Upper bound of a pair's violation from a lower bound `best` of its scan's largest value, plus (with a
