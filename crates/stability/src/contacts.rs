@@ -27,6 +27,7 @@ use crate::polygon2d::{convex_hull_2d, intersect_convex};
 use crate::sat::{Separation, Shape, separation, separation_along};
 use crate::world::{WorldComponent, WorldPart, aabb_overlap};
 use glam::{DVec2, DVec3};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// A body of the stack: the fixed floor or a part (index in the stack).
@@ -174,12 +175,21 @@ fn kind_of(points: &[DVec3]) -> PatchKind {
 /// Contacts and interferences among `parts` and with the floor, with length tolerance `tol`.
 ///
 /// Only parts for which `include(i)` holds take part (to analyse a prefix of a stack).
-pub fn analyse_contacts(parts: &[WorldPart], tol: f64, include: impl Fn(usize) -> bool) -> ContactAnalysis {
+pub fn analyse_contacts(parts: &[WorldPart], tol: f64, include: impl Fn(usize) -> bool + Sync) -> ContactAnalysis {
+    // each part's contacts in parallel, appended in the parts' order (the list of the sequential loop)
+    let per_part: Vec<ContactAnalysis> = (0..parts.len())
+        .into_par_iter()
+        .filter(|&j| include(j))
+        .map(|j| {
+            let mut own = ContactAnalysis::default();
+            contacts_of_part(parts, j, tol, &include, &mut own);
+            own
+        })
+        .collect();
     let mut out = ContactAnalysis::default();
-    for j in 0..parts.len() {
-        if include(j) {
-            contacts_of_part(parts, j, tol, &include, &mut out);
-        }
+    for own in per_part {
+        out.patches.extend(own.patches);
+        out.interferences.extend(own.interferences);
     }
     tracing::debug!(patches = out.patches.len(), interferences = out.interferences.len(), "contacts analysed");
     out
