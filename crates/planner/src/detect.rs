@@ -304,24 +304,35 @@ struct OpenPair {
     moving: usize,
     fixed: usize,
     bound: f64,
+    /// [`OpenPair::order`] of the pair, compared as one integer.
+    rank: u128,
 }
 
 impl OpenPair {
+    fn new(moving: usize, fixed: usize, bound: f64) -> Self {
+        Self { moving, fixed, bound, rank: Self::order(bound, moving, fixed) }
+    }
+
     fn key(&self) -> (f64, usize, usize) {
         (self.bound, self.moving, self.fixed)
+    }
+
+    /// [`precedes`]'s order as an integer, greater first: the bound's bits mapped to `f64::total_cmp`'s order, then
+    /// the complements of the moving and the stack component (a lower index precedes). Indices beyond `u32` (not
+    /// met: a scene that large does not fit in memory) would share their tie-break.
+    fn order(bound: f64, moving: usize, fixed: usize) -> u128 {
+        let mut bits = bound.to_bits() as i64;
+        bits ^= (((bits >> 63) as u64) >> 1) as i64;
+        let ordered = (bits as u64) ^ (1u64 << 63);
+        let index = |i: usize| u128::from(!u32::try_from(i).unwrap_or(u32::MAX));
+        (u128::from(ordered) << 64) | (index(moving) << 32) | index(fixed)
     }
 }
 
 /// The queue's order: the greatest open pair is the one whose bound precedes every other's ([`precedes`]).
 impl Ord for OpenPair {
     fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        if precedes(self.key(), other.key()) {
-            std::cmp::Ordering::Greater
-        } else if precedes(other.key(), self.key()) {
-            std::cmp::Ordering::Less
-        } else {
-            std::cmp::Ordering::Equal
-        }
+        self.rank.cmp(&other.rank)
     }
 }
 
@@ -422,6 +433,8 @@ impl CandidateQueue {
         near.extend(
             scene.boxes.iter().enumerate().filter(|(_, b)| boxes_overlap(&part_box, b, margin)).map(|(i, _)| i),
         );
+        // by the boxes' lowest x, so that each moving component's loop stops at the first box beyond its own in x
+        near.sort_unstable_by(|&a, &b| scene.boxes[a].0.x.total_cmp(&scene.boxes[b].0.x));
         near_boxes.clear();
         near_boxes.extend(near.iter().map(|&i| scene.boxes[i]));
         for (mi, placed) in orientation.components.iter().enumerate() {
@@ -429,14 +442,15 @@ impl CandidateQueue {
                 break;
             }
             let moved_box = moved_box(placed, p, sweep.map(|_| sweep_lift(scene.top, placed, p)));
-            for (&fi, fixed_box) in near.iter().zip(&near_boxes) {
+            let reach = near_boxes.partition_point(|b| b.0.x <= moved_box.1.x + margin);
+            for (&fi, fixed_box) in near[..reach].iter().zip(&near_boxes[..reach]) {
                 if !boxes_overlap(&moved_box, fixed_box, margin) {
                     continue;
                 }
                 counts.narrow_phase += 1;
                 // (not scanned yet: the boxes bound its violation; `next` scans it when that bound matters)
                 let bound = queue.bound(box_bound(&moved_box, fixed_box, rule.weight, tol));
-                pending.push(OpenPair { moving: mi, fixed: fi, bound });
+                pending.push(OpenPair::new(mi, fi, bound));
             }
         }
         scratch.spare.near = near;
@@ -693,6 +707,32 @@ mod tests {
             b.violation.total_cmp(&a.violation).then(a.moving.cmp(&b.moving)).then(a.fixed.cmp(&b.fixed))
         });
         out
+    }
+
+    proptest::proptest! {
+        /// The open pairs' integer order is [`precedes`]'s (the bound by `f64::total_cmp`, descending, then the lower
+        /// moving and stack component), including signed zeros, infinities and equal bounds.
+        #[test]
+        fn open_pairs_order_as_precedes(
+            a in (proptest::sample::select(vec![0.0, -0.0, 1.5, -1.5, f64::INFINITY, f64::NEG_INFINITY, 3e-300]),
+                -2.0f64..2.0, 0usize..4, 0usize..4, proptest::bool::ANY),
+            b in (proptest::sample::select(vec![0.0, -0.0, 1.5, -1.5, f64::INFINITY, f64::NEG_INFINITY, 3e-300]),
+                -2.0f64..2.0, 0usize..4, 0usize..4, proptest::bool::ANY),
+        ) {
+            let pick = |(special, any, m, f, use_special): (f64, f64, usize, usize, bool)| {
+                (if use_special { special } else { any }, m, f)
+            };
+            let (x, y) = (pick(a), pick(b));
+            let (p, q) = (OpenPair::new(x.1, x.2, x.0), OpenPair::new(y.1, y.2, y.0));
+            let expected = if precedes(x, y) {
+                std::cmp::Ordering::Greater
+            } else if precedes(y, x) {
+                std::cmp::Ordering::Less
+            } else {
+                std::cmp::Ordering::Equal
+            };
+            proptest::prop_assert_eq!(p.cmp(&q), expected, "{:?} {:?}", x, y);
+        }
     }
 
     /// The lazy queue (first and repeated tests of each pair, with the scratch lists recycled) gives exactly the
