@@ -180,6 +180,13 @@ mod tests {
         ]
     }
 
+    /// [`unit_box`] cut by `n . p <= d` for each `(n_x, n_y, n_z, d)` of `cuts`.
+    fn box_with_cuts(cuts: &[(f64, f64, f64, f64)], tol: Tolerance) -> Cell<3> {
+        let mut list = unit_box();
+        list.extend(cuts.iter().map(|&(x, y, z, d)| hs([x, y, z], d)));
+        Cell::new(list, tol).expect("finite inequalities inside a box: a bounded cell")
+    }
+
     #[test]
     fn a_box_is_its_own_outer_box() {
         let (lo, hi) = outer_box(&unit_box(), 0.0);
@@ -254,11 +261,7 @@ mod tests {
             probe in (-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0, -3.0f64..3.0),
         ) {
             let tol = Tolerance::for_scale(10.0);
-            let mut list = unit_box();
-            for (x, y, z, d) in cuts {
-                list.push(hs([x, y, z], d));
-            }
-            let cell = Cell::new(list, tol).expect("finite inequalities inside a box: a bounded cell");
+            let cell = box_with_cuts(&cuts, tol);
             prop_assume!(!cell.is_empty());
             let b = cell.grown_outer_box();
             for i in 0..3 {
@@ -291,11 +294,7 @@ mod tests {
             probes in proptest::collection::vec((-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0, -3.0f64..3.0), 6),
         ) {
             let tol = Tolerance::for_scale(10.0);
-            let mut list = unit_box();
-            for (x, y, z, d) in cuts {
-                list.push(hs([x, y, z], d));
-            }
-            let cell = Cell::new(list, tol).expect("finite inequalities inside a box: a bounded cell");
+            let cell = box_with_cuts(&cuts, tol);
             prop_assume!(!cell.is_empty());
             let (_, pruned) = cell.grown_outer_box_pruned();
             let Some(pruned) = pruned else { return Ok(()) };
