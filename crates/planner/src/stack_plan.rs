@@ -338,8 +338,6 @@ pub fn plan_stack_with_progress(
     // tests, kept from candidate to candidate and from part to part
     let mut growing = GrowingStack::new(&check_options).map_err(|e| PlanError::Check(e.to_string()))?;
     let mut placed: Vec<Pose> = Vec::new();
-    // the placed parts' components for the candidates' drops (`settled`), grown part by part
-    let mut scene = StackScene::new(&[]);
     let mut planned: Vec<PlannedPart> = Vec::new();
     let mut stats = PlanStats::default();
     let mut stopped = None;
@@ -416,7 +414,7 @@ pub fn plan_stack_with_progress(
                 };
                 let started = std::time::Instant::now();
                 stats.candidates_checked += 1;
-                let candidate = settled(part, &rests, candidate, &scene, &cache, tol, &request.cost)?;
+                let candidate = settled(part, &rests, candidate, search.scene(), &cache, tol, &request.cost)?;
                 let verdict = accept(&mut growing, part, &candidate.0, &mut stats)?;
                 stats.seconds_checks += started.elapsed().as_secs_f64();
                 tracing::trace!(
@@ -477,7 +475,6 @@ pub fn plan_stack_with_progress(
         if let Some((stage, (candidate, release_drop), rejected, grasp_radius)) = best.cloned() {
             let pose = candidate.pose();
             placed.push(pose);
-            scene.push_part(part, pose);
             growing
                 .push(PlacedPart { part, rotation: pose.rotation, position: pose.position })
                 .map_err(|e| PlanError::Check(e.to_string()))?;

@@ -12,8 +12,8 @@
 //!   faces in. Gravity loads the stack, and a sideways normal at such a contact would let two opposite edge
 //!   contacts pinch a part along one line and hold it by friction (a part resting across the seam of two coplanar
 //!   tops was found "stable" that way, with its centre of gravity outside its supports). The supporting sets
-//!   `S_A = {v in A : n.v >= max_A n.x - tol}` and `S_B = {v in B : n.v <= min_B n.x + tol}` (a vertex, an edge or a face of each) are projected onto the contact
-//!   plane and intersected as planar convex sets ([`crate::polygon2d::intersect_convex`]): coplanar opposite faces give
+//!   `S_A = {v in A : n.v >= max_A n.x - tol}` and `S_B = {v in B : n.v <= min_B n.x + tol}` (a vertex, an edge or
+//!   a face of each) are projected onto the contact plane and intersected as planar convex sets ([`crate::polygon2d::intersect_convex`]): coplanar opposite faces give
 //!   the polygon of their overlap, an edge on a face a segment, crossing edges or a vertex on a face a point. The
 //!   patch's points are the vertices of that set, lifted to the mid-plane between the two supporting planes.
 //!
