@@ -280,7 +280,7 @@ fn png_distinct_colours(png: &[u8]) -> usize {
 
 /// Triangle parts with the default 5 mm clearance nest (\[A\] Fig. 19): each is released above the inclined walls of
 /// the one below and drops onto them; `check` then measures the clearance where the robot lets go, against the parts
-/// placed before, and passes. Without the drops (a plain stack file of the resting positions) the nested parts
+/// placed before, and passes, also with the plan's own options taken as its defaults. Without the drops (a plain stack file of the resting positions) the nested parts
 /// touch and the clearance fails, as it must.
 #[test]
 fn triangle_plans_nest_with_clearance_and_check_at_the_release_positions() {
@@ -301,6 +301,19 @@ fn triangle_plans_nest_with_clearance_and_check_at_the_release_positions() {
     assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
     let report: Value = serde_json::from_str(&stdout(&o)).expect("check json");
     assert_eq!(report["options"]["release_drops"].as_array().map(Vec::len), Some(3));
+    // without options a plan file is checked with the planner's own: mu 0.5, the 5 mm clearance, the 10 mm cup
+    let o = run_in(dir.path(), &["check", "out/plan.json", "--json"]);
+    assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
+    let report: Value = serde_json::from_str(&stdout(&o)).expect("check json");
+    assert_eq!(report["options"]["mu"], 0.5);
+    assert_eq!(report["options"]["clearance"], 5.0);
+    assert_eq!(report["options"]["grasp"]["cup_diameter"], 10.0);
+    // the command line wins: the Triangle's upward faces hold a disc of about 10 mm radius, not a 30 mm cup
+    let o = run_in(dir.path(), &["check", "out/plan.json", "--cup-diameter", "30", "--json"]);
+    assert_eq!(o.status.code(), Some(1), "{}\n{}", stdout(&o), stderr(&o));
+    let report: Value = serde_json::from_str(&stdout(&o)).expect("check json");
+    assert_eq!(report["options"]["grasp"]["cup_diameter"], 30.0);
+    assert!(report["parts"].as_array().expect("parts").iter().all(|p| p["graspable"] == false));
     // the resting positions alone: the nested parts touch, so a symmetric 5 mm clearance fails
     let mut resting = plan.clone();
     for p in resting["placements"].as_array_mut().expect("placements") {

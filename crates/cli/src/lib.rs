@@ -46,7 +46,7 @@ pub enum Command {
     /// Information about a part, and export to other formats.
     #[command(subcommand)]
     Part(cmd::part::PartCommand),
-    /// A stacking plan for N identical parts, with pictures, a 3-D model and a report (default: 15 Triangle parts).
+    /// A stacking plan for N identical parts, with pictures, a 3-D model and a report (default: 15 Channel parts).
     Plan(cmd::plan::Args),
     /// Redraws the pictures, 3-D model and report of an existing plan file.
     Render(cmd::render::Args),

@@ -1,6 +1,7 @@
 //! `stackplan check STACK.json [--mu MU] [--clearance MM] [--cup-diameter MM] [--json]`: interference, clearance,
 //! stability, grasp, insertion and removal of every part of a stack (crate `stackplan-stability`; JSON documented in
-//! `crates/stability/README.md`). Exit status 1 when a check fails.
+//! `docs/formats.md`). A plan file is checked with the planner's friction, clearance and cup (its `plan.options`)
+//! unless the command line gives them. Exit status 1 when a check fails.
 
 use crate::Outcome;
 use crate::output;
@@ -16,15 +17,16 @@ use std::path::PathBuf;
 pub struct Args {
     /// The stack file (JSON: a part and its placements).
     pub stack: PathBuf,
-    /// Coulomb friction coefficient.
-    #[arg(long, default_value_t = 0.5)]
-    pub mu: f64,
-    /// Required horizontal clearance between parts (mm); 0 disables the test.
-    #[arg(long, default_value_t = 0.0)]
-    pub clearance: f64,
-    /// Suction cup diameter (mm).
-    #[arg(long, default_value_t = 30.0)]
-    pub cup_diameter: f64,
+    /// Coulomb friction coefficient [default: a plan file's `options.mu`, else 0.5].
+    #[arg(long)]
+    pub mu: Option<f64>,
+    /// Required horizontal clearance between parts (mm); 0 disables the test [default: a plan file's
+    /// `options.clearance`, else 0].
+    #[arg(long)]
+    pub clearance: Option<f64>,
+    /// Suction cup diameter (mm) [default: a plan file's `options.cup_diameter`, else 30].
+    #[arg(long)]
+    pub cup_diameter: Option<f64>,
     /// Contact tolerance (mm) instead of the policy's 1e-9 x stack size (for stacks with rounded coordinates).
     #[arg(long)]
     pub contact_tolerance: Option<f64>,
@@ -61,6 +63,12 @@ fn release_drops(extras: &[serde_json::Map<String, serde_json::Value>]) -> Vec<f
         .collect()
 }
 
+/// `options.KEY` of a plan file's summary (`stackplan plan` writes the planner's options there) when it is a finite
+/// number; `None` for a plain stack file or any other value.
+fn plan_option(plan: Option<&serde_json::Value>, key: &str) -> Option<f64> {
+    plan?.get("options")?.get(key)?.as_f64().filter(|v| v.is_finite())
+}
+
 /// Runs `check`.
 pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let file = stackplan::geom::io::stack::read_stack(&args.stack)
@@ -70,10 +78,15 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         .iter()
         .map(|pose| PlacedPart { part: &file.part, rotation: pose.rotation, position: pose.position })
         .collect();
+    // a plan file is checked with the planner's own friction, clearance and cup unless the command line says otherwise
+    let plan = file.plan.as_ref();
+    let mu = args.mu.or_else(|| plan_option(plan, "mu")).unwrap_or(0.5);
+    let clearance = args.clearance.or_else(|| plan_option(plan, "clearance")).unwrap_or(0.0);
+    let cup_diameter = args.cup_diameter.or_else(|| plan_option(plan, "cup_diameter")).unwrap_or(30.0);
     let options = CheckOptions {
-        mu: args.mu,
-        clearance: args.clearance,
-        grasp: GraspOptions { cup_diameter: args.cup_diameter, ..GraspOptions::default() },
+        mu,
+        clearance,
+        grasp: GraspOptions { cup_diameter, ..GraspOptions::default() },
         margin_directions: args.margin_directions,
         contact_tolerance: args.contact_tolerance,
         prefix_stability: true,

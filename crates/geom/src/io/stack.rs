@@ -31,6 +31,8 @@ pub struct StackFile {
     pub placements: Vec<Pose>,
     /// The extra keys of each placement (parallel to `placements`).
     pub extras: Vec<Map<String, Value>>,
+    /// The top-level `plan` summary of a plan file (`stackplan plan`), as written; `None` for a plain stack file.
+    pub plan: Option<Value>,
 }
 
 /// How [`write_stack`] refers to the part.
@@ -48,8 +50,8 @@ struct StackRecord {
     part: Value,
     placements: Vec<PlacementRecord>,
     /// The summary a plan file (`stackplan plan`) carries beside its placements; not part of the stack.
-    #[serde(default, rename = "plan")]
-    _plan: Option<Value>,
+    #[serde(default)]
+    plan: Option<Value>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -110,7 +112,7 @@ pub fn parse_stack(bytes: &[u8], file: &Path, options: &ReadOptions) -> Result<S
         placements.push(pose);
         extras.push(p.extra);
     }
-    Ok(StackFile { part, part_path, placements, extras })
+    Ok(StackFile { part, part_path, placements, extras, plan: record.plan })
 }
 
 /// The stack file text. `extras[i]` (if present) is merged into placement `i` (it cannot override the pose keys).
