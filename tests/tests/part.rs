@@ -78,3 +78,19 @@ fn export_writes_readable_files() {
     let obj = info("c.obj");
     assert!((obj - original).abs() <= 1e-6 * original, "{obj} vs {original}");
 }
+
+/// The formats of one export are written together or not at all: a target in a missing directory fails the run
+/// (exit 2, naming it) before the other target is written.
+#[test]
+fn an_export_that_fails_for_one_format_writes_none() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let part = fixture("channel");
+    let o = run_in(
+        dir.path(),
+        &["part", "export", part.to_str().expect("utf-8"), "--glb", "c.glb", "--obj", "no/such/dir/c.obj"],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("c.obj"), "{}", stderr(&o));
+    assert!(!dir.path().join("c.glb").exists(), "the GLB is not written when the OBJ cannot be");
+    assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 0, "no temporary file left behind");
+}

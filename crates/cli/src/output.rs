@@ -11,6 +11,12 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
     Ok(stackplan_geom::io::atomic::write_atomic(path, bytes)?)
 }
 
+/// Writes every `(path, bytes)` or none (`stackplan_geom::io::write_all_atomic`): the outputs of one command are
+/// complete together or not written.
+pub fn write_all_atomic(files: &[(std::path::PathBuf, &[u8])]) -> anyhow::Result<()> {
+    Ok(stackplan_geom::io::write_all_atomic(files.iter().map(|(p, b)| (p.as_path(), *b)))?)
+}
+
 /// Pretty JSON text of `value` with a trailing newline.
 pub fn json_text(value: &impl Serialize) -> anyhow::Result<String> {
     let mut s = serde_json::to_string_pretty(value)?;

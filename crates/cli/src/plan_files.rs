@@ -8,7 +8,7 @@
 //! (`k = ceil(n / MAX_BUILD_FRAMES)`), each frame captioned with its part count. All frames share one scale and floor
 //! line so the stack's growth can be compared frame to frame.
 
-use crate::output::write_atomic;
+use crate::output::write_all_atomic;
 use crate::render::{
     Figure, FigurePanel, ISOMETRIC, MUTED, Marker, Scene, Solid, figure_png, figure_svg, part_color, three_views,
 };
@@ -166,15 +166,14 @@ impl PlanPictures {
         ]
     }
 
-    /// Writes `plan.json` (the given text) and every picture into `dir` (created if needed), each atomically.
+    /// Writes `plan.json` (the given text) and every picture into `dir` (created if needed), all or none
+    /// ([`write_all_atomic`]).
     pub fn write_all(&self, dir: &Path, plan_text: &[u8]) -> anyhow::Result<()> {
         use anyhow::Context;
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-        write_atomic(&dir.join("plan.json"), plan_text)?;
-        for (name, bytes) in self.files() {
-            write_atomic(&dir.join(name), bytes)?;
-        }
-        Ok(())
+        let mut files = vec![(dir.join("plan.json"), plan_text)];
+        files.extend(self.files().into_iter().map(|(name, bytes)| (dir.join(name), bytes)));
+        write_all_atomic(&files)
     }
 }
 

@@ -284,6 +284,41 @@ fn a_failing_write_leaves_no_file_and_keeps_the_old_one() {
     assert!(!missing_dir.exists());
 }
 
+/// Files written together are written all or none: a target in a missing directory or a target that is a directory
+/// fails the whole set before any target changes, with no temporary file left; then all are written.
+#[test]
+fn files_written_together_are_written_all_or_none() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let a = dir.path().join("a.json");
+    let b = dir.path().join("b.png");
+    std::fs::write(&a, b"old a").expect("write");
+    let missing = dir.path().join("no/such/dir/c.svg");
+    let e =
+        atomic::write_all_atomic([(a.as_path(), &b"new a"[..]), (b.as_path(), b"new b"), (missing.as_path(), b"c")])
+            .expect_err("a missing directory");
+    assert!(matches!(&e, IoError::Os { file, .. } if file == &missing), "{e}");
+    assert_eq!(std::fs::read(&a).expect("read"), b"old a", "the first target is untouched");
+    assert!(!b.exists(), "the second target is not written");
+    let names = |d: &std::path::Path| -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(d)
+            .expect("dir")
+            .map(|e| e.expect("entry").file_name().to_string_lossy().into())
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(names(dir.path()), vec!["a.json".to_string()], "no temporary file left behind");
+    let sub = dir.path().join("sub");
+    std::fs::create_dir(&sub).expect("mkdir");
+    let e = atomic::write_all_atomic([(a.as_path(), &b"new a"[..]), (sub.as_path(), b"x")]).expect_err("a directory");
+    assert!(e.to_string().contains("sub"), "{e}");
+    assert_eq!(std::fs::read(&a).expect("read"), b"old a");
+    atomic::write_all_atomic([(a.as_path(), &b"new a"[..]), (b.as_path(), b"new b")]).expect("write both");
+    assert_eq!(std::fs::read(&a).expect("read"), b"new a");
+    assert_eq!(std::fs::read(&b).expect("read"), b"new b");
+    assert_eq!(names(dir.path()), vec!["a.json".to_string(), "b.png".to_string(), "sub".to_string()]);
+}
+
 /// An atomically written file gets the permissions an ordinary new file gets (not the temporary file's owner-only
 /// mode), and an overwritten file keeps its own.
 #[cfg(unix)]

@@ -186,15 +186,12 @@ fn info(args: &InfoArgs) -> anyhow::Result<Outcome> {
 
 fn export(args: &ExportArgs) -> anyhow::Result<Outcome> {
     let part = load_part(&args.part)?;
-    // each writer is atomic (temp file + rename); the format follows the flag, whatever the extension
-    if let Some(path) = &args.glb {
-        output::write_atomic(path, &glb_bytes(&[GlbItem::part(&part)]))?;
-    }
-    if let Some(path) = &args.obj {
-        output::write_atomic(path, obj_string(&part).as_bytes())?;
-    }
-    if let Some(path) = &args.stl {
-        output::write_atomic(path, &stl_binary_bytes(&part))?;
-    }
+    // the format follows the flag, whatever the extension; the files are written all or none
+    let glb = args.glb.as_ref().map(|p| (p.clone(), glb_bytes(&[GlbItem::part(&part)])));
+    let obj = args.obj.as_ref().map(|p| (p.clone(), obj_string(&part).into_bytes()));
+    let stl = args.stl.as_ref().map(|p| (p.clone(), stl_binary_bytes(&part)));
+    let files: Vec<(PathBuf, &[u8])> =
+        [&glb, &obj, &stl].into_iter().flatten().map(|(p, b)| (p.clone(), &b[..])).collect();
+    output::write_all_atomic(&files)?;
     Ok(Outcome::Success)
 }

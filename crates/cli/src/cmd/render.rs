@@ -6,8 +6,9 @@
 //! reported with its name ([`crate::plan_files::PlanFileError`]) before anything is written.
 
 use crate::Outcome;
-use crate::output::write_atomic;
+use crate::output::write_all_atomic;
 use crate::plan_files::{plan_pictures, read_plan_file};
+use anyhow::Context;
 use std::path::PathBuf;
 
 /// Arguments of `render`.
@@ -47,10 +48,10 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     );
     let file = read_plan_file(&args.plan)?;
     let pictures = plan_pictures(&file)?;
-    if let Some(dir) = &args.out {
-        let text = std::fs::read(&args.plan)?;
-        pictures.write_all(dir, &text)?;
-    }
+    let text = match &args.out {
+        Some(_) => std::fs::read(&args.plan)?,
+        None => Vec::new(),
+    };
     let outputs: [(&Option<PathBuf>, &[u8]); 6] = [
         (&args.png, &pictures.stack_png),
         (&args.svg, pictures.stack_svg.as_bytes()),
@@ -59,10 +60,14 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         (&args.glb, &pictures.glb),
         (&args.html, pictures.html.as_bytes()),
     ];
-    for (path, bytes) in outputs {
-        if let Some(path) = path {
-            write_atomic(path, bytes)?;
-        }
+    // every requested file, or none
+    let mut files: Vec<(PathBuf, &[u8])> = Vec::new();
+    if let Some(dir) = &args.out {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        files.push((dir.join("plan.json"), &text));
+        files.extend(pictures.files().into_iter().map(|(name, bytes)| (dir.join(name), bytes)));
     }
+    files.extend(outputs.into_iter().filter_map(|(path, bytes)| path.as_ref().map(|p| (p.clone(), bytes))));
+    write_all_atomic(&files)?;
     Ok(Outcome::Success)
 }

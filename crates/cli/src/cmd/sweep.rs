@@ -10,7 +10,7 @@
 
 use crate::Outcome;
 use crate::cmd::plan::{PlannerArgs, check_w, run_planner};
-use crate::output::{json_text, write_atomic};
+use crate::output::{json_text, write_all_atomic};
 use crate::plan_files::{PNG_SCALE, PlanFile, parse_plan_file, plan_document_text, stack_scene};
 use crate::render::{Figure, FigurePanel, ISOMETRIC, Scene, figure_png, figure_svg};
 use anyhow::Context;
@@ -183,12 +183,14 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let svg = figure_svg(&figure);
     let png = figure_png(&figure, PNG_SCALE)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
-    for (name, text, _) in &plans {
-        write_atomic(&args.out.join(name), text.as_bytes())?;
-    }
-    write_atomic(&args.out.join("sweep.json"), json_text(&sweep)?.as_bytes())?;
-    write_atomic(&args.out.join("sweep.svg"), svg.as_bytes())?;
-    write_atomic(&args.out.join("sweep.png"), &png)?;
+    // the plan files, sweep.json and the pictures: all or none
+    let sweep_text = json_text(&sweep)?;
+    let mut files: Vec<(std::path::PathBuf, &[u8])> =
+        plans.iter().map(|(name, text, _)| (args.out.join(name), text.as_bytes())).collect();
+    files.push((args.out.join("sweep.json"), sweep_text.as_bytes()));
+    files.push((args.out.join("sweep.svg"), svg.as_bytes()));
+    files.push((args.out.join("sweep.png"), &png));
+    write_all_atomic(&files)?;
     let mut text = String::new();
     for r in &sweep.runs {
         text.push_str(&format!(

@@ -3,6 +3,11 @@
 //! the old file or the complete new one, and a failure at any step leaves no partial file (the temporary file is
 //! removed when it is dropped). O(size of the data).
 //!
+//! Several files that belong together (a plan and its pictures, the formats of one export) go through
+//! [`write_all_atomic`]: every file is first written to its temporary file, and only when all of them are complete are
+//! they renamed over their targets, so a failure while writing (a missing or read-only directory, a full disk, a
+//! target that is a directory) leaves none of the targets changed.
+//!
 //! Permissions: the temporary file is created with the mode an ordinary new file would get (`0o666` less the
 //! process umask), or with the existing target's mode when it is overwritten, so the rename does not leave an
 //! owner-only file behind (the temporary-file default).
@@ -23,6 +28,34 @@ pub fn write_atomic_with(
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<(), IoError> {
     let path = path.as_ref();
+    persist(staged(path, fill)?, path)
+}
+
+/// Writes every `(path, bytes)` of `files` or none of them: all are written to temporary files beside their targets
+/// (flushed to disk) before the first is renamed over its target, in the given order (see the module
+/// documentation). A failure before the renames leaves every target as it was and no temporary file behind; only a
+/// rename itself failing (the file system changed under the program meanwhile) can leave the earlier targets
+/// written. The error names the file. O(total size).
+pub fn write_all_atomic<'a>(files: impl IntoIterator<Item = (&'a Path, &'a [u8])>) -> Result<(), IoError> {
+    let mut staged_files = Vec::new();
+    for (path, bytes) in files {
+        // a target that is a directory would fail only at its rename, after the others were renamed
+        if path.is_dir() {
+            return Err(IoError::os(path, std::io::Error::other("is a directory")));
+        }
+        staged_files.push((staged(path, |w| w.write_all(bytes))?, path));
+    }
+    for (tmp, path) in staged_files {
+        persist(tmp, path)?;
+    }
+    Ok(())
+}
+
+/// The temporary file beside `path` holding what `fill` wrote, flushed and synced (removed when dropped).
+fn staged(
+    path: &Path,
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<tempfile::NamedTempFile, IoError> {
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -44,7 +77,12 @@ pub fn write_atomic_with(
         buffered.flush().map_err(err)?;
     }
     tmp.as_file().sync_all().map_err(err)?;
-    tmp.persist(path).map_err(|e| err(e.error))?;
+    Ok(tmp)
+}
+
+/// Renames the staged `tmp` over `path`.
+fn persist(tmp: tempfile::NamedTempFile, path: &Path) -> Result<(), IoError> {
+    tmp.persist(path).map_err(|e| IoError::os(path, e.error))?;
     tracing::debug!(file = %path.display(), "wrote file atomically");
     Ok(())
 }

@@ -4,7 +4,8 @@
 //! Every reader returns an [`IoError`] that names the file and the place (line, line and column, byte offset, piece,
 //! shell, face or placement index) and never panics on any input. Every writer goes through
 //! [`atomic::write_atomic`]: the bytes go to a temporary file in the target's directory, which is then renamed over
-//! the target, so a failed write never leaves a partial file behind.
+//! the target, so a failed write never leaves a partial file behind; files that belong together go through
+//! [`atomic::write_all_atomic`], which renames none of them until all are written.
 //!
 //! Mesh inputs (STL shells, OBJ groups) must be convex: [`mesh`] checks it exactly (hull with exact predicates, every
 //! polygon on a hull face plane by exact `orient3d`, enclosed volume equal to the hull's) unless
@@ -29,7 +30,7 @@ use crate::sheet_metal::{Decomposition, SheetMetalError};
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-pub use atomic::write_atomic;
+pub use atomic::{write_all_atomic, write_atomic};
 pub use glb::{GlbItem, write_glb};
 pub use json::{parse_part_json, part_json_string, read_part_json, write_part_json};
 pub use obj::{obj_scene_string, obj_string, parse_obj, read_obj, write_obj, write_obj_scene};
