@@ -97,11 +97,28 @@ pub fn main() -> ExitCode {
             // the one place where the program writes errors for people
             #[allow(clippy::print_stderr)]
             {
-                eprintln!("error: {e:#}");
+                eprintln!("error: {}", error_text(&e));
             }
             ExitCode::from(2)
         }
     }
+}
+
+/// The error and its causes joined by ": " (as `{:#}` prints them), leaving out a cause whose message the text
+/// already ends with: the typed errors of the libraries name their source in their own message.
+pub fn error_text(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain() {
+        let message = cause.to_string();
+        if text.ends_with(&message) {
+            continue;
+        }
+        if !text.is_empty() {
+            text.push_str(": ");
+        }
+        text.push_str(&message);
+    }
+    text
 }
 
 fn init_logging(verbose: u8, quiet: bool) {
@@ -124,4 +141,36 @@ fn init_logging(verbose: u8, quiet: bool) {
         .with(tracing_subscriber::fmt::layer().with_writer(indicatif_layer.get_stderr_writer()).with_target(false))
         .with(indicatif_layer)
         .try_init();
+}
+
+#[cfg(test)]
+mod tests {
+    use super::error_text;
+    use anyhow::Context;
+
+    #[derive(Debug, thiserror::Error)]
+    #[error("the hull is flat")]
+    struct Flat;
+
+    /// A typed error that names its source in its own message.
+    #[derive(Debug, thiserror::Error)]
+    #[error("part.json: piece 0: degenerate piece: {source}")]
+    struct Degenerate {
+        source: Flat,
+    }
+
+    #[test]
+    fn a_cause_the_message_already_names_is_printed_once() {
+        let e = anyhow::Error::new(Degenerate { source: Flat });
+        assert_eq!(format!("{e:#}"), "part.json: piece 0: degenerate piece: the hull is flat: the hull is flat");
+        assert_eq!(error_text(&e), "part.json: piece 0: degenerate piece: the hull is flat");
+        let wrapped = Err::<(), _>(e).context("reading the stack s.json").expect_err("an error");
+        assert_eq!(
+            error_text(&wrapped),
+            "reading the stack s.json: part.json: piece 0: degenerate piece: the hull is flat"
+        );
+        // causes not named by the message above them stay
+        let plain = Err::<(), _>(Flat).context("loading").expect_err("an error");
+        assert_eq!(error_text(&plain), "loading: the hull is flat");
+    }
 }
