@@ -31,6 +31,30 @@ fn cspace_of_two_unit_cubes_is_the_cube_of_side_two() {
     assert!((pair["volume"].as_f64().expect("volume") - 8.0).abs() < 1e-9);
 }
 
+/// Negative numbers are values, not flags, in every subcommand: `--theta-deg -30` is the turn by 330 degrees, and a
+/// negative height reaches the planner's own check (exit 2 with its message) instead of a parser error.
+#[test]
+fn negative_numbers_are_values() {
+    let at = |theta: &str| {
+        let o = run(&["cspace", "example:block", "example:l-corner", "--theta-deg", theta, "--json"]);
+        assert!(o.status.success(), "{theta}: {}", stderr(&o));
+        json(&o)
+    };
+    let (minus, plus) = (at("-30"), at("330"));
+    assert_eq!(minus["theta_deg"], -30.0);
+    for (a, b) in minus["pairs"].as_array().expect("pairs").iter().zip(plus["pairs"].as_array().expect("pairs")) {
+        let volume = |v: &Value| v["volume"].as_f64().expect("volume");
+        assert!((volume(a) - volume(b)).abs() <= 1e-9 * volume(b), "{} vs {}", volume(a), volume(b));
+    }
+    let o = run(&["interference", "example:cube", "example:cube", "--position", "-0.5,0,0", "--theta-deg", "-5"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let dir = tempfile::tempdir().expect("tempdir");
+    let o = run_in(dir.path(), &["plan", "example:block", "--height", "-5"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("height must be positive"), "{}", stderr(&o));
+    assert!(!dir.path().join("out").exists());
+}
+
 #[test]
 fn cspace_extrapolated_obstacle_equals_the_built_one_inside_its_interval() {
     let base = ["cspace", "example:channel", "example:channel", "--pair", "0,1", "--json"];

@@ -69,8 +69,20 @@ pub enum Command {
 }
 
 /// Runs the command line with the process arguments; returns the exit status.
+/// The command line as clap sees it, with negative numbers taken as values in every subcommand (`--theta-deg -30`,
+/// `--fixed-z -1`, `--height -5` reaches its own check), not as unknown flags.
+pub fn command() -> clap::Command {
+    fn with_negatives(c: clap::Command) -> clap::Command {
+        c.allow_negative_numbers(true).mut_subcommands(with_negatives)
+    }
+    with_negatives(<Cli as clap::CommandFactory>::command())
+}
+
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match <Cli as clap::FromArgMatches>::from_arg_matches(&command().get_matches()) {
+        Ok(cli) => cli,
+        Err(e) => e.exit(),
+    };
     init_logging(cli.verbose, cli.quiet);
     if let Some(n) = cli.threads
         && let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build_global()
