@@ -81,6 +81,11 @@ const CASES: &[(&str, Check, &str)] = &[
         "sheet_metal.thickness",
     ),
     (
+        "json_thickness_huge.json",
+        |e| matches!(e, IoError::BadCoordinate { value, .. } if *value == 1e300),
+        "sheet_metal.thickness",
+    ),
+    (
         "json_nonplanar_face.json",
         |e| matches!(e, IoError::SheetMetal { source: SheetMetalError::NonPlanar { face: 2, .. }, .. }),
         "face 2",

@@ -135,6 +135,8 @@ pub(crate) fn part_from_record(
                     value: sheet.thickness,
                 });
             }
+            // (a thickness beyond the coordinate limit would give faces whose areas overflow)
+            check_coordinate(sheet.thickness, file, || key("sheet_metal.thickness"))?;
             if sheet.faces.is_empty() {
                 return Err(IoError::Empty {
                     file: file.to_path_buf(),

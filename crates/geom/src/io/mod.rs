@@ -128,7 +128,7 @@ pub enum IoError {
         message: String,
     },
     /// A NaN or infinite coordinate, or one beyond [`MAX_COORDINATE`].
-    #[error("{}: {at}: coordinate {value} is not finite or exceeds {MAX_COORDINATE:e} mm in magnitude", file.display())]
+    #[error("{}: {at}: coordinate {} is not finite or exceeds {MAX_COORDINATE:e} mm in magnitude", file.display(), short_number(*value))]
     BadCoordinate {
         /// The file.
         file: PathBuf,
@@ -364,6 +364,13 @@ pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, IoError> {
 /// The file stem as a default part name.
 pub(crate) fn stem_name(path: &Path) -> String {
     path.file_stem().and_then(|s| s.to_str()).unwrap_or("part").to_string()
+}
+
+/// `value` as Rust prints it, in exponent form when that is shorter (`1e300` rather than 301 digits).
+fn short_number(value: f64) -> String {
+    let plain = value.to_string();
+    let exponent = format!("{value:e}");
+    if exponent.len() < plain.len() { exponent } else { plain }
 }
 
 /// Checks one coordinate: finite and within [`MAX_COORDINATE`].
