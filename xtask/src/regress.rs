@@ -117,7 +117,8 @@ fn run_dir(dir: &Path, bless: bool, filter: Option<&str>) -> anyhow::Result<bool
             let obj: Map<String, Value> = fields.into_iter().collect();
             let mut text = serde_json::to_string_pretty(&Value::Object(obj))?;
             text.push('\n');
-            std::fs::write(&golden_path, text).with_context(|| format!("cannot write {}", golden_path.display()))?;
+            stackplan_geom::io::write_atomic(&golden_path, text.as_bytes())
+                .with_context(|| format!("cannot write {}", golden_path.display()))?;
             println!("{name:<34} blessed");
             continue;
         }

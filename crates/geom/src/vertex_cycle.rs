@@ -129,12 +129,38 @@ impl<'a> IntoIterator for &'a VertexCycle {
 
 impl IntoIterator for VertexCycle {
     type Item = usize;
-    type IntoIter = smallvec::IntoIter<[usize; VertexCycle::INLINE]>;
+    type IntoIter = IntoIter;
 
     fn into_iter(self) -> Self::IntoIter {
-        self.0.into_iter()
+        IntoIter(self.0.into_iter())
     }
 }
+
+/// The owning iterator of a [`VertexCycle`] (its indices in order; the storage stays private).
+#[derive(Debug, Clone)]
+pub struct IntoIter(smallvec::IntoIter<[usize; VertexCycle::INLINE]>);
+
+impl Iterator for IntoIter {
+    type Item = usize;
+
+    fn next(&mut self) -> Option<usize> {
+        self.0.next()
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        self.0.size_hint()
+    }
+}
+
+impl DoubleEndedIterator for IntoIter {
+    fn next_back(&mut self) -> Option<usize> {
+        self.0.next_back()
+    }
+}
+
+impl ExactSizeIterator for IntoIter {}
+
+impl std::iter::FusedIterator for IntoIter {}
 
 impl PartialEq<[usize]> for VertexCycle {
     fn eq(&self, other: &[usize]) -> bool {

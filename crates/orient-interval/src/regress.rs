@@ -1,5 +1,5 @@
-//! Regression summary of a part pair for `cargo xtask regress` (see REGRESS.md): per convex pair, the
-//! constant-structure intervals over a full turn and the constructions vs extrapolations of a sweep.
+//! Regression summary of a part pair for `cargo xtask regress` (docs/formats.md, "Regression scenarios"): per convex
+//! pair, the constant-structure intervals over a full turn and the constructions vs extrapolations of a sweep.
 //! Deterministic (no timings). Cost: one sweep per component pair.
 
 use crate::critical::PairEvents;

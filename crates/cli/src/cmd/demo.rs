@@ -5,7 +5,7 @@
 
 use crate::Outcome;
 use crate::cmd::part::part_info;
-use crate::output::{json_text, write_atomic};
+use crate::output::{json_text, write_all_atomic};
 use crate::render::{Marker, Scene, Solid, part_color, png, svg};
 use anyhow::Context;
 use stackplan_geom::io::glb::{GlbItem, glb_bytes};
@@ -31,13 +31,15 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let decomposition = crate::input::decomposition(args.triangulate);
     let bar = indicatif::ProgressBar::new(EXAMPLES.len() as u64);
     let mut summary = Vec::new();
+    // every file of the demo, written all or none at the end
+    let mut files: Vec<(std::path::PathBuf, Vec<u8>)> = Vec::new();
     for name in EXAMPLES {
         bar.set_message(name);
         let part = stackplan_geom::examples::part_by_name(name, decomposition)
             .with_context(|| format!("built-in example {name} is missing"))?;
         let info = part_info(&part, true);
-        write_atomic(&args.out.join(format!("{name}.json")), json_text(&info)?.as_bytes())?;
-        write_atomic(&args.out.join(format!("{name}.glb")), &glb_bytes(&[GlbItem::part(&part)]))?;
+        files.push((args.out.join(format!("{name}.json")), json_text(&info)?.into_bytes()));
+        files.push((args.out.join(format!("{name}.glb")), glb_bytes(&[GlbItem::part(&part)])));
         let scene = Scene {
             solids: part
                 .components
@@ -50,8 +52,8 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
             title: format!("{name}: {} convex components, c.g. marked", part.components.len()),
             labels: Vec::new(),
         };
-        write_atomic(&args.out.join(format!("{name}.svg")), svg(&scene).as_bytes())?;
-        write_atomic(&args.out.join(format!("{name}.png")), &png(&scene, 2.0)?)?;
+        files.push((args.out.join(format!("{name}.svg")), svg(&scene).into_bytes()));
+        files.push((args.out.join(format!("{name}.png")), png(&scene, 2.0)?));
         summary.push(serde_json::json!({
             "name": name,
             "components": info.components,
@@ -62,7 +64,9 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         bar.inc(1);
     }
     bar.finish_and_clear();
-    write_atomic(&args.out.join("summary.json"), json_text(&summary)?.as_bytes())?;
+    files.push((args.out.join("summary.json"), json_text(&summary)?.into_bytes()));
+    let files: Vec<(std::path::PathBuf, &[u8])> = files.iter().map(|(p, b)| (p.clone(), b.as_slice())).collect();
+    write_all_atomic(&files)?;
     tracing::info!("wrote {} examples to {}", EXAMPLES.len(), args.out.display());
     Ok(Outcome::Success)
 }
