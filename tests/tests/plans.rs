@@ -323,3 +323,16 @@ fn triangle_plans_nest_with_clearance_and_check_at_the_release_positions() {
     let o = run_in(dir.path(), &["check", "resting.json", "--clearance", "4.999", "--cup-diameter", "10", "--json"]);
     assert_eq!(o.status.code(), Some(1), "{}\n{}", stdout(&o), stderr(&o));
 }
+
+/// The default floor holds three parts side by side with the clearance between them (`1.5 f + c` each side of the
+/// origin): the first part sits at the centre, so the square 80 x 80 mm block gets room beside it and all 15 fit (on
+/// a floor of three bare footprints nothing fitted beside the first block and the plan stopped at a column of 7).
+#[test]
+fn the_default_floor_has_room_beside_a_square_part() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let o = run_in(dir.path(), &["plan", "example:block", "-q"]);
+    assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
+    let plan = read_json(&dir.path().join("out/plan.json"));
+    assert_eq!(plan["plan"]["placed"], 15, "{}", plan["plan"]["stopped"]);
+    assert_eq!(plan["plan"]["options"]["floor"]["polygon"][0], serde_json::json!([-125.0, -125.0]));
+}

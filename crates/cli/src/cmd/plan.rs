@@ -36,7 +36,7 @@ pub struct PlannerArgs {
     /// Number of parts.
     #[arg(long, default_value_t = 15)]
     pub count: usize,
-    /// Floor rectangle X0,Y0,X1,Y1 (mm); default: 3 x 3 part footprints centred on the origin.
+    /// Floor rectangle X0,Y0,X1,Y1 (mm); default: a square of 3 part footprints plus 2 clearances, centred on 0.
     #[arg(long, value_name = "X0,Y0,X1,Y1", allow_hyphen_values = true)]
     pub floor: Option<String>,
     /// Maximum stack height (mm); default: 6 part heights.
@@ -111,9 +111,13 @@ impl PlannerArgs {
         let (lo, hi) = part.aabb();
         let size = hi - lo;
         let footprint = size.x.max(size.y);
+        // three parts side by side with the clearance between them: the first part sits at the centre, so a square
+        // part has room beside it only when the clearance is counted (a bad clearance is reported by the planner)
+        let clearance = if self.clearance.is_finite() { self.clearance.max(0.0) } else { 0.0 };
+        let half = 1.5 * footprint + clearance;
         let [x0, y0, x1, y1] = match &self.floor {
             Some(s) => parse_floor(s)?,
-            None => [-1.5 * footprint, -1.5 * footprint, 1.5 * footprint, 1.5 * footprint],
+            None => [-half, -half, half, half],
         };
         let height = self.height.unwrap_or(6.0 * size.z.max(size.x.min(size.y)));
         let mut options = PlanOptions::new(self.count, FloorVolume::rectangle(x0, y0, x1, y1, height));
