@@ -278,10 +278,10 @@ fn png_distinct_colours(png: &[u8]) -> usize {
     colours.len()
 }
 
-/// Triangle parts with the default 5 mm clearance nest (\[A\] Fig. 19): each is released above the inclined walls of
-/// the one below and drops onto them; `check` then measures the clearance where the robot lets go, against the parts
-/// placed before, and passes, also with the plan's own options taken as its defaults. Without the drops (a plain stack file of the resting positions) the nested parts
-/// touch and the clearance fails, as it must.
+/// /// Triangle parts with the default 5 mm clearance nest (\[A\] Fig. 19): each is released above the inclined walls
+/// of /// the one below and drops onto them; `check` then measures the clearance where the robot lets go, against the
+/// parts /// placed before, and passes, also with the plan's own options taken as its defaults. Without the drops (a
+/// plain stack file of the resting positions) the nested parts /// touch and the clearance fails, as it must.
 #[test]
 fn triangle_plans_nest_with_clearance_and_check_at_the_release_positions() {
     let dir = tempfile::tempdir().expect("tempdir");

@@ -13,8 +13,9 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
 
 /// Writes every `(path, bytes)` or none (`stackplan_geom::io::write_all_atomic`): the outputs of one command are
 /// complete together or not written.
-pub fn write_all_atomic(files: &[(std::path::PathBuf, &[u8])]) -> anyhow::Result<()> {
-    Ok(stackplan_geom::io::write_all_atomic(files.iter().map(|(p, b)| (p.as_path(), *b)))?)
+pub fn write_all_atomic<P: AsRef<Path>, B: AsRef<[u8]>>(files: impl IntoIterator<Item = (P, B)>) -> anyhow::Result<()> {
+    let files: Vec<(P, B)> = files.into_iter().collect();
+    Ok(stackplan_geom::io::write_all_atomic(files.iter().map(|(p, b)| (p.as_ref(), b.as_ref())))?)
 }
 
 /// Pretty JSON text of `value` with a trailing newline.

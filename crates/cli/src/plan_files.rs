@@ -173,7 +173,7 @@ impl PlanPictures {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
         let mut files = vec![(dir.join("plan.json"), plan_text)];
         files.extend(self.files().into_iter().map(|(name, bytes)| (dir.join(name), bytes)));
-        write_all_atomic(&files)
+        write_all_atomic(files)
     }
 }
 

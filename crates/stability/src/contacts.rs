@@ -13,9 +13,10 @@
 //!   contacts pinch a part along one line and hold it by friction (a part resting across the seam of two coplanar
 //!   tops was found "stable" that way, with its centre of gravity outside its supports). The supporting sets
 //!   `S_A = {v in A : n.v >= max_A n.x - tol}` and `S_B = {v in B : n.v <= min_B n.x + tol}` (a vertex, an edge or
-//!   a face of each) are projected onto the contact plane and intersected as planar convex sets ([`crate::polygon2d::intersect_convex`]): coplanar opposite faces give
-//!   the polygon of their overlap, an edge on a face a segment, crossing edges or a vertex on a face a point. The
-//!   patch's points are the vertices of that set, lifted to the mid-plane between the two supporting planes.
+//!   a face of each) are projected onto the contact plane and intersected as planar convex sets
+//!   ([`crate::polygon2d::intersect_convex`]): coplanar opposite faces give the polygon of their overlap, an edge
+//!   on a face a segment, crossing edges or a vertex on a face a point. The patch's points are the vertices of that
+//!   set, lifted to the mid-plane between the two supporting planes.
 //!
 //! The floor is the fixed plane z = 0: a component touches it when its lowest vertex is within `tol` of z = 0 and the
 //! patch is the planar hull of its vertices within `tol` of the floor (normal +z). `tol` is the tolerance policy of
@@ -27,7 +28,6 @@ use crate::polygon2d::{convex_hull_2d, intersect_convex};
 use crate::sat::{Separation, Shape, separation, separation_along};
 use crate::world::{WorldComponent, WorldPart, aabb_overlap};
 use glam::{DVec2, DVec3};
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// A body of the stack: the fixed floor or a part (index in the stack).
@@ -175,21 +175,12 @@ fn kind_of(points: &[DVec3]) -> PatchKind {
 /// Contacts and interferences among `parts` and with the floor, with length tolerance `tol`.
 ///
 /// Only parts for which `include(i)` holds take part (to analyse a prefix of a stack).
-pub fn analyse_contacts(parts: &[WorldPart], tol: f64, include: impl Fn(usize) -> bool + Sync) -> ContactAnalysis {
-    // each part's contacts in parallel, appended in the parts' order (the list of the sequential loop)
-    let per_part: Vec<ContactAnalysis> = (0..parts.len())
-        .into_par_iter()
-        .filter(|&j| include(j))
-        .map(|j| {
-            let mut own = ContactAnalysis::default();
-            contacts_of_part(parts, j, tol, &include, &mut own);
-            own
-        })
-        .collect();
+pub fn analyse_contacts(parts: &[WorldPart], tol: f64, include: impl Fn(usize) -> bool) -> ContactAnalysis {
     let mut out = ContactAnalysis::default();
-    for own in per_part {
-        out.patches.extend(own.patches);
-        out.interferences.extend(own.interferences);
+    for j in 0..parts.len() {
+        if include(j) {
+            contacts_of_part(parts, j, tol, &include, &mut out);
+        }
     }
     tracing::debug!(patches = out.patches.len(), interferences = out.interferences.len(), "contacts analysed");
     out

@@ -6,7 +6,6 @@
 
 use crate::StabilityError;
 use glam::{DMat3, DVec3};
-use rayon::prelude::*;
 use stackplan_geom::{ConvexPolytope, Part, Tolerance};
 
 /// A part in a stack: the part and its pose (`world = rotation * v + position`).
@@ -94,11 +93,10 @@ impl WorldPart {
         if !placed.position.is_finite() {
             return Err(StabilityError::NonFinitePosition { part: index });
         }
-        // (in parallel, collected in order)
         let components: Vec<WorldComponent> = placed
             .part
             .components
-            .par_iter()
+            .iter()
             .map(|c| WorldComponent::new(c.transformed(placed.rotation, placed.position)))
             .collect();
         if components.is_empty() {

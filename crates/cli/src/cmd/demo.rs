@@ -65,8 +65,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     }
     bar.finish_and_clear();
     files.push((args.out.join("summary.json"), json_text(&summary)?.into_bytes()));
-    let files: Vec<(std::path::PathBuf, &[u8])> = files.iter().map(|(p, b)| (p.clone(), b.as_slice())).collect();
-    write_all_atomic(&files)?;
+    write_all_atomic(files)?;
     tracing::info!("wrote {} examples to {}", EXAMPLES.len(), args.out.display());
     Ok(Outcome::Success)
 }

@@ -187,11 +187,9 @@ fn info(args: &InfoArgs) -> anyhow::Result<Outcome> {
 fn export(args: &ExportArgs) -> anyhow::Result<Outcome> {
     let part = load_part(&args.part)?;
     // the format follows the flag, whatever the extension; the files are written all or none
-    let glb = args.glb.as_ref().map(|p| (p.clone(), glb_bytes(&[GlbItem::part(&part)])));
-    let obj = args.obj.as_ref().map(|p| (p.clone(), obj_string(&part).into_bytes()));
-    let stl = args.stl.as_ref().map(|p| (p.clone(), stl_binary_bytes(&part)));
-    let files: Vec<(PathBuf, &[u8])> =
-        [&glb, &obj, &stl].into_iter().flatten().map(|(p, b)| (p.clone(), &b[..])).collect();
-    output::write_all_atomic(&files)?;
+    let glb = args.glb.as_ref().map(|p| (p, glb_bytes(&[GlbItem::part(&part)])));
+    let obj = args.obj.as_ref().map(|p| (p, obj_string(&part).into_bytes()));
+    let stl = args.stl.as_ref().map(|p| (p, stl_binary_bytes(&part)));
+    output::write_all_atomic([glb, obj, stl].into_iter().flatten())?;
     Ok(Outcome::Success)
 }

@@ -68,6 +68,6 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         files.extend(pictures.files().into_iter().map(|(name, bytes)| (dir.join(name), bytes)));
     }
     files.extend(outputs.into_iter().filter_map(|(path, bytes)| path.as_ref().map(|p| (p.clone(), bytes))));
-    write_all_atomic(&files)?;
+    write_all_atomic(files)?;
     Ok(Outcome::Success)
 }

@@ -190,7 +190,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     files.push((args.out.join("sweep.json"), sweep_text.as_bytes()));
     files.push((args.out.join("sweep.svg"), svg.as_bytes()));
     files.push((args.out.join("sweep.png"), &png));
-    write_all_atomic(&files)?;
+    write_all_atomic(files)?;
     let mut text = String::new();
     for r in &sweep.runs {
         text.push_str(&format!(
