@@ -26,7 +26,10 @@
 //!    the stack's footprint a second time). Stage 1's part is taken unless stage 2's is strictly
 //!    cheaper (the seed takes stage 1 whenever it succeeds; with `w = 0` that would stack parts on top of each other
 //!    instead of spreading them on the floor as its own Fig. 2 shows, so here the footprint limit breaks ties and
-//!    near-ties of cost (1) in favour of a compact stack, and never overrides the cost).
+//!    near-ties of cost (1) in favour of a compact stack, and never overrides the cost). So that it never does,
+//!    stage 2 after an accepted stage 1 tests every candidate cheaper than stage 1's part (up to
+//!    [`PlanOptions::max_candidates`]), not only [`PlanOptions::candidates`]: with 8, Complex at `w 0.1` put its
+//!    9th part on top of the stack at cost 134 304 while a floor position at 45 758 passed.
 //!
 //! A part that fits nowhere ends the plan with the reason; the plan keeps the parts placed so far.
 //! Cost: O(n) placements, each the search of [`crate::search`] plus at most `candidates` stack checks.
@@ -67,7 +70,8 @@ pub struct PlanOptions {
     pub cup_diameter: f64,
     /// Require top-down insertion (insertion obstacles in the search, and the check).
     pub insertion: bool,
-    /// Interference-free candidates per part and stage, tested in cost order.
+    /// Interference-free candidates per part and stage, tested in cost order (a stage 2 after an accepted stage 1
+    /// tests every candidate cheaper than stage 1's part, up to `max_candidates`).
     pub candidates: usize,
     /// When every candidate of the last stage fails the checks (and no stage accepted one), the search there
     /// continues with more candidates, up to this many in all: a part fits nowhere only when the search is exhausted
@@ -374,10 +378,15 @@ pub fn plan_stack_with_progress(
             request.insertion = options.insertion;
             request.partitions = options.partitions;
             // a stage tests `candidates` candidates; the last one, when nothing at all was accepted, continues the
-            // same search up to `max_candidates`
-            let limit =
-                if stage == last_stage && accepted.is_empty() { options.max_candidates } else { options.candidates };
+            // same search up to `max_candidates`; a stage after one that accepted a part tests every candidate cheaper
+            // than that part (up to `max_candidates`; the cost limit ends the search): the part goes to the cheapest
+            // position that passes, never behind a budget of failed candidates
             let beaten_at = accepted.iter().map(|a| a.1.0.cost).reduce(f64::min);
+            let limit = if (stage == last_stage && accepted.is_empty()) || beaten_at.is_some() {
+                options.max_candidates
+            } else {
+                options.candidates
+            };
             let started = std::time::Instant::now();
             let mut search = match PlacementSearch::new(&request, &cache, &mut caches) {
                 Ok(search) => search,
@@ -687,6 +696,33 @@ mod tests {
         assert!(repeated.stats.repeated_searches >= 1);
         assert!(repeated.parts[3].rejected_candidates >= options.candidates);
         assert_eq!(&repeated.parts[..3], &once.parts[..3]);
+    }
+
+    /// Channel at w = 0.9 with one candidate per stage: the seventh part's stage 1 accepts a position on the stack
+    /// (cost 42 306.7) while stage 2's cheapest position fails the checks and its second passes at 40 490.1. Stage 2
+    /// tests every candidate cheaper than stage 1's part, so the budget of one candidate does not decide the plan:
+    /// it is the plan with a budget of eight, where stage 2's second candidate is within the budget anyway.
+    #[test]
+    fn stage_two_tests_every_candidate_cheaper_than_stage_one_part() {
+        let part =
+            stackplan_geom::examples::part_by_name("channel", stackplan_geom::sheet_metal::Decomposition::ConvexMerge)
+                .expect("example");
+        let floor = FloorVolume::rectangle(-305.0, -305.0, 305.0, 305.0, 612.0);
+        let mut options = PlanOptions { w: 0.9, dtheta: 15f64.to_radians(), ..PlanOptions::new(8, floor) };
+        options.candidates = 1;
+        let one = plan_stack(&part, &options).expect("plan");
+        options.candidates = 8;
+        let eight = plan_stack(&part, &options).expect("plan");
+        assert_eq!(one.parts.len(), 8, "{:?}", one.stopped);
+        let beyond_budget: Vec<&PlannedPart> =
+            one.parts.iter().filter(|p| p.stage == 2 && p.rejected_candidates >= 1).collect();
+        assert!(!beyond_budget.is_empty(), "a stage 2 part found past the budget of one candidate");
+        assert!(one.stats.repeated_searches >= 1);
+        for (a, b) in one.parts.iter().zip(&eight.parts) {
+            assert_eq!((a.stage, a.position, a.theta_deg), (b.stage, b.position, b.theta_deg));
+        }
+        assert_eq!(one.total_cost, eight.total_cost);
+        assert_rests_without_interference(&part, &one);
     }
 
     /// The Triangle part with the seed's 5 mm horizontal clearance nests (\[A\] Fig. 19): the search's position floats

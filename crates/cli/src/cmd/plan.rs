@@ -54,7 +54,8 @@ pub struct PlannerArgs {
     /// Suction cup diameter (mm).
     #[arg(long, default_value_t = 10.0)]
     pub cup_diameter: f64,
-    /// Interference-free candidates tested per part and stage.
+    /// Interference-free candidates tested per part and stage (stage 2 after an accepted stage 1 tests every one
+    /// cheaper than that part).
     #[arg(long, default_value_t = 8)]
     pub candidates: usize,
     /// Split concave sheet-metal faces by plain triangulation (the seed's component counts).
