@@ -379,8 +379,8 @@ pub fn plan_stack_with_progress(
             request.partitions = options.partitions;
             // a stage tests `candidates` candidates; the last one, when nothing at all was accepted, continues the
             // same search up to `max_candidates`; a stage after one that accepted a part tests every candidate cheaper
-            // than that part (up to `max_candidates`; the cost limit ends the search): the part goes to the cheapest
-            // position that passes, never behind a budget of failed candidates
+            // than that part (up to `max_candidates`; the cost limit ends the search), so no cheaper stage-2
+            // candidate that passes is left behind a budget of failed ones
             let beaten_at = accepted.iter().map(|a| a.1.0.cost).reduce(f64::min);
             let limit = if (stage == last_stage && accepted.is_empty()) || beaten_at.is_some() {
                 options.max_candidates
