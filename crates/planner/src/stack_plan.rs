@@ -161,7 +161,8 @@ pub struct PlanStats {
     pub searches: usize,
     /// Interference-free candidates checked for stability, grasp and insertion.
     pub candidates_checked: usize,
-    /// Searches continued past `candidates` candidates because every candidate failed the checks.
+    /// Searches continued past `candidates` candidates because every candidate failed the checks (the last stage when
+    /// no stage accepted a part, or stage 2 below the cost of stage 1's part).
     #[serde(default)]
     pub repeated_searches: usize,
     /// Candidates rejected as not stable on their supports.
