@@ -748,7 +748,8 @@ impl Problem {
 
     /// The largest load factors for several horizontal load directions, one solver reused through `update_A` (only
     /// the load column changes; the symbolic factorisation and the equilibration of the first direction are kept,
-    /// which changes the answers only at the solver's tolerance). Per direction: the status and the clamped factor.
+    /// which changes the answers only at the solver's tolerance; a reused solve that does not end `Solved` is tried
+    /// once more with a fresh solver). Per direction: the status and the clamped factor.
     fn solve_loads(&self, loads: &[DVec3]) -> Result<Vec<(SolverStatus, f64)>, EquilibriumError> {
         let Some(&first) = loads.first() else { return Ok(Vec::new()) };
         let mut solver = self.solver(Some(first), MARGIN_CAP)?;
@@ -761,6 +762,12 @@ impl Problem {
                 }
             }
             solver.solve();
+            if k > 0 && solver.solution.status != SolverStatus::Solved {
+                // a solver reused through `update_A` can stop short of full accuracy (`AlmostSolved`) at a degenerate
+                // optimum (sliding and tipping at once) where a fresh one solves: one more try, fresh
+                solver = self.solver(Some(d), MARGIN_CAP)?;
+                solver.solve();
+            }
             let x = &solver.solution.x;
             out.push((solver.solution.status, x[x.len() - 1].clamp(0.0, MARGIN_CAP)));
         }
