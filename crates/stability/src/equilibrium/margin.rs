@@ -237,8 +237,8 @@ fn unit_margins(
 }
 
 /// The largest load factors (bounded by [`SOCP_CAP`]) for horizontal loads at `angles`, one solver created for the
-/// first and reused through `update_A` for the others (a reused solve that does not end `Solved` is tried once more
-/// with a fresh solver); `None` where the solve does not end `Solved`.
+/// first and reused through `update_A` for the others (a solve that does not end `Solved` is tried again,
+/// [`Problem::retry_margin`]); `None` where no attempt ends `Solved`.
 fn solve_sequence(problem: &Problem, angles: &[f64]) -> Result<Vec<Option<f64>>, EquilibriumError> {
     let direction = |angle: f64| DVec3::new(angle.cos(), angle.sin(), 0.0);
     let Some(&first) = angles.first() else { return Ok(Vec::new()) };
@@ -252,14 +252,12 @@ fn solve_sequence(problem: &Problem, angles: &[f64]) -> Result<Vec<Option<f64>>,
             }
         }
         solver.solve();
-        if k > 0 && solver.solution.status != SolverStatus::Solved {
-            // as in the reference (`Problem::solve_loads`): a reused solver can stop at `AlmostSolved` where a fresh
-            // one solves
-            solver = problem.solver(Some(direction(angle)), SOCP_CAP)?;
-            solver.solve();
-        }
         let x = &solver.solution.x;
-        out.push((solver.solution.status == SolverStatus::Solved).then(|| x[x.len() - 1].clamp(0.0, SOCP_CAP)));
+        let mut result = (solver.solution.status, x[x.len() - 1]);
+        if result.0 != SolverStatus::Solved {
+            result = problem.retry_margin(direction(angle), SOCP_CAP, k == 0)?;
+        }
+        out.push((result.0 == SolverStatus::Solved).then(|| result.1.clamp(0.0, SOCP_CAP)));
     }
     Ok(out)
 }
