@@ -12,8 +12,9 @@
 //!
 //! with `s_ik = +1` when `i` is the patch's `b`, `-1` when it is `a`. Fixed bodies (the floor, and the supports in the
 //! "new part" problem) carry no equations. Units: `g = 1`, so forces are in the part's mass unit times g (a part of
-//! mass m weighs m). The problem is scaled internally (forces by the total movable mass, moment arms by the stack size)
-//! so that clarabel sees O(1) data.
+//! mass m weighs m). The problem is scaled internally (forces by the total movable mass, moment arms by the stack size,
+//! and each part's six rows by that part's own weight) so that clarabel sees O(1) data and its feasibility tolerance
+//! holds every part's balance to the same accuracy relative to that part's weight.
 //!
 //! * Equilibrium (`alpha = 0`): minimise `1/2 sum ||f_k||^2` (a unique, minimum-norm force distribution). Solved ->
 //!   [`Verdict::Stable`]; `PrimalInfeasible` -> [`Verdict::Unstable`]; any other status -> [`Verdict::Unknown`],
@@ -674,8 +675,11 @@ struct Problem {
     /// Equality rows as triplets (row, column, value) over the force variables; rhs per row.
     rows: Vec<(usize, usize, f64)>,
     rhs: Vec<f64>,
-    /// Per movable part: its first row and its scaled weight (for the load column).
+    /// Per movable part: its first row and its weight in the units of its rows (for the load column; 1 after the
+    /// row scaling of [`Problem::new`]).
     mover_rows: Vec<(usize, f64)>,
+    /// Per movable part: the factor its six rows are multiplied by (`force_scale / mass`, see [`Problem::new`]).
+    row_scales: Vec<f64>,
     mu: f64,
     force_scale: f64,
     /// The length unit of the moment rows (the movers' box diagonal, at least 1).
@@ -693,13 +697,22 @@ impl Problem {
         }
         let length_scale = (hi - lo).length().max(1.0);
         let mut row_of = vec![usize::MAX; parts.len()];
+        let mut row_scale_of = vec![1.0; parts.len()];
         let mut mover_rows = Vec::with_capacity(movers.len());
+        let mut row_scales = Vec::with_capacity(movers.len());
         let mut rhs = Vec::with_capacity(6 * movers.len());
         for (m, &i) in movers.iter().enumerate() {
             row_of[i] = 6 * m;
+            // each part's rows in units of its own weight: the solver's feasibility tolerance (absolute on the rows)
+            // then bounds every part's force and moment residuals relative to that part's weight, not to the
+            // group's; a light part in a heavy group (a 6 mm plank on two boxes) otherwise balances only to
+            // `tol * W / w`, and its margin, a moment over its weight times a small lever arm, drifts by as much
             let w = parts[i].mass / force_scale;
-            mover_rows.push((6 * m, w));
-            rhs.extend_from_slice(&[0.0, 0.0, w, 0.0, 0.0, 0.0]);
+            let scale = if w > 0.0 { 1.0 / w } else { 1.0 };
+            row_scale_of[i] = scale;
+            row_scales.push(scale);
+            mover_rows.push((6 * m, w * scale));
+            rhs.extend_from_slice(&[0.0, 0.0, w * scale, 0.0, 0.0, 0.0]);
         }
         let mut rows = Vec::new();
         for (k, pt) in points.iter().enumerate() {
@@ -710,7 +723,7 @@ impl Problem {
                 }
                 let arm = (pt.p - parts[body].cg) / length_scale;
                 for (c, dir) in pt.frame.iter().enumerate() {
-                    let f = *dir * sign;
+                    let f = *dir * (sign * row_scale_of[body]);
                     let moment = arm.cross(f);
                     for (axis, value) in [f.x, f.y, f.z, moment.x, moment.y, moment.z].into_iter().enumerate() {
                         if value != 0.0 {
@@ -724,7 +737,7 @@ impl Problem {
                 add(a, -1.0);
             }
         }
-        Self { n_points: points.len(), rows, rhs, mover_rows, mu, force_scale, length_scale }
+        Self { n_points: points.len(), rows, rhs, mover_rows, row_scales, mu, force_scale, length_scale }
     }
 
     /// Solves the equilibrium problem (no load), with the solver's iterative refinement when `refine`. Returns the
@@ -733,7 +746,10 @@ impl Problem {
     fn solve_verdict(&self, refine: bool) -> Result<(SolverStatus, Vec<f64>, Vec<f64>), EquilibriumError> {
         let mut solver = self.solver_with(None, MARGIN_CAP, refine)?;
         solver.solve();
-        let dual = solver.solution.z.iter().take(self.rhs.len()).copied().collect();
+        // the duals of the unscaled rows (a mechanism's twists must be in one unit for every part)
+        let dual = (solver.solution.z.iter().take(self.rhs.len()).enumerate())
+            .map(|(r, y)| y * self.row_scales[r / 6])
+            .collect();
         Ok((solver.solution.status, solver.solution.x.clone(), dual))
     }
 

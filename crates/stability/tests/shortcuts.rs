@@ -97,6 +97,29 @@ fn shortcuts_match_the_plain_socps_on_fixture_columns() {
     });
 }
 
+/// A light thin plank overhanging a heavy box, both movable (one group): the plank's c.g. 0.5 mm inside the box's +x edge and
+/// 2 mm above it tips at `0.5 / 2 = 0.25` (friction 1 does not limit it; the box holds far more), so the whole
+/// stack's margin is 0.25, by the closed form and by the plain SOCP within 2e-7. The SOCP needs each part's rows in
+/// units of that part's weight (`Problem::new`): in units of the group's weight (the plank is 1/16 of it) the
+/// solver's tolerance on the plank's moment row, over the 2 mm lever arm, put the plain margin 6.8e-7 off (now
+/// 7e-8). A 4096-case run of `shortcuts_match_the_plain_socps_on_random_box_stacks` found this (seed 10053, 1.4e-6
+/// apart on a 6 mm plank; its case is kept in the regressions file).
+#[test]
+fn a_light_plank_on_a_heavy_box_tips_at_its_closed_form_margin_in_the_plain_socp() {
+    let base = box_part("base", DVec3::new(60.0, 60.0, 40.0));
+    let plank = box_part("plank", DVec3::new(60.0, 40.0, 4.0));
+    let stack = [at(&base, DVec3::ZERO), at(&plank, DVec3::new(29.5, 10.0, 40.0))];
+    let options = CheckOptions { mu: 1.0, ..options() };
+    let plain = check_stack_reference(&stack, &options).expect("check");
+    let fast = check_stack(&stack, &options).expect("check");
+    for (what, check) in [("plain", &plain), ("fast", &fast)] {
+        let margin = check.stack.margin.expect("stable stack has a margin");
+        assert!((margin - 0.25).abs() <= 2e-7, "{what}: margin {margin}, closed form 0.25");
+        let direction = check.stack.weakest_direction.expect("direction");
+        assert!((direction - DVec3::X).length() <= 1e-9, "{what}: weakest direction {direction}");
+    }
+}
+
 /// The planner's 15-part Channel stack (flipped channels straddling a flange of the one below: flat supports at two
 /// heights, where the minimum-norm forces need friction).
 #[test]
