@@ -381,13 +381,11 @@ pub fn plan_stack_with_progress(
             // a stage tests `candidates` candidates; the last one, when nothing at all was accepted, continues the
             // same search up to `max_candidates`; a stage after one that accepted a part tests every candidate cheaper
             // than that part (up to `max_candidates`; the cost limit ends the search), so no cheaper stage-2
-            // candidate that passes is left behind a budget of failed ones
+            // candidate that passes is left behind a budget of failed ones (`beaten_at` is set iff a part was
+            // accepted, so both cases are "last stage, or beaten")
             let beaten_at = accepted.iter().map(|a| a.1.0.cost).reduce(f64::min);
-            let limit = if (stage == last_stage && accepted.is_empty()) || beaten_at.is_some() {
-                options.max_candidates
-            } else {
-                options.candidates
-            };
+            let limit =
+                if stage == last_stage || beaten_at.is_some() { options.max_candidates } else { options.candidates };
             let started = std::time::Instant::now();
             let mut search = match PlacementSearch::new(&request, &cache, &mut caches) {
                 Ok(search) => search,
