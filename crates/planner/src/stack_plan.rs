@@ -289,7 +289,10 @@ pub fn plan_stack_with_progress(
         return Err(PlanError::BadOption("max_candidates must be at least candidates".into()));
     }
     if !(options.cup_diameter > 0.0 && options.cup_diameter.is_finite()) {
-        return Err(PlanError::BadOption(format!("the cup diameter must be positive, got {}", options.cup_diameter)));
+        return Err(PlanError::BadOption(format!(
+            "the cup diameter must be positive and finite, got {}",
+            options.cup_diameter
+        )));
     }
     if !(options.mu >= 0.0 && options.mu.is_finite()) {
         return Err(PlanError::BadOption(format!("mu must be non-negative and finite, got {}", options.mu)));

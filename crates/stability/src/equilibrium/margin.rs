@@ -253,7 +253,7 @@ fn solve_sequence(problem: &Problem, angles: &[f64]) -> Result<Vec<Option<f64>>,
         }
         solver.solve();
         let x = &solver.solution.x;
-        let mut result = (solver.solution.status, x[x.len() - 1]);
+        let mut result = (super::margin_status(&solver), x[x.len() - 1]);
         if result.0 != SolverStatus::Solved {
             result = problem.retry_margin(direction(angle), SOCP_CAP, k == 0)?;
         }
