@@ -767,7 +767,7 @@ impl Problem {
     /// status, the primal solution (forces in the local frames) and the dual variables of the equality rows (after a
     /// `PrimalInfeasible`, the solver's certificate: see `instability::Mechanism::from_dual`).
     fn solve_verdict(&self, refine: bool) -> Result<(SolverStatus, Vec<f64>, Vec<f64>), EquilibriumError> {
-        let mut solver = self.solver_with(None, MARGIN_CAP, refine)?;
+        let mut solver = self.solver_with(None, MARGIN_CAP, refine, true)?;
         solver.solve();
         let dual = solver.solution.z.iter().take(self.rhs.len()).copied().collect();
         Ok((solver.solution.status, solver.solution.x.clone(), dual))
@@ -809,11 +809,14 @@ impl Problem {
     }
 
     /// The margin problem for direction `load` once more, after a solve that did not end `Solved`: on a fresh solver
-    /// (unless that solve was on one already), then on a fresh solver without iterative refinement; the first that
-    /// ends `Solved`, or the last attempt's status. At a degenerate optimum (sliding and tipping at once, so the
-    /// margin equals `mu`) a solver reused through `update_A`, and even a fresh one, can stop at `AlmostSolved`
-    /// after a few iterations where these solve it (found by 4096-case runs of `tests/shortcuts.rs`; their cases
-    /// are kept in its regressions file). Returns the status and the unclamped load factor.
+    /// (unless that solve was on one already), then on a fresh solver without iterative refinement, then on a fresh
+    /// one without clarabel's equilibration; the first that ends `Solved` (see [`margin_status`]), or the last
+    /// attempt's status. At a degenerate optimum (sliding and tipping at once, so the margin equals `mu`) a solver
+    /// reused through `update_A`, and even a fresh one, can stop at `AlmostSolved` after a few iterations where the
+    /// first two solve it; and on some problems the equilibrated one stalls at a gap of 4e-8 with or without
+    /// refinement where the plain one converges (the problem of oxfordcontrol/Clarabel.rs issue 217). All found by
+    /// 4096-case runs of `tests/shortcuts.rs` (seeds 10053 and 2718 among them); their cases are kept in its
+    /// regressions file. Returns the status and the unclamped load factor.
     fn retry_margin(
         &self,
         load: DVec3,
@@ -821,11 +824,11 @@ impl Problem {
         fresh_already: bool,
     ) -> Result<(SolverStatus, f64), EquilibriumError> {
         let mut last = (SolverStatus::Unsolved, 0.0);
-        for refine in [true, false] {
-            if refine && fresh_already {
+        for (refine, equilibrate) in [(true, true), (false, true), (true, false)] {
+            if refine && equilibrate && fresh_already {
                 continue;
             }
-            let mut solver = self.solver_with(Some(load), cap, refine)?;
+            let mut solver = self.solver_with(Some(load), cap, refine, equilibrate)?;
             solver.solve();
             let x = &solver.solution.x;
             last = (margin_status(&solver), x[x.len() - 1]);
@@ -838,11 +841,17 @@ impl Problem {
 
     /// A clarabel solver for the equilibrium problem (`load = None`) or the margin problem for direction `d`.
     fn solver(&self, load: Option<DVec3>, cap: f64) -> Result<DefaultSolver<f64>, EquilibriumError> {
-        self.solver_with(load, cap, true)
+        self.solver_with(load, cap, true, true)
     }
 
-    /// [`Problem::solver`] with the solver's iterative refinement on or off.
-    fn solver_with(&self, load: Option<DVec3>, cap: f64, refine: bool) -> Result<DefaultSolver<f64>, EquilibriumError> {
+    /// [`Problem::solver`] with the solver's iterative refinement and its equilibration (Ruiz scaling) on or off.
+    fn solver_with(
+        &self,
+        load: Option<DVec3>,
+        cap: f64,
+        refine: bool,
+        equilibrate: bool,
+    ) -> Result<DefaultSolver<f64>, EquilibriumError> {
         let nf = 3 * self.n_points;
         let n = nf + usize::from(load.is_some());
         let (a, (b, cones)) = self.constraints(load, cap);
@@ -861,6 +870,7 @@ impl Problem {
         let settings = DefaultSettingsBuilder::default()
             .verbose(false)
             .iterative_refinement_enable(refine)
+            .equilibrate_enable(equilibrate)
             .tol_feas(tolerance)
             .tol_gap_abs(tolerance)
             .tol_gap_rel(tolerance)
