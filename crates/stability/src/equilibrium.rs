@@ -117,15 +117,9 @@ const DEFAULT_TOLERANCE: f64 = 1e-8;
 /// [`DEFAULT_TOLERANCE`]; clarabel reports the residuals of the iterate it returns).
 fn margin_status(solver: &DefaultSolver<f64>) -> SolverStatus {
     let status = solver.solution.status;
-    if status == SolverStatus::Solved || !solved_to_default_tolerances(&solver.info) {
-        return status;
-    }
-    match status {
-        SolverStatus::AlmostSolved | SolverStatus::InsufficientProgress | SolverStatus::MaxIterations => {
-            SolverStatus::Solved
-        }
-        other => other,
-    }
+    let stalled =
+        matches!(status, SolverStatus::AlmostSolved | SolverStatus::InsufficientProgress | SolverStatus::MaxIterations);
+    if stalled && solved_to_default_tolerances(&solver.info) { SolverStatus::Solved } else { status }
 }
 
 /// Whether clarabel's iterate meets its default criteria of `Solved` (see [`margin_status`]).
@@ -513,7 +507,7 @@ fn margins(solved: &[Problem], directions: usize) -> Result<(Option<f64>, Option
         .map(|&(g, first)| {
             let js: Vec<usize> = (first..directions.min(first + DIRECTIONS_PER_SOLVER)).collect();
             let loads: Vec<DVec3> = js.iter().map(|&j| direction(j)).collect();
-            let results = solved[g].solve_loads(&loads)?;
+            let results = solved[g].solve_loads(&loads, MARGIN_CAP)?;
             Ok(results
                 .into_iter()
                 .zip(&js)
@@ -782,28 +776,30 @@ impl Problem {
         Ok((solver.solution.status, solver.solution.x.clone()))
     }
 
-    /// The largest load factors for several horizontal load directions, one solver reused through `update_A` (only
-    /// the load column changes; the symbolic factorisation and the equilibration of the first direction are kept,
-    /// which changes the answers only at the solver's tolerance; a solve that does not end `Solved` is tried again,
-    /// [`Problem::retry_margin`]). Per direction: the status and the clamped factor.
-    fn solve_loads(&self, loads: &[DVec3]) -> Result<Vec<(SolverStatus, f64)>, EquilibriumError> {
+    /// The largest load factors (bounded by `cap`) for several horizontal load directions, one solver created for the
+    /// first and reused through `update_A` for the others (only the load column changes; the symbolic factorisation
+    /// and the equilibration of the first direction are kept, which changes the answers only at the solver's
+    /// tolerance; a solve that does not end `Solved` is tried again, [`Problem::retry_margin`]). Per direction: the
+    /// status ([`margin_status`]) and the factor clamped to `[0, cap]`. Used by the reference margins and, per
+    /// margin unit, by the fast ones (`margin.rs`).
+    fn solve_loads(&self, loads: &[DVec3], cap: f64) -> Result<Vec<(SolverStatus, f64)>, EquilibriumError> {
         let Some(&first) = loads.first() else { return Ok(Vec::new()) };
-        let mut solver = self.solver(Some(first), MARGIN_CAP)?;
+        let mut solver = self.solver(Some(first), cap)?;
         let mut out = Vec::with_capacity(loads.len());
         for (k, &d) in loads.iter().enumerate() {
             if k > 0 {
-                let (a, _) = self.constraints(Some(d), MARGIN_CAP);
+                let (a, _) = self.constraints(Some(d), cap);
                 if solver.update_A(&a).is_err() {
-                    solver = self.solver(Some(d), MARGIN_CAP)?;
+                    solver = self.solver(Some(d), cap)?;
                 }
             }
             solver.solve();
             let x = &solver.solution.x;
             let mut result = (margin_status(&solver), x[x.len() - 1]);
             if result.0 != SolverStatus::Solved {
-                result = self.retry_margin(d, MARGIN_CAP, k == 0)?;
+                result = self.retry_margin(d, cap, k == 0)?;
             }
-            out.push((result.0, result.1.clamp(0.0, MARGIN_CAP)));
+            out.push((result.0, result.1.clamp(0.0, cap)));
         }
         Ok(out)
     }

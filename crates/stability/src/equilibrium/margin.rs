@@ -51,7 +51,7 @@ use super::tree::{edge_point, support_tree};
 use super::{EquilibriumError, FlatSupport, Group, MARGIN_CAP, Point, Problem, Rigid};
 use crate::contacts::plane_basis;
 use crate::polygon2d::convex_hull_2d;
-use clarabel::solver::{IPSolver, SolverStatus};
+use clarabel::solver::SolverStatus;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
@@ -236,30 +236,13 @@ fn unit_margins(
     Ok(out)
 }
 
-/// The largest load factors (bounded by [`SOCP_CAP`]) for horizontal loads at `angles`, one solver created for the
-/// first and reused through `update_A` for the others (a solve that does not end `Solved` is tried again,
-/// [`Problem::retry_margin`]); `None` where no attempt ends `Solved`.
+/// The largest load factors (bounded by [`SOCP_CAP`]) for horizontal loads at `angles`, by
+/// [`Problem::solve_loads`] (one solver reused across the angles, retried where a solve does not end `Solved`);
+/// `None` where no attempt ends `Solved`.
 fn solve_sequence(problem: &Problem, angles: &[f64]) -> Result<Vec<Option<f64>>, EquilibriumError> {
-    let direction = |angle: f64| DVec3::new(angle.cos(), angle.sin(), 0.0);
-    let Some(&first) = angles.first() else { return Ok(Vec::new()) };
-    let mut solver = problem.solver(Some(direction(first)), SOCP_CAP)?;
-    let mut out = Vec::with_capacity(angles.len());
-    for (k, &angle) in angles.iter().enumerate() {
-        if k > 0 {
-            let (a, _) = problem.constraints(Some(direction(angle)), SOCP_CAP);
-            if solver.update_A(&a).is_err() {
-                solver = problem.solver(Some(direction(angle)), SOCP_CAP)?;
-            }
-        }
-        solver.solve();
-        let x = &solver.solution.x;
-        let mut result = (super::margin_status(&solver), x[x.len() - 1]);
-        if result.0 != SolverStatus::Solved {
-            result = problem.retry_margin(direction(angle), SOCP_CAP, k == 0)?;
-        }
-        out.push((result.0 == SolverStatus::Solved).then(|| result.1.clamp(0.0, SOCP_CAP)));
-    }
-    Ok(out)
+    let loads: Vec<DVec3> = angles.iter().map(|&angle| DVec3::new(angle.cos(), angle.sin(), 0.0)).collect();
+    let results = problem.solve_loads(&loads, SOCP_CAP)?;
+    Ok(results.into_iter().map(|(status, alpha)| (status == SolverStatus::Solved).then_some(alpha)).collect())
 }
 
 /// The margin units of a group: one per edge of its support tree, or the group itself when the support graph is not
