@@ -45,7 +45,7 @@ use stackplan_cspace::cache::ObstacleCache;
 use stackplan_geom::{Part, Pose, Tolerance};
 use stackplan_stability::check::{CheckOptions, check_stack};
 use stackplan_stability::grasp::{GraspOptions, grasp_faces, is_graspable};
-use stackplan_stability::growing::{GrowingStack, Rejection};
+use stackplan_stability::growing::{GrowingStack, Rejection, ToleranceScale};
 use stackplan_stability::world::PlacedPart;
 
 /// Options of a stacking plan.
@@ -344,7 +344,11 @@ pub fn plan_stack_with_progress(
     let mut caches = SearchCaches::carrying_frontiers();
     // the stack as the candidate tests see it: its parts in world coordinates, their contacts and the memos of the
     // tests, kept from candidate to candidate and from part to part
-    let mut growing = GrowingStack::new(&check_options).map_err(|e| PlanError::Check(e.to_string()))?;
+    // the candidates' tolerance: the box diagonal rounded up to a power of two, so that candidates widening the box
+    // share the placed parts' contact analysis (ToleranceScale::PowerOfTwo)
+    let mut growing = GrowingStack::new(&check_options)
+        .map_err(|e| PlanError::Check(e.to_string()))?
+        .with_tolerance_scale(ToleranceScale::PowerOfTwo);
     let mut placed: Vec<Pose> = Vec::new();
     let mut planned: Vec<PlannedPart> = Vec::new();
     let mut stats = PlanStats::default();

@@ -38,7 +38,7 @@ pub use equilibrium::{
     Equilibrium, EquilibriumOptions, SolveCache, Verdict, solve_equilibrium, solve_equilibrium_with,
 };
 pub use grasp::{GraspFace, GraspOptions, grasp_faces};
-pub use growing::{Accepted, GrowingStack, Rejection};
+pub use growing::{Accepted, GrowingStack, Rejection, ToleranceScale};
 pub use resting_poses::{RestingPose, resting_poses};
 pub use world::{PlacedPart, WorldPart, world_stack};
 

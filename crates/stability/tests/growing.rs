@@ -14,8 +14,8 @@ use proptest::prelude::*;
 use stackplan_stability::check::{CheckOptions, PartCheck, check_stack};
 use stackplan_stability::check_added_part;
 use stackplan_stability::equilibrium::Verdict;
-use stackplan_stability::growing::{Accepted, GrowingStack, Rejection};
-use stackplan_stability::world::PlacedPart;
+use stackplan_stability::growing::{Accepted, GrowingStack, Rejection, ToleranceScale};
+use stackplan_stability::world::{PlacedPart, stack_tolerance, world_stack};
 
 fn options(mu: f64, cup_diameter: f64) -> CheckOptions {
     let mut o = CheckOptions { mu, margin_directions: 0, prefix_stability: false, ..CheckOptions::default() };
@@ -44,12 +44,24 @@ fn is_unknown(v: &Verdict) -> bool {
 
 /// Grows `stack` part by part, comparing every candidate whose precondition holds; returns how many were compared.
 fn compare_candidates(stack: &[PlacedPart<'_>], options: &CheckOptions, what: &str) -> usize {
-    let mut growing = GrowingStack::new(options).expect("options");
+    compare_candidates_at(stack, options, what, ToleranceScale::Exact)
+}
+
+/// [`compare_candidates`] with the candidates' tolerance chosen by `scale`: the report it is compared with is
+/// `check_added_part`'s at the tolerance the growing stack says it uses ([`GrowingStack::tolerance_for`]).
+fn compare_candidates_at(stack: &[PlacedPart<'_>], options: &CheckOptions, what: &str, scale: ToleranceScale) -> usize {
+    let mut growing = GrowingStack::new(options).expect("options").with_tolerance_scale(scale);
     let mut compared = 0;
     for (i, &candidate) in stack.iter().enumerate() {
         let before_stable = i == 0 || check_stack(&stack[..i], options).expect("check").stack.verdict.is_stable();
         if before_stable {
-            let report = check_added_part(&stack[..=i], options).expect("added");
+            let tol = growing.tolerance_for(&candidate).expect("pose");
+            if scale == ToleranceScale::Exact {
+                let exact = stack_tolerance(&world_stack(&stack[..=i]).expect("world")).linear;
+                assert_eq!(tol.to_bits(), exact.to_bits(), "{what}, part {i}: the exact tolerance");
+            }
+            let at_tol = CheckOptions { contact_tolerance: Some(tol), ..options.clone() };
+            let report = check_added_part(&stack[..=i], &at_tol).expect("added");
             let tested = growing.check_candidate(candidate).expect("candidate");
             // the same candidate again: the memos answer the same
             assert_eq!(growing.check_candidate(candidate).expect("candidate"), tested, "{what}, part {i}: repeated");
@@ -84,6 +96,33 @@ fn candidates_fail_and_pass_like_the_added_part_report_on_fixture_columns() {
         }
     });
     assert!(compared >= 150, "only {compared} candidates compared");
+}
+
+/// The stacking planner's choice: the box diagonal rounded up to a power of two (between 1 and 2 times the exact
+/// tolerance), shared by candidates that widen the box by different amounts; the verdicts are the report's at that
+/// tolerance.
+#[test]
+fn candidates_at_power_of_two_tolerances_fail_and_pass_like_the_report_at_that_tolerance() {
+    let mut compared = 0;
+    for_each_fixture_column(&[(0.0, 0.0), (7.0, -3.0)], |label, _, stack| {
+        compared += compare_candidates_at(stack, &options(0.5, 10.0), label, ToleranceScale::PowerOfTwo);
+    });
+    let plan = planned_channels();
+    compared += compare_candidates_at(&placements(&plan), &options(0.5, 10.0), "channels", ToleranceScale::PowerOfTwo);
+    assert!(compared >= 60, "only {compared} candidates compared");
+    // a column of 1 mm cubes: every diagonal up to the next power of two (the rounding is exact)
+    let cube = box_part("cube", DVec3::splat(1.0));
+    let column: Vec<PlacedPart<'_>> = (0..9).map(|k| at(&cube, DVec3::new(0.0, 0.0, k as f64))).collect();
+    let mut growing =
+        GrowingStack::new(&options(0.5, 0.5)).expect("options").with_tolerance_scale(ToleranceScale::PowerOfTwo);
+    for (k, &candidate) in column.iter().enumerate() {
+        let diagonal = (2.0 + ((k + 1) * (k + 1)) as f64).sqrt();
+        let expected = 1e-9 * 2f64.powf(diagonal.log2().ceil());
+        let tol = growing.tolerance_for(&candidate).expect("pose");
+        assert!((tol - expected).abs() <= 1e-24, "{k}: {tol} vs {expected}");
+        assert!(tol >= 1e-9 * diagonal && tol < 2e-9 * diagonal);
+        growing.push(candidate).expect("push");
+    }
 }
 
 #[test]
