@@ -23,6 +23,7 @@ use stackplan_cspace::interference::{PairContact, gjk_distance, project};
 use stackplan_geom::polytope::ConvexPolytope;
 use stackplan_geom::{Part, Pose};
 use std::collections::BinaryHeap;
+use std::sync::Arc;
 
 /// A component of a stack part, placed in the world.
 #[derive(Debug, Clone)]
@@ -33,6 +34,9 @@ pub struct StackComponent {
     pub piece: usize,
     /// The component in world coordinates.
     pub world: ConvexPolytope,
+    /// The component turned by its part's rotation but not moved (`R v`): the geometry up to translation, which is
+    /// all a pair's orientation events depend on ([`crate::interval_obstacles`] shares them between copies).
+    pub turned: Arc<ConvexPolytope>,
     /// Prepared for the separating-axis test.
     pub placed: PlacedConvex,
 }
@@ -65,10 +69,11 @@ impl StackScene {
     pub fn push_part(&mut self, part: &Part, pose: Pose) {
         for (ci, c) in part.components.iter().enumerate() {
             let world = c.transformed(pose.rotation, pose.position);
+            let turned = Arc::new(c.transformed(pose.rotation, DVec3::ZERO));
             let placed = PlacedConvex::new(c, pose.rotation, pose.position);
             self.top = self.top.max(placed.aabb.1.z);
             self.boxes.push(placed.aabb);
-            self.components.push(StackComponent { part: self.parts, piece: ci, world, placed });
+            self.components.push(StackComponent { part: self.parts, piece: ci, world, turned, placed });
         }
         self.parts += 1;
     }

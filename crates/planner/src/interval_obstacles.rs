@@ -12,7 +12,11 @@
 //! * the first obstacle is constructed through the shared [`ObstacleCache`] (bit for bit what a plain construction
 //!   gives) and remembered;
 //! * at the second construction the pair's events are computed (O(F_B E_A + F_A E_B), about 2-4 constructions, so
-//!   pairs met at a single angle never pay for them) and both obstacles become structures with their intervals;
+//!   pairs met at a single angle never pay for them) and both obstacles become structures with their intervals. The
+//!   events depend on the stack component only up to translation (normals and edge directions), so they are
+//!   computed from the component turned but not moved ([`StackComponent::turned`]) and shared by every stack
+//!   component with the same bits there (the copies of a piece in the same rotation: in the 15-part Complex plan
+//!   1 180 computations became 362, see docs/benchmarks.md);
 //! * from then on an angle inside a stored interval is extrapolated (O(size of the obstacle)), any other is
 //!   constructed and stored with its interval. An angle on an event (an exact alignment: 0 and 90 degrees for boxes)
 //!   has a one-angle interval, so it is always constructed. Hull-route obstacles (no generating features) are
@@ -30,7 +34,9 @@ use stackplan_geom::Part;
 use stackplan_geom::polytope::ConvexPolytope;
 use stackplan_orient_interval::{ObstacleStructure, PairEvents, rotation_z};
 use std::collections::HashMap;
-use std::sync::Arc;
+use std::collections::hash_map::DefaultHasher;
+use std::hash::{Hash, Hasher};
+use std::sync::{Arc, Mutex, PoisonError};
 
 /// How an obstacle was obtained.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -48,8 +54,8 @@ struct PairIntervals {
     moving_rest: ConvexPolytope,
     /// The first construction, kept until the events are computed.
     first: Option<(f64, Arc<Obstacle>)>,
-    /// The pair's event bands (computed at the second construction).
-    events: Option<PairEvents>,
+    /// The pair's event bands (computed at the second construction, shared between copies).
+    events: Option<Arc<PairEvents>>,
     /// Structures with their intervals.
     structures: Vec<ObstacleStructure>,
 }
@@ -58,6 +64,86 @@ struct PairIntervals {
 #[derive(Debug, Default)]
 pub struct IntervalObstacles {
     pairs: HashMap<(usize, usize, usize), PairIntervals>,
+    /// Events by (moving component, resting pose index, hash of the turned stack component's bits), with the turned
+    /// component they were computed from (compared bit for bit on a hit); shared with the other partitions' stores
+    /// ([`Self::share_events`]).
+    events: EventStore,
+}
+
+/// Events of one (moving component, resting pose) against each bit pattern of a turned stack component.
+type SharedEvents = HashMap<(usize, usize, u64), Vec<(Arc<ConvexPolytope>, Arc<PairEvents>)>>;
+
+/// Pair events shared by the stores of a search's partitions: a pure function of the moving component in its resting
+/// pose and the turned stack component, so which partition computes an entry first changes nothing.
+#[derive(Debug, Default, Clone)]
+pub struct EventStore(Arc<Mutex<SharedEvents>>);
+
+impl EventStore {
+    /// Drops every entry.
+    pub fn clear(&self) {
+        self.0.lock().unwrap_or_else(PoisonError::into_inner).clear();
+    }
+}
+
+/// The events of the moving component `moving` in resting pose `rest` (`moving_rest`) against a stack component
+/// turned as `turned`: computed once per bit pattern of `turned`.
+fn shared_events(
+    store: &EventStore,
+    moving: usize,
+    rest: usize,
+    moving_rest: &ConvexPolytope,
+    turned: &Arc<ConvexPolytope>,
+) -> Arc<PairEvents> {
+    let key = (moving, rest, polytope_bits_hash(turned));
+    let find = |map: &SharedEvents| {
+        map.get(&key)?
+            .iter()
+            .find(|(t, _)| Arc::ptr_eq(t, turned) || same_bits(t, turned))
+            .map(|(_, events)| Arc::clone(events))
+    };
+    if let Some(events) = find(&store.0.lock().unwrap_or_else(PoisonError::into_inner)) {
+        return events;
+    }
+    // computed outside the lock; another partition may have stored the same (equal) events meanwhile
+    let events = Arc::new(PairEvents::new(moving_rest, turned));
+    let mut map = store.0.lock().unwrap_or_else(PoisonError::into_inner);
+    if let Some(stored) = find(&map) {
+        return stored;
+    }
+    map.entry(key).or_default().push((Arc::clone(turned), Arc::clone(&events)));
+    events
+}
+
+/// A hash of every bit of a polytope (vertices, face planes and cycles, edges).
+fn polytope_bits_hash(p: &ConvexPolytope) -> u64 {
+    let mut h = DefaultHasher::new();
+    for v in p.vertices() {
+        v.to_array().map(f64::to_bits).hash(&mut h);
+    }
+    for f in p.faces() {
+        f.plane.normal.to_array().map(f64::to_bits).hash(&mut h);
+        f.plane.offset.to_bits().hash(&mut h);
+        f.vertices[..].hash(&mut h);
+    }
+    for e in p.edges() {
+        e.vertices.hash(&mut h);
+        e.faces.hash(&mut h);
+    }
+    h.finish()
+}
+
+/// Whether two polytopes are the same bits (vertices, face planes and cycles, edges).
+fn same_bits(a: &ConvexPolytope, b: &ConvexPolytope) -> bool {
+    let bits = |v: &glam::DVec3| v.to_array().map(f64::to_bits);
+    a.vertices().len() == b.vertices().len()
+        && a.faces().len() == b.faces().len()
+        && a.edges() == b.edges()
+        && a.vertices().iter().zip(b.vertices()).all(|(x, y)| bits(x) == bits(y))
+        && a.faces().iter().zip(b.faces()).all(|(f, g)| {
+            bits(&f.plane.normal) == bits(&g.plane.normal)
+                && f.plane.offset.to_bits() == g.plane.offset.to_bits()
+                && f.vertices[..] == g.vertices[..]
+        })
 }
 
 impl IntervalObstacles {
@@ -66,9 +152,15 @@ impl IntervalObstacles {
         Self::default()
     }
 
-    /// Drops every stored structure.
+    /// Drops every stored structure (and the shared events).
     pub fn clear(&mut self) {
         self.pairs.clear();
+        self.events.clear();
+    }
+
+    /// Shares `events` (the pair events of every partition of a search) instead of this store's own.
+    pub fn share_events(&mut self, events: &EventStore) {
+        self.events = events.clone();
     }
 
     /// The obstacle of `part`'s component `moving` turned by `R_z(theta) rest_rotation` (`rotation`, the search's
@@ -106,7 +198,7 @@ impl IntervalObstacles {
                 entry.first = Some((theta, Arc::clone(&built)));
                 return Ok((built, ObstacleRoute::Constructed));
             };
-            let events = PairEvents::new(&entry.moving_rest, &fixed.world);
+            let events = shared_events(&self.events, moving, rest, &entry.moving_rest, &fixed.turned);
             entry.store(&events, &fixed.world, first.0, &first.1);
             entry.events = Some(events);
         }
@@ -141,5 +233,59 @@ impl PairIntervals {
             Ok(s) => self.structures.push(s),
             Err(e) => tracing::debug!(theta, "obstacle not extrapolable: {e}"),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use stackplan_geom::{Decomposition, examples::part_by_name};
+
+    /// The events of a pair depend on the stack component only up to translation: copies of a piece in one
+    /// rotation share one computation, and the events from the turned piece give the intervals of the events from
+    /// each placed copy (band ends to rounding, the same degenerate angles at every planner angle).
+    #[test]
+    fn translated_copies_share_the_events_of_the_turned_piece() {
+        let part = part_by_name("complex", Decomposition::ConvexMerge).expect("example");
+        let rest = DMat3::from_rotation_x(std::f64::consts::PI);
+        let pose = DMat3::from_rotation_z(std::f64::consts::FRAC_PI_2);
+        let store = EventStore::default();
+        let mut computed = 0;
+        for (moving, fixed) in [(0, 0), (3, 7), (12, 25), (29, 1)] {
+            let moving_rest = part.components[moving].transformed(rest, DVec3::ZERO);
+            let turned = Arc::new(part.components[fixed].transformed(pose, DVec3::ZERO));
+            let mut shared = Vec::new();
+            for offset in [DVec3::ZERO, DVec3::new(317.5, -81.25, 31.0), DVec3::new(-1003.0, 945.0, 364.0)] {
+                // each copy has its own turned polytope (the scene builds one per stack component)
+                let own = Arc::new(part.components[fixed].transformed(pose, DVec3::ZERO));
+                shared.push(shared_events(&store, moving, 0, &moving_rest, &own));
+                let world = part.components[fixed].transformed(pose, offset);
+                let direct = PairEvents::new(&moving_rest, &world);
+                let from_turned = &shared[shared.len() - 1];
+                assert_eq!(direct.bands().len(), from_turned.bands().len(), "pair {moving}-{fixed} at {offset}");
+                for (a, b) in direct.bands().iter().zip(from_turned.bands()) {
+                    assert!((a.lo - b.lo).abs() <= 1e-9 && (a.hi - b.hi).abs() <= 1e-9, "{a:?} vs {b:?}");
+                }
+                for k in 0..72 {
+                    let theta = (k as f64 * 5.0).to_radians();
+                    let (a, b) = (direct.interval_around(theta), from_turned.interval_around(theta));
+                    assert_eq!(a.degenerate, b.degenerate, "pair {moving}-{fixed}, theta {k} x 5 degrees");
+                    assert!((a.start - b.start).abs() <= 1e-9 && (a.end - b.end).abs() <= 1e-9);
+                }
+            }
+            assert!(shared.windows(2).all(|w| Arc::ptr_eq(&w[0], &w[1])), "one computation per turned piece");
+            assert!(Arc::ptr_eq(&shared[0], &shared_events(&store, moving, 0, &moving_rest, &turned)));
+            computed += 1;
+        }
+        let entries: usize = store.0.lock().expect("lock").values().map(Vec::len).sum();
+        assert_eq!(entries, computed);
+        // another rotation of the same piece is another entry
+        let other = Arc::new(part.components[0].transformed(DMat3::IDENTITY, DVec3::ZERO));
+        let moving_rest = part.components[0].transformed(rest, DVec3::ZERO);
+        shared_events(&store, 0, 0, &moving_rest, &other);
+        let entries: usize = store.0.lock().expect("lock").values().map(Vec::len).sum();
+        assert_eq!(entries, computed + 1);
+        store.clear();
+        assert!(store.0.lock().expect("lock").is_empty());
     }
 }

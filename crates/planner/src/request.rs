@@ -308,6 +308,13 @@ pub enum PlacementError {
         /// The solver's message.
         reason: String,
     },
+    /// The obstacle cache passed in holds obstacles of another moving part, or of another stack at the same part
+    /// indices ([`stackplan_cspace::ObstacleCache::claim`]): one cache serves one part placed into one (growing)
+    /// stack.
+    #[error(
+        "the obstacle cache was built for another part or another stack (use one cache per part and growing stack)"
+    )]
+    ForeignCache,
     /// The search popped more nodes than allowed (a safeguard; the search always terminates in exact arithmetic).
     #[error("the search exceeded its node budget of {budget} nodes after finding {found} placement(s)")]
     NodeBudget {

@@ -90,7 +90,7 @@
 
 use crate::dary_heap::DaryHeap;
 use crate::detect::{CandidateQueue, DetectCounts, DetectScratch, StackScene, SweepAxes};
-use crate::interval_obstacles::{IntervalObstacles, ObstacleRoute};
+use crate::interval_obstacles::{EventStore, IntervalObstacles, ObstacleRoute};
 use crate::obstacles::DerivedObstacle;
 use crate::orientation::{Orientation, SeparableQuadratic, rotated_components};
 use crate::qp::{QpOptimum, Quadratic, minimise};
@@ -607,7 +607,8 @@ pub fn place_with_cache(
 /// What successive searches into a growing stack share beyond the [`ObstacleCache`]: the derived obstacles (insertion
 /// and clearance applied) of each (orientation, pair), keyed by orientation index, the constant-topology structures
 /// the obstacles are extrapolated from ([`IntervalObstacles`]) and the detection's scratch lists. They are reused
-/// only while the searches have the same orientations (bit-identical rotations), the same clearance, insertion,
+/// only while the searches place the same part (a fingerprint of its components' vertex bits) with the same
+/// orientations (bit-identical rotations), the same clearance, insertion,
 /// horizontal-clearance and extrapolation settings, and the previous search's stack components are the first
 /// components of the new stack, bit for bit (parts appended, never moved); otherwise they are cleared. The derived
 /// obstacles are pure functions of those inputs; an extrapolated obstacle depends (in its last bits) on which angle its
@@ -622,6 +623,8 @@ pub struct SearchCaches {
     carry: bool,
     /// One per partition.
     lanes: Vec<LaneCaches>,
+    /// The pair events of the constant-topology intervals, shared by the partitions ([`IntervalObstacles`]).
+    events: EventStore,
     /// The states of the last searches, by floor and cost, newest last (at most [`CARRIED_FRONTIERS`]).
     frontiers: Vec<(FrontierSignature, States)>,
     /// The last search's scene and its stack's keys: a search whose stack extends that stack places only its new
@@ -757,6 +760,8 @@ struct CacheSignature {
     horizontal: bool,
     extrapolate: bool,
     partitions: usize,
+    /// [`part_fingerprint`] of the part placed (the derived obstacles and structures are its components').
+    moving: u64,
     stack: Vec<SceneKey>,
 }
 
@@ -803,12 +808,14 @@ impl SearchCaches {
                 && old.horizontal == next.horizontal
                 && old.extrapolate == next.extrapolate
                 && old.partitions == next.partitions
+                && old.moving == next.moving
                 && old.stack.len() <= next.stack.len()
                 && old.stack.iter().zip(&next.stack).all(|(a, b)| a == b)
         });
         if !keep {
             self.lanes.clear();
             self.frontiers.clear();
+            self.events.clear();
         }
         self.lanes.resize_with(next.partitions, LaneCaches::default);
         self.signature = Some(next);
@@ -877,6 +884,20 @@ fn prepare<'r, 'a>(
         .map(|(i, (rest, ti, theta, r))| Orientation::without_components(part, i, rest, ti, theta, r, &request.cost))
         .collect();
     let keys = scene_keys(&request.stack);
+    // the obstacle cache's keys name parts by index: refuse a cache built for another part or another stack
+    let moving = part_fingerprint(part);
+    let fixed: Vec<u64> = keys
+        .iter()
+        .map(|key| {
+            use std::hash::{Hash, Hasher};
+            let mut hasher = std::collections::hash_map::DefaultHasher::new();
+            key.hash(&mut hasher);
+            hasher.finish()
+        })
+        .collect();
+    if !cache.claim(moving, &fixed) {
+        return Err(PlacementError::ForeignCache);
+    }
     let scene = caches.scene(request, &keys);
     // rotated components and sweep axes are built when an orientation is first expanded
     let sweeps: Vec<Option<Arc<SweepAxes>>> = vec![None; orientations.len()];
@@ -898,11 +919,13 @@ fn prepare<'r, 'a>(
         horizontal: request.horizontal_clearance,
         extrapolate: request.extrapolate,
         partitions: request.partitions,
+        moving,
         stack: keys,
     });
     let n_orientations = orientations.len();
     let lanes = request.partitions;
     let mut searches = Vec::with_capacity(lanes);
+    let caches_events = caches.events.clone();
     for (lane, lane_caches) in caches.lanes.iter_mut().enumerate() {
         // the pairs earlier searches built, by orientation (one pass over the shared derived obstacles); caches that
         // carry frontiers keep the obstacle table itself (carried cells name obstacles by id)
@@ -936,7 +959,11 @@ fn prepare<'r, 'a>(
             detect_scratch: std::mem::take(&mut lane_caches.detect_scratch),
             rotated: std::mem::take(&mut lane_caches.rotated),
             derived: std::mem::take(&mut lane_caches.derived),
-            intervals: std::mem::take(&mut lane_caches.intervals),
+            intervals: {
+                let mut intervals = std::mem::take(&mut lane_caches.intervals);
+                intervals.share_events(&caches_events);
+                intervals
+            },
             stats: stats.clone(),
             rounds: 0,
         });

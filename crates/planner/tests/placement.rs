@@ -154,3 +154,41 @@ fn shared_search_caches_change_no_result() {
     let b = place_with_cache(&req, &ObstacleCache::new()).expect("search");
     assert_eq!(a.placements, b.placements);
 }
+
+/// The obstacle cache names parts by index only: reusing one for another moving part, or for another stack at the
+/// same indices, is refused (it would return the other pair's obstacles), while a growing stack and the same
+/// requests again are served; every answer equals a fresh cache's.
+#[test]
+fn an_obstacle_cache_serves_one_part_and_one_growing_stack() {
+    use stackplan_cspace::ObstacleCache;
+    use stackplan_planner::place_with_cache;
+    let base = cuboid_part(DVec3::ZERO, DVec3::new(100.0, 100.0, 50.0));
+    let small = cuboid_part(DVec3::ZERO, DVec3::new(50.0, 50.0, 50.0));
+    let plank = cuboid_part(DVec3::ZERO, DVec3::new(120.0, 30.0, 10.0));
+    let floor = FloorVolume::rectangle(-200.0, -200.0, 300.0, 300.0, 400.0);
+    let on_base = Pose { rotation: DMat3::IDENTITY, position: DVec3::new(0.0, 0.0, 50.0) };
+    let request = |part, stack| {
+        let mut req = PlacementRequest::new(part, stack, floor.clone());
+        req.thetas = uniform_thetas(4);
+        req.k = 2;
+        req
+    };
+    let one = vec![StackPart { part: &base, pose: Pose::IDENTITY }];
+    let two = vec![StackPart { part: &base, pose: Pose::IDENTITY }, StackPart { part: &small, pose: on_base }];
+    let cache = ObstacleCache::new();
+    let fresh = |req: &PlacementRequest<'_>| place(req).expect("placement").placements;
+    for req in [request(&small, one.clone()), request(&small, two.clone()), request(&small, one.clone())] {
+        assert_eq!(place_with_cache(&req, &cache).expect("placement").placements, fresh(&req));
+    }
+    // another moving part with the same cache
+    let err = place_with_cache(&request(&plank, one.clone()), &cache);
+    assert_eq!(err.map(|r| r.placements), Err(PlacementError::ForeignCache));
+    // another stack: part 0 moved
+    let moved = vec![StackPart { part: &base, pose: Pose { rotation: DMat3::IDENTITY, position: DVec3::X } }];
+    let err = place_with_cache(&request(&small, moved.clone()), &cache);
+    assert_eq!(err.map(|r| r.placements), Err(PlacementError::ForeignCache));
+    // once the cache forgets the moved part, it serves the new stack
+    cache.invalidate_part(0);
+    let req = request(&small, moved);
+    assert_eq!(place_with_cache(&req, &cache).expect("placement").placements, fresh(&req));
+}
