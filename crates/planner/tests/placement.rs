@@ -161,7 +161,7 @@ fn shared_search_caches_change_no_result() {
 #[test]
 fn an_obstacle_cache_serves_one_part_and_one_growing_stack() {
     use stackplan_cspace::ObstacleCache;
-    use stackplan_planner::place_with_cache;
+    use stackplan_planner::{SearchCaches, place_with_cache, place_with_caches};
     let base = cuboid_part(DVec3::ZERO, DVec3::new(100.0, 100.0, 50.0));
     let small = cuboid_part(DVec3::ZERO, DVec3::new(50.0, 50.0, 50.0));
     let plank = cuboid_part(DVec3::ZERO, DVec3::new(120.0, 30.0, 10.0));
@@ -191,4 +191,12 @@ fn an_obstacle_cache_serves_one_part_and_one_growing_stack() {
     cache.invalidate_part(0);
     let req = request(&small, moved);
     assert_eq!(place_with_cache(&req, &cache).expect("placement").placements, fresh(&req));
+    // the search caches (derived obstacles, interval structures) are cleared when the part placed changes
+    // (two planks: the same symmetry, so the same orientations and rotations)
+    let other_plank = cuboid_part(DVec3::ZERO, DVec3::new(90.0, 40.0, 10.0));
+    let mut caches = SearchCaches::new();
+    for req in [request(&plank, one.clone()), request(&other_plank, one.clone()), request(&plank, two.clone())] {
+        let got = place_with_caches(&req, &ObstacleCache::new(), &mut caches).expect("placement").placements;
+        assert_eq!(got, fresh(&req));
+    }
 }
