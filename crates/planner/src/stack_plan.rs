@@ -44,6 +44,7 @@ use serde::{Deserialize, Serialize};
 use stackplan_cspace::cache::ObstacleCache;
 use stackplan_geom::{Part, Pose, Tolerance};
 use stackplan_stability::check::{CheckOptions, check_stack};
+use stackplan_stability::equilibrium::Verdict;
 use stackplan_stability::grasp::{GraspOptions, grasp_faces, is_graspable};
 use stackplan_stability::growing::{GrowingStack, Rejection, ToleranceScale};
 use stackplan_stability::world::PlacedPart;
@@ -177,6 +178,10 @@ pub struct PlanStats {
     /// Candidates rejected because they cannot be lowered straight down into place.
     #[serde(default)]
     pub rejected_not_insertable: usize,
+    /// Of the rejections as not stable (on its supports, or the stack with it), those where the equilibrium solver
+    /// ended undecided ([`stackplan_stability::Verdict::Unknown`], read as not stable) instead of proving instability.
+    #[serde(default)]
+    pub undecided_verdicts: usize,
     /// Component pairs whose obstacle was built, over all searches.
     pub pairs_evaluated: u64,
     /// Obstacles constructed (cache misses).
@@ -603,6 +608,13 @@ fn accept(
     let tested = growing
         .check_candidate(PlacedPart { part, rotation: pose.rotation, position: pose.position })
         .map_err(|e| PlanError::Check(e.to_string()))?;
+    if let Err(Rejection::NotStable(Verdict::Unknown(status)) | Rejection::StackNotStable(Verdict::Unknown(status))) =
+        &tested
+    {
+        // never read as stable, but not a proof either: counted apart so the plan says so
+        stats.undecided_verdicts += 1;
+        tracing::warn!(status, position = ?pose.position, "equilibrium undecided for a candidate: rejected as not stable");
+    }
     let (reason, count) = match tested {
         Ok(accepted) => return Ok(Ok(accepted.grasp_radius)),
         Err(Rejection::NotStable(_)) => ("not stable on its supports", &mut stats.rejected_not_stable),
@@ -702,6 +714,9 @@ mod tests {
         assert!(repeated.stats.repeated_searches >= 1);
         assert!(repeated.parts[3].rejected_candidates >= options.candidates);
         assert_eq!(&repeated.parts[..3], &once.parts[..3]);
+        // the rejections are proofs of instability, not solver failures
+        assert!(repeated.stats.rejected_not_stable + repeated.stats.rejected_stack_not_stable >= 1);
+        assert_eq!(repeated.stats.undecided_verdicts, 0);
     }
 
     /// Channel at w = 0.9 with one candidate per stage: the seventh part's stage 1 accepts a position on the stack
