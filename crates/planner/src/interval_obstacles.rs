@@ -60,18 +60,20 @@ struct PairIntervals {
     structures: Vec<ObstacleStructure>,
 }
 
-/// The store; see the module documentation. Keys: (moving component, resting pose index, stack component index).
+/// The store; see the module documentation. Keys: (moving component, resting pose index, stack component index), so
+/// a store serves the searches of one part at fixed resting rotations into one (growing) stack, as the search caches
+/// that own it ensure; the shared pair events are keyed by bits and serve any.
 #[derive(Debug, Default)]
 pub struct IntervalObstacles {
     pairs: HashMap<(usize, usize, usize), PairIntervals>,
-    /// Events by (moving component, resting pose index, hash of the turned stack component's bits), with the turned
-    /// component they were computed from (compared bit for bit on a hit); shared with the other partitions' stores
+    /// Pair events by the bits of both polytopes they were computed from; shared with the other partitions' stores
     /// ([`Self::share_events`]).
     events: EventStore,
 }
 
-/// Events of one (moving component, resting pose) against each bit pattern of a turned stack component.
-type SharedEvents = HashMap<(usize, usize, u64), Vec<(Arc<ConvexPolytope>, Arc<PairEvents>)>>;
+/// Pair events by the hashes of the bits of the moving component in its resting pose and of the turned stack
+/// component, with both polytopes (compared bit for bit on a hit: the events are keyed by everything they depend on).
+type SharedEvents = HashMap<(u64, u64), Vec<(ConvexPolytope, Arc<ConvexPolytope>, Arc<PairEvents>)>>;
 
 /// Pair events shared by the stores of a search's partitions: a pure function of the moving component in its resting
 /// pose and the turned stack component, so which partition computes an entry first changes nothing.
@@ -85,21 +87,15 @@ impl EventStore {
     }
 }
 
-/// The events of the moving component `moving` in resting pose `rest` (`moving_rest`) against a stack component
-/// turned as `turned`: computed once per bit pattern of `turned`.
-fn shared_events(
-    store: &EventStore,
-    moving: usize,
-    rest: usize,
-    moving_rest: &ConvexPolytope,
-    turned: &Arc<ConvexPolytope>,
-) -> Arc<PairEvents> {
-    let key = (moving, rest, polytope_bits_hash(turned));
+/// The events of a moving component in its resting pose (`moving_rest`) against a stack component turned as
+/// `turned`: computed once per pair of bit patterns.
+fn shared_events(store: &EventStore, moving_rest: &ConvexPolytope, turned: &Arc<ConvexPolytope>) -> Arc<PairEvents> {
+    let key = (polytope_bits_hash(moving_rest), polytope_bits_hash(turned));
     let find = |map: &SharedEvents| {
         map.get(&key)?
             .iter()
-            .find(|(t, _)| Arc::ptr_eq(t, turned) || same_bits(t, turned))
-            .map(|(_, events)| Arc::clone(events))
+            .find(|(m, t, _)| (Arc::ptr_eq(t, turned) || same_bits(t, turned)) && same_bits(m, moving_rest))
+            .map(|(_, _, events)| Arc::clone(events))
     };
     if let Some(events) = find(&store.0.lock().unwrap_or_else(PoisonError::into_inner)) {
         return events;
@@ -110,7 +106,7 @@ fn shared_events(
     if let Some(stored) = find(&map) {
         return stored;
     }
-    map.entry(key).or_default().push((Arc::clone(turned), Arc::clone(&events)));
+    map.entry(key).or_default().push((moving_rest.clone(), Arc::clone(turned), Arc::clone(&events)));
     events
 }
 
@@ -198,7 +194,7 @@ impl IntervalObstacles {
                 entry.first = Some((theta, Arc::clone(&built)));
                 return Ok((built, ObstacleRoute::Constructed));
             };
-            let events = shared_events(&self.events, moving, rest, &entry.moving_rest, &fixed.turned);
+            let events = shared_events(&self.events, &entry.moving_rest, &fixed.turned);
             entry.store(&events, &fixed.world, first.0, &first.1);
             entry.events = Some(events);
         }
@@ -258,7 +254,7 @@ mod tests {
             for offset in [DVec3::ZERO, DVec3::new(317.5, -81.25, 31.0), DVec3::new(-1003.0, 945.0, 364.0)] {
                 // each copy has its own turned polytope (the scene builds one per stack component)
                 let own = Arc::new(part.components[fixed].transformed(pose, DVec3::ZERO));
-                shared.push(shared_events(&store, moving, 0, &moving_rest, &own));
+                shared.push(shared_events(&store, &moving_rest, &own));
                 let world = part.components[fixed].transformed(pose, offset);
                 let direct = PairEvents::new(&moving_rest, &world);
                 let from_turned = &shared[shared.len() - 1];
@@ -274,17 +270,18 @@ mod tests {
                 }
             }
             assert!(shared.windows(2).all(|w| Arc::ptr_eq(&w[0], &w[1])), "one computation per turned piece");
-            assert!(Arc::ptr_eq(&shared[0], &shared_events(&store, moving, 0, &moving_rest, &turned)));
+            assert!(Arc::ptr_eq(&shared[0], &shared_events(&store, &moving_rest, &turned)));
             computed += 1;
         }
         let entries: usize = store.0.lock().expect("lock").values().map(Vec::len).sum();
         assert_eq!(entries, computed);
-        // another rotation of the same piece is another entry
+        // another rotation of the same piece is another entry, and so is another moving component against it
         let other = Arc::new(part.components[0].transformed(DMat3::IDENTITY, DVec3::ZERO));
         let moving_rest = part.components[0].transformed(rest, DVec3::ZERO);
-        shared_events(&store, 0, 0, &moving_rest, &other);
+        shared_events(&store, &moving_rest, &other);
+        shared_events(&store, &part.components[5].transformed(rest, DVec3::ZERO), &other);
         let entries: usize = store.0.lock().expect("lock").values().map(Vec::len).sum();
-        assert_eq!(entries, computed + 1);
+        assert_eq!(entries, computed + 2);
         store.clear();
         assert!(store.0.lock().expect("lock").is_empty());
     }
