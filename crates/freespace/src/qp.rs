@@ -20,7 +20,7 @@
 //!   `Solved` are errors). Its point is some minimiser (no tie-break); its `active` list is the tight inequalities.
 
 use crate::active_set::{ActiveSetError, MAX_N, Outcome, Problem};
-use crate::cell::{Cell, default_tie, from_v4, to_v4};
+use crate::cell::{Cell, Halfspace, default_tie, from_v4, to_v4};
 use crate::cost::SeparableQuadratic;
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus};
@@ -195,7 +195,35 @@ fn problem<'c, const D: usize>(
 }
 
 /// Exact minimum of `cost` over `cell`: see the module documentation.
+///
+/// **Cells thinner than the tolerance.** A cell can be non-empty only within its tolerance ([`CellShape::Flat`],
+/// or a [`CellShape::Known`] cell that is: two obstacle faces a few nanometres apart with normals 1e-9 rad from
+/// opposite, as a part fitting exactly between two others gives). Its exact inequalities may then have no common
+/// point, and the working set of two nearly opposite planes gets multipliers near 1e265 that fail the KKT check.
+/// When both paths fail on a cell, the problem is solved once more on the cell with every offset grown by the
+/// tolerance (the cell on which emptiness is decided, [`Cell::is_empty_with`]), where the inequalities do have a
+/// common point; its answer, KKT-verified on that cell, lies within twice the tolerance of every original inequality
+/// (the search treats points within the tolerance of an obstacle face as touching). An error remains an error: the
+/// grown problem's own when it fails too.
+///
+/// [`CellShape::Flat`]: crate::cell::CellShape::Flat
+/// [`CellShape::Known`]: crate::cell::CellShape::Known
 pub fn minimize<const D: usize>(cell: &Cell<D>, cost: &impl SeparableQuadratic<D>) -> Result<QpSolution<D>, QpError> {
+    match minimize_exact(cell, cost) {
+        Err(e @ (QpError::Kkt { .. } | QpError::Solver(_))) => {
+            let tol = cell.tolerance().linear;
+            let grown: Vec<Halfspace<D>> =
+                cell.halfspaces().iter().map(|h| Halfspace { offset: h.offset + tol, ..*h }).collect();
+            let grown = Cell::new(grown, cell.tolerance()).map_err(|_| e.clone())?;
+            tracing::debug!(error = %e, "placement QP failed on a cell; solving it on the tolerance-grown cell");
+            minimize_exact(&grown, cost)
+        }
+        other => other,
+    }
+}
+
+/// [`minimize`] without the retry on the grown cell.
+fn minimize_exact<const D: usize>(cell: &Cell<D>, cost: &impl SeparableQuadratic<D>) -> Result<QpSolution<D>, QpError> {
     let (prob, start, h, g) = problem(cell, cost)?;
     // strictly convex costs: the closed-form range-space iteration; a result that fails the KKT check (or a
     // breakdown of that path) falls back to the general method, whose answer is the definition
@@ -281,9 +309,15 @@ fn solution<const D: usize>(
 /// * primal feasibility: `a_j . p - b_j <= tol` for every `j` (the cell's tolerance);
 /// * complementarity: every `j` in `active` is tight, `|a_j . p - b_j| <= tol`;
 /// * dual feasibility: `lambda_j >= -eps`;
-/// * stationarity: `|grad f(p) + sum_j lambda_j a_j| <= eps`,
+/// * stationarity: `|grad f(p) + sum_j lambda_j a_j| <= 1e-8 * max(G, T)`,
 ///
-/// with `eps = 1e-8 * G`, `G = max_i (h_i L + |g_i|)` the gradient scale over the cell's length scale `L`.
+/// with `eps = 1e-8 * G`, `G = max_i (h_i L + |g_i|)` the gradient scale over the cell's length scale `L`, and
+/// `T = max_i (|h_i p_i| + |g_i| + sum_j |lambda_j a_ji|)` the size of the terms the residual sums (its rounding
+/// scale). `T` exceeds `G` only where the multipliers are huge: at a vertex held by nearly parallel planes (the
+/// c-space obstacles of sheet-metal parts whose faces are a few micrometres out of line have faces 1e-7 rad from
+/// parallel) they are about `|grad f| / sin(angle)`, and the rounding of the 2 x 2 system that gives them leaves a
+/// residual near 1e-10 `T`, far above `1e-8 G` (the test `the_apex_of_a_thin_wedge_passes_the_kkt_check`). A wrong
+/// working set leaves a residual of the order of `G`, which ordinary multipliers (`T` about `G`) still reject.
 pub fn verify_kkt<const D: usize>(
     cell: &Cell<D>,
     cost: &impl SeparableQuadratic<D>,
@@ -315,8 +349,10 @@ fn verify_kkt_dual<const D: usize>(
     let gs = (0..D).map(|i| h[i] * scale + g[i].abs()).fold(f64::MIN_POSITIVE, f64::max);
     let eps = 1e-8 * gs;
     let mut residual = [0.0; D];
+    let mut terms = [0.0; D];
     for i in 0..D {
         residual[i] = h[i] * sol.point[i] + g[i];
+        terms[i] = (h[i] * sol.point[i]).abs() + g[i].abs();
     }
     for (&j, &l) in sol.active.iter().zip(&sol.multipliers) {
         let e = hs[j].excess(&sol.point).abs();
@@ -328,11 +364,14 @@ fn verify_kkt_dual<const D: usize>(
         }
         for i in 0..D {
             residual[i] += l * hs[j].normal[i];
+            terms[i] += (l * hs[j].normal[i]).abs();
         }
     }
     let r = residual.iter().map(|x| x * x).sum::<f64>().sqrt();
-    if r > eps {
-        return Err(QpError::Kkt { what: "stationarity", value: r, allowed: eps });
+    let allowed = 1e-8 * terms.iter().copied().fold(gs, f64::max);
+    // (non-finite multipliers or residual never pass: `allowed` would be infinite too)
+    if !(r <= allowed && allowed.is_finite()) {
+        return Err(QpError::Kkt { what: "stationarity", value: r, allowed });
     }
     Ok(())
 }
@@ -425,6 +464,7 @@ pub(crate) fn clarabel_qp<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cell::CellShape;
     use crate::cell::{Halfspace, Tag};
     use crate::cost::SeparableCost;
     use stackplan_geom::Tolerance;
@@ -491,6 +531,109 @@ mod tests {
         for i in 0..3 {
             assert!((x[i] - exact.point[i]).abs() < 1e-7, "clarabel {x:?} vs exact {:?}", exact.point);
         }
+    }
+
+    /// A wedge-shaped cell (found by `planner/tests/plans_vs_parry.rs`: an L of two boxes whose outer faces are
+    /// 3.5e-6 mm apart, so the pair's c-space obstacle has two faces 2.5e-7 rad from parallel): the optimum is the
+    /// wedge's apex, held by both nearly parallel planes with multipliers near 1e8, whose rounding leaves a
+    /// stationarity residual of about 1e-2 (relative 1e-10 of the terms summed).
+    fn wedge_cell() -> (Cell<3>, SeparableCost<3>) {
+        let wedge: [([f64; 3], f64); 13] = [
+            ([0.0, -1.0, 0.0], 49.10412399076219),
+            ([1.0, -0.0, 0.0], 61.380151866013556),
+            ([0.0, 1.0, 0.0], 26.471365294545485),
+            ([-1.0, -0.0, 0.0], 34.715136346825965),
+            ([0.0, 0.0, -1.0], -12.60650595661997),
+            ([0.0, 0.0, 1.0], 150.0),
+            ([6.123233995736766e-17, -1.0, -3.749399456654644e-33], 33.94913804432505),
+            ([-6.123233995736766e-17, 1.0, 3.749399456654644e-33], 11.316379348108352),
+            ([-1.0, -6.123233995736766e-17, 6.123233995736766e-17], 0.7260130911520407),
+            ([1.0, 6.123233995736766e-17, -6.123233995736766e-17], 25.939008672913427),
+            ([6.123233995736766e-17, 0.0, 1.0], 25.213008790802007),
+            ([-0.9999999999999694, 6.123233995736766e-17, -2.4768480339515496e-7], 0.7260099687129289),
+            ([-0.9999999999999694, 6.123233995736766e-17, -2.4768480339515496e-7], -25.93901179535345),
+        ];
+        let hs = wedge.iter().enumerate().map(|(k, (n, d))| Halfspace::new(*n, *d, Tag::User(k as u64))).collect();
+        let cell = Cell::new(hs, Tolerance::for_scale(37.1778011596673)).expect("cell");
+        let (h, c) = (
+            [1.2173464143156723, 1.2173464143156723, 1.5653071713686555],
+            [13.332507759593794, -11.316379348108352, 6.303253801426855],
+        );
+        let cost =
+            SeparableCost::new(std::array::from_fn(|i| 2.0 * h[i]), std::array::from_fn(|i| -2.0 * h[i] * c[i]), 0.0)
+                .expect("cost");
+        (cell, cost)
+    }
+
+    #[test]
+    fn the_apex_of_a_thin_wedge_passes_the_kkt_check() {
+        let (cell, cost) = wedge_cell();
+        let k = minimize_clarabel(&cell, &cost).expect("clarabel");
+        for s in [minimize(&cell, &cost).expect("exact"), minimize_general(&cell, &cost).expect("general")] {
+            // the apex of the wedge (z = 12.6065094..., 3.5e-6 above the floor, x at the face x <= 25.939...);
+            // clarabel stops on the floor, within the tolerance of the walls (1e-7 rad apart, the tolerance
+            // reaches 0.15 mm along the wedge), at a cost below the apex's by rounding
+            assert!((s.point[0] - 25.939008672913427).abs() < 1e-9 && (s.point[2] - 12.6065094454).abs() < 1e-8);
+            assert!((s.point[2] - k.point[2]).abs() < 1e-5, "exact {:?} vs clarabel {:?}", s.point, k.point);
+            assert!(k.cost <= s.cost + 1e-9 * s.cost.abs() && s.cost - k.cost < 1e-3, "{} vs {}", s.cost, k.cost);
+            verify_kkt(&cell, &cost, &s).expect("the solver's answer passes the check");
+            // held by the two walls alone, with multipliers about |grad f| / 2.5e-7
+            assert_eq!(s.active, vec![9, 12]);
+            assert!(s.multipliers.iter().all(|&l| l > 1e7), "{:?}", s.multipliers);
+        }
+        // a wrong working set still fails: the wall x <= 25.939 alone leaves the gradient in z unbalanced
+        let exact = minimize(&cell, &cost).expect("exact");
+        let floor_only = QpSolution {
+            active: ShortList::from_slice(&[9]),
+            multipliers: ShortList::from_slice(&[30.69]),
+            ..exact.clone()
+        };
+        assert!(matches!(verify_kkt(&cell, &cost, &floor_only), Err(QpError::Kkt { what: "stationarity", .. })));
+        // and so do huge multipliers that do not balance the gradient
+        let unbalanced = QpSolution { multipliers: ShortList::from_slice(&[8.0e7, 8.1e7]), ..exact };
+        assert!(matches!(verify_kkt(&cell, &cost, &unbalanced), Err(QpError::Kkt { what: "stationarity", .. })));
+    }
+
+    /// A cell thinner than the tolerance (found by `planner/tests/plans_vs_parry.rs`, an L whose outer faces are
+    /// 1e-7 mm out of line, `w = 0`): its lower and upper planes, 1e-8 rad from opposite, have no exact common point
+    /// (9e-9 mm apart), the working set gets multipliers near 1e265 and clarabel ends in a numerical error; the
+    /// retry on the tolerance-grown cell solves it.
+    #[test]
+    fn a_cell_thinner_than_the_tolerance_is_solved_on_the_grown_cell() {
+        let flat: [([f64; 3], f64); 11] = [
+            ([1.0, -0.0, 0.0], -33.59283991765285),
+            ([0.0, 1.0, 0.0], 19.159859157251127),
+            ([-1.0, -0.0, 0.0], 34.36539536814442),
+            ([0.0, 0.0, -1.0], -17.814320164694255),
+            ([0.0, 0.0, 1.0], 149.9999998719327),
+            ([1.0, -0.0, 0.0], -33.59283991765285),
+            ([-0.0, -1.0, -0.0], -1.1065727715007512),
+            ([6.123233995736766e-17, 0.0, 1.0], 35.62864042938851),
+            ([-2.8067307673313902e-9, 4.861400292184758e-9, 1.0], 35.628640600797546),
+            ([-1.1226923390950122e-8, 0.0, 1.0], 35.62864089073468),
+            ([0.0, -6.481867241936348e-9, -1.0], -35.628640562661346),
+        ];
+        let hs = flat.iter().enumerate().map(|(k, (n, d))| Halfspace::new(*n, *d, Tag::User(k as u64))).collect();
+        let cell = Cell::new(hs, Tolerance { linear: 3.411399075099622e-8 }).expect("cell");
+        assert!(matches!(cell.shape(), CellShape::Flat { .. }), "{:?}", cell.shape());
+        let (h, c) = ([0.0, 0.0, 4.0], [2.113722224754235, 14.392212099388535, 8.9071600292715]);
+        let cost =
+            SeparableCost::new(std::array::from_fn(|i| 2.0 * h[i]), std::array::from_fn(|i| -2.0 * h[i] * c[i]), 0.0)
+                .expect("cost");
+        // the exact problem alone fails its check
+        assert!(matches!(minimize_exact(&cell, &cost), Err(QpError::Kkt { .. })));
+        let s = minimize(&cell, &cost).expect("solved on the grown cell");
+        let tol = cell.tolerance().linear;
+        for hs in cell.halfspaces() {
+            assert!(hs.excess(&s.point) <= 2.0 * tol, "{:?} violated by {}", hs, hs.excess(&s.point));
+        }
+        // verified on the grown cell: the lowest z there (the cost depends on z alone)
+        let grown: Vec<Halfspace<3>> =
+            cell.halfspaces().iter().map(|h| Halfspace { offset: h.offset + tol, ..*h }).collect();
+        let grown = Cell::new(grown, cell.tolerance()).expect("grown");
+        verify_kkt(&grown, &cost, &s).expect("KKT on the grown cell");
+        let lowest = grown.support(&[0.0, 0.0, -1.0]).expect("LP").expect("bounded").0;
+        assert!((-lowest - s.point[2]).abs() <= 2.0 * tol, "z {} against the lowest {}", s.point[2], -lowest);
     }
 
     #[test]
