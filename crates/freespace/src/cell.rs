@@ -523,6 +523,48 @@ impl<const D: usize> Cell<D> {
         phase_one_rows(rows, grown, start, mask, self.length_scale())
     }
 
+    /// This cell with every offset grown by its tolerance: the cell on which emptiness is decided
+    /// ([`Cell::is_empty_with`]; a cell that is non-empty within the tolerance has an exact common point here). The QP
+    /// retries on it when a cell thinner than the tolerance defeats the solvers ([`crate::qp::minimize`]).
+    pub fn grown_by_tolerance(&self) -> Result<Self, CellError> {
+        let tol = self.tolerance.linear;
+        let grown = self.halfspaces.iter().map(|h| Halfspace { offset: h.offset + tol, ..*h }).collect();
+        Self::new(grown, self.tolerance)
+    }
+
+    /// [`Cell::grown_by_tolerance`] without the near-duplicates: inequality `j` is left out when an earlier kept
+    /// inequality `k` implies it within the tolerance over the box around the cell ([`crate::outer_box::outer_box`]
+    /// grown by the tolerance): `max over the box of (a_j - a_k) . p <= b_j - b_k + tol`, so every point of the
+    /// reduced grown cell satisfies `j` within twice the tolerance. The c-space obstacles of parts whose faces are a
+    /// sliver out of line put a dozen planes through one vertex with normals 1e-16 to 1e-9 apart, a degenerate
+    /// problem on which both QP solvers can fail. Returns the cell and the index in this cell of each of its
+    /// inequalities. `Err` when the box is not finite.
+    pub fn grown_without_near_duplicates(&self) -> Result<(Self, Vec<usize>), CellError> {
+        let tol = self.tolerance.linear;
+        let (lo, hi) = crate::outer_box::outer_box(&self.halfspaces, tol);
+        if lo.iter().chain(&hi).any(|v| !v.is_finite()) {
+            return Err(CellError::Unbounded);
+        }
+        let mut kept: Vec<Halfspace<D>> = Vec::with_capacity(self.halfspaces.len());
+        let mut index = Vec::with_capacity(self.halfspaces.len());
+        for (j, h) in self.halfspaces.iter().enumerate() {
+            let implied = kept.iter().any(|k| {
+                let reach: f64 = (0..D)
+                    .map(|i| {
+                        let d = h.normal[i] - k.normal[i];
+                        if d > 0.0 { d * hi[i] } else { d * lo[i] }
+                    })
+                    .sum();
+                reach <= h.offset - (k.offset - tol) + tol
+            });
+            if !implied {
+                kept.push(Halfspace { offset: h.offset + tol, ..*h });
+                index.push(j);
+            }
+        }
+        Ok((Self::new(kept, self.tolerance)?, index))
+    }
+
     /// The intersection of two cells (inequalities of `self`, then of `other`); tolerance of `self`.
     pub fn intersection(&self, other: &Self) -> Result<Self, CellError> {
         self.with_halfspaces(other.halfspaces.iter().copied())
@@ -610,14 +652,27 @@ impl<const D: usize> Cell<D> {
             tie: default_tie(D),
             length_scale: self.length_scale(),
         };
-        match prob.solve(to_v4(&start)).map_err(|source| CellError::Solver { purpose, source })? {
-            Outcome::Optimal { point, .. } => {
-                let p = from_v4::<D>(&point);
-                let value = (0..D).map(|i| objective[i] * p[i]).sum();
-                Ok(LpResult::Optimal { point: p, value })
+        let point = match prob.solve(to_v4(&start)) {
+            Ok(Outcome::Optimal { point, .. }) => point,
+            Ok(Outcome::Unbounded { .. }) => return Ok(LpResult::Unbounded),
+            // a degenerate LP (a dozen nearly coincident planes through one vertex, the cells of parts whose faces
+            // are a sliver out of line) can cycle to the iteration limit: clarabel's interior point solves it (some
+            // optimal point, without the tie-break; an unbounded or unsolved LP keeps the active set's error)
+            Err(source) => {
+                tracing::debug!(error = %source, purpose, "LP: active set failed; clarabel");
+                let keep = |j: &usize| mask.is_none_or(|m| m[*j]);
+                let rows: Vec<V4> = (0..self.len()).filter(keep).map(|j| self.rows()[j]).collect();
+                let offsets: Vec<f64> = (0..self.len()).filter(keep).map(|j| self.offsets()[j]).collect();
+                let x = crate::qp::clarabel_qp::<D>(&[0.0; D], objective, &rows, &offsets)
+                    .map_err(|_| CellError::Solver { purpose, source })?;
+                let mut point = [0.0; MAX_N];
+                point[..D].copy_from_slice(&x[..D]);
+                point
             }
-            Outcome::Unbounded { .. } => Ok(LpResult::Unbounded),
-        }
+        };
+        let p = from_v4::<D>(&point);
+        let value = (0..D).map(|i| objective[i] * p[i]).sum();
+        Ok(LpResult::Optimal { point: p, value })
     }
 
     fn chebyshev(&self) -> Result<CellShape<D>, CellError> {
@@ -659,10 +714,23 @@ impl<const D: usize> Cell<D> {
         };
         let mut start = [0.0; MAX_N];
         start[D] = r0;
-        let out = prob.solve(start).map_err(|source| CellError::Solver { purpose: "Chebyshev centre", source })?;
-        let (point, bounded) = match out {
-            Outcome::Optimal { point, .. } => (point, true),
-            Outcome::Unbounded { point, .. } => (point, false),
+        let (point, bounded) = match prob.solve(start) {
+            Ok(Outcome::Optimal { point, .. }) => (point, true),
+            Ok(Outcome::Unbounded { point, .. }) => (point, false),
+            // a degenerate LP (many nearly coincident planes through one vertex: the cells of parts whose faces are
+            // a sliver out of line) can cycle to the iteration limit: clarabel's interior point solves it instead
+            Err(source) => {
+                tracing::debug!(error = %source, rows = rows.len(), "Chebyshev LP: active set failed; clarabel");
+                let solved = match D {
+                    2 => crate::qp::clarabel_qp::<3>(&[0.0; 3], &[0.0, 0.0, -1.0], rows, offsets),
+                    3 => crate::qp::clarabel_qp::<4>(&[0.0; 4], &[0.0, 0.0, 0.0, -1.0], rows, offsets),
+                    _ => return Err(CellError::Solver { purpose: "Chebyshev centre", source }),
+                };
+                let x = solved.map_err(|_| CellError::Solver { purpose: "Chebyshev centre", source })?;
+                let mut point = [0.0; MAX_N];
+                point[..=D].copy_from_slice(&x[..=D]);
+                (point, true)
+            }
         };
         let radius = point[D];
         if radius < -tol {

@@ -20,7 +20,7 @@
 //!   `Solved` are errors). Its point is some minimiser (no tie-break); its `active` list is the tight inequalities.
 
 use crate::active_set::{ActiveSetError, MAX_N, Outcome, Problem};
-use crate::cell::{Cell, Halfspace, default_tie, from_v4, to_v4};
+use crate::cell::{Cell, default_tie, from_v4, to_v4};
 use crate::cost::SeparableQuadratic;
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus};
@@ -167,7 +167,10 @@ fn check_cost<const D: usize>(cost: &impl SeparableQuadratic<D>) -> Result<([f64
 }
 
 fn tight_set<const D: usize>(cell: &Cell<D>, p: &[f64; D]) -> Vec<usize> {
-    let tol = cell.tolerance().linear;
+    tight_set_within(cell, p, cell.tolerance().linear)
+}
+
+fn tight_set_within<const D: usize>(cell: &Cell<D>, p: &[f64; D], tol: f64) -> Vec<usize> {
     (0..cell.len()).filter(|&j| cell.halfspaces()[j].excess(p).abs() <= tol).collect()
 }
 
@@ -211,15 +214,225 @@ fn problem<'c, const D: usize>(
 pub fn minimize<const D: usize>(cell: &Cell<D>, cost: &impl SeparableQuadratic<D>) -> Result<QpSolution<D>, QpError> {
     match minimize_exact(cell, cost) {
         Err(e @ (QpError::Kkt { .. } | QpError::Solver(_))) => {
-            let tol = cell.tolerance().linear;
-            let grown: Vec<Halfspace<D>> =
-                cell.halfspaces().iter().map(|h| Halfspace { offset: h.offset + tol, ..*h }).collect();
-            let grown = Cell::new(grown, cell.tolerance()).map_err(|_| e.clone())?;
+            let grown = cell.grown_by_tolerance().map_err(|_| e.clone())?;
             tracing::debug!(error = %e, "placement QP failed on a cell; solving it on the tolerance-grown cell");
-            minimize_exact(&grown, cost)
+            match minimize_exact(&grown, cost) {
+                Ok(sol) => Ok(sol),
+                Err(e2 @ (QpError::Kkt { .. } | QpError::Solver(_))) => {
+                    // the grown cell without its near-duplicate inequalities; indices mapped back to this cell's
+                    let (reduced, index) = cell.grown_without_near_duplicates().map_err(|_| e2.clone())?;
+                    tracing::debug!(error = %e2, kept = reduced.len(), of = cell.len(), "QP on the reduced cell");
+                    let sol = match minimize_exact(&reduced, cost) {
+                        Ok(sol) => sol,
+                        Err(e3) => minimize_enumerated(&reduced, cost).ok_or(e3)?,
+                    };
+                    let map = |list: &[usize]| list.iter().map(|&j| index[j]).collect::<Vec<usize>>();
+                    let tight = tight_set_within(cell, &sol.point, 3.0 * cell.tolerance().linear);
+                    Ok(QpSolution { active: ShortList::from_slice(&map(&sol.active)), tight, ..sol })
+                }
+                Err(e2) => Err(e2),
+            }
         }
         other => other,
     }
+}
+
+/// A candidate of [`minimize_enumerated`]: cost, point, subset and multipliers.
+type Candidate<const D: usize> = (f64, [f64; D], Vec<usize>, Vec<f64>);
+
+/// The most inequalities [`minimize_enumerated`] takes (C(16, <= 3) = 697 systems).
+const ENUMERATE_MAX: usize = 16;
+
+/// The minimum of a strictly convex `cost` (every `h_i > 0`) over a small `cell` by enumeration, the last resort of
+/// [`minimize`] on degenerate cells: for every set `S` of at most `D` inequalities, the minimiser of the cost on
+/// `a_j . p = b_j (j in S)` (the KKT system `[H A^T; A 0]`, Gaussian elimination with partial pivoting); the cheapest
+/// that satisfies every inequality within the tolerance is the optimum (a convex QP's minimiser is the minimiser on
+/// the affine hull of the face it lies in, and that face is cut out by at most `D` of its tight inequalities). Its
+/// multipliers are those of its system when they pass the KKT check, else none (the caller's certificate is then
+/// the gradient alone). Unlike the active-set iteration this never divides by the sine of the angle between two
+/// nearly opposite planes to choose a step: an ill-conditioned system costs accuracy in its own multipliers only.
+/// `None`: a cost that is not strictly convex, more than [`ENUMERATE_MAX`] inequalities, or no feasible candidate.
+/// O(C(m, <= D) D^3).
+fn minimize_enumerated<const D: usize>(cell: &Cell<D>, cost: &impl SeparableQuadratic<D>) -> Option<QpSolution<D>> {
+    let (h, g) = check_cost(cost).ok()?;
+    let m = cell.len();
+    if m > ENUMERATE_MAX || !h.iter().all(|&x| x > 0.0) {
+        return None;
+    }
+    let hs = cell.halfspaces();
+    let tol = cell.tolerance().linear;
+    // (cost, point, subset, multipliers)
+    let mut best: Option<Candidate<D>> = None;
+    let mut subset: Vec<usize> = Vec::with_capacity(D);
+    // every subset of at most D inequalities, in lexicographic order (an odometer over sorted index lists)
+    loop {
+        if let Some((p, lambda)) = equality_qp(hs, &h, &g, &subset) {
+            let feasible = hs.iter().all(|x| x.excess(&p) <= tol);
+            let value = cost.evaluate(&p);
+            if feasible && value.is_finite() && best.as_ref().is_none_or(|b| value < b.0) {
+                best = Some((value, p, subset.clone(), lambda));
+            }
+        }
+        // next subset: extend, else advance the last index, else drop it and advance the one before
+        if subset.len() < D && subset.last().map_or(0, |&j| j + 1) < m {
+            subset.push(subset.last().map_or(0, |&j| j + 1));
+            continue;
+        }
+        loop {
+            match subset.pop() {
+                None => break,
+                Some(j) if j + 1 < m => {
+                    subset.push(j + 1);
+                    break;
+                }
+                Some(_) => {}
+            }
+        }
+        if subset.is_empty() {
+            break;
+        }
+    }
+    let (value, point, active, lambda) = best?;
+    let mut order: Vec<usize> = (0..active.len()).collect();
+    order.sort_by_key(|&k| active[k]);
+    let active: Vec<usize> = order.iter().map(|&k| active[k]).collect();
+    let lambda: Vec<f64> = order.iter().map(|&k| lambda[k]).collect();
+    let mut sol = QpSolution {
+        point,
+        cost: value,
+        active: ShortList::from_slice(&active),
+        multipliers: ShortList::from_slice(&lambda),
+        tight: tight_set(cell, &point),
+        iterations: 0,
+    };
+    if verify_kkt_dual(cell, &h, &g, &sol).is_err() {
+        sol.multipliers = ShortList::default();
+        sol.active = ShortList::default();
+    }
+    Some(sol)
+}
+
+/// The minimiser of `1/2 sum h_i p_i^2 + g . p` on `a_j . p = b_j (j in subset)` and its multipliers, by the
+/// null-space method: the subset's normals orthonormalised by modified Gram-Schmidt (`a_j = sum_{i <= j} r_ji q_i`;
+/// a normal whose residual is below 1e-12 of its length is dependent: `None`, the face is another subset's), the
+/// point `Q^T c` with `R c = b` on the constraints, the basis `Z` of their orthogonal complement completed from the
+/// axes, and the reduced system `Z^T H Z y = -Z^T (H p0 + g)`; the multipliers from `R^T lambda = -Q (H p + g)`.
+/// Nearly opposite normals (1e-9 rad) are independent here and give an accurate point: only the multipliers, which
+/// divide by the small residual, lose accuracy. `None` also when a result is not finite.
+fn equality_qp<const D: usize>(
+    hs: &[crate::cell::Halfspace<D>],
+    h: &[f64; D],
+    g: &[f64; D],
+    subset: &[usize],
+) -> Option<([f64; D], Vec<f64>)> {
+    let k = subset.len();
+    let dot = |a: &[f64; D], b: &[f64; D]| (0..D).map(|i| a[i] * b[i]).sum::<f64>();
+    // orthonormal rows q and the lower-triangular r with a_j = sum_i r[j][i] q_i
+    let mut q = [[0.0f64; D]; D];
+    let mut r = [[0.0f64; D]; D];
+    for (j, &row) in subset.iter().enumerate() {
+        let mut v = hs[row].normal;
+        let length = dot(&v, &v).sqrt();
+        for i in 0..j {
+            let c = dot(&v, &q[i]);
+            r[j][i] = c;
+            for t in 0..D {
+                v[t] -= c * q[i][t];
+            }
+        }
+        let rest = dot(&v, &v).sqrt();
+        if rest.is_nan() || rest <= 1e-12 * length {
+            return None;
+        }
+        r[j][j] = rest;
+        q[j] = v.map(|x| x / rest);
+    }
+    // c from R c = b (forward substitution), p0 = Q^T c
+    let mut c = [0.0f64; D];
+    for j in 0..k {
+        let tail: f64 = (0..j).map(|i| r[j][i] * c[i]).sum();
+        c[j] = (hs[subset[j]].offset - tail) / r[j][j];
+    }
+    let mut p = [0.0f64; D];
+    for j in 0..k {
+        for t in 0..D {
+            p[t] += c[j] * q[j][t];
+        }
+    }
+    // Z: the axes orthogonalised against Q (and each other), the D - k longest residuals
+    let mut basis: Vec<[f64; D]> = q[..k].to_vec();
+    let mut z: Vec<[f64; D]> = Vec::new();
+    for axis in 0..D {
+        if basis.len() == D {
+            break;
+        }
+        let mut v = [0.0f64; D];
+        v[axis] = 1.0;
+        for b in &basis {
+            let c = dot(&v, b);
+            for t in 0..D {
+                v[t] -= c * b[t];
+            }
+        }
+        let n = dot(&v, &v).sqrt();
+        if n > 1e-6 {
+            let v = v.map(|x| x / n);
+            basis.push(v);
+            z.push(v);
+        }
+    }
+    if k + z.len() != D {
+        return None;
+    }
+    // the reduced system over y: (Z^T H Z) y = -Z^T (H p0 + g)
+    let nz = z.len();
+    let mut m = [[0.0f64; MAX_N + 1]; MAX_N];
+    for a in 0..nz {
+        for b in 0..nz {
+            m[a][b] = (0..D).map(|t| z[a][t] * h[t] * z[b][t]).sum();
+        }
+        m[a][nz] = -(0..D).map(|t| z[a][t] * (h[t] * p[t] + g[t])).sum::<f64>();
+    }
+    let y = solve_dense(&mut m, nz)?;
+    for a in 0..nz {
+        for t in 0..D {
+            p[t] += y[a] * z[a][t];
+        }
+    }
+    // multipliers: R^T lambda = -Q grad (back substitution, R^T upper-triangular)
+    let grad: [f64; D] = std::array::from_fn(|t| h[t] * p[t] + g[t]);
+    let mut lambda = vec![0.0f64; k];
+    for j in (0..k).rev() {
+        let tail: f64 = (j + 1..k).map(|i| r[i][j] * lambda[i]).sum();
+        lambda[j] = (-dot(&q[j], &grad) - tail) / r[j][j];
+    }
+    (p.iter().all(|v| v.is_finite()) && lambda.iter().all(|v| v.is_finite())).then_some((p, lambda))
+}
+
+/// Solves the `n x n` system `m[..n][..n] x = m[..n][n]` (Gaussian elimination with partial pivoting); `None` when a
+/// pivot is not above 1e-14 of the largest entry.
+fn solve_dense(m: &mut [[f64; MAX_N + 1]; MAX_N], n: usize) -> Option<[f64; MAX_N]> {
+    let scale = (0..n).flat_map(|a| (0..n).map(move |b| (a, b))).map(|(a, b)| m[a][b].abs()).fold(0.0, f64::max);
+    for col in 0..n {
+        let pivot = (col..n).max_by(|&a, &b| m[a][col].abs().total_cmp(&m[b][col].abs()))?;
+        let size = m[pivot][col].abs();
+        if size.is_nan() || size <= 1e-14 * scale {
+            return None;
+        }
+        m.swap(col, pivot);
+        for row in col + 1..n {
+            let f = m[row][col] / m[col][col];
+            for c in col..=n {
+                m[row][c] -= f * m[col][c];
+            }
+        }
+    }
+    let mut x = [0.0; MAX_N];
+    for row in (0..n).rev() {
+        let tail: f64 = (row + 1..n).map(|c| m[row][c] * x[c]).sum();
+        x[row] = (m[row][n] - tail) / m[row][row];
+    }
+    Some(x)
 }
 
 /// [`minimize`] without the retry on the grown cell.
@@ -634,6 +847,83 @@ mod tests {
         verify_kkt(&grown, &cost, &s).expect("KKT on the grown cell");
         let lowest = grown.support(&[0.0, 0.0, -1.0]).expect("LP").expect("bounded").0;
         assert!((-lowest - s.point[2]).abs() <= 2.0 * tol, "z {} against the lowest {}", s.point[2], -lowest);
+    }
+
+    /// A cell of 36 inequalities (found by `planner/tests/plans_vs_parry.rs`, nearly flush L-shapes, seed 7): a dozen
+    /// planes through one vertex with normals 1e-16 to 1e-9 apart, and a slab in y 7e-8 mm thick whose two sides are
+    /// 5e-9 rad from opposite, so that the cost's optimum is the slab's apex 13.6 mm below the top. The active-set
+    /// method fails on the cell, on the grown cell and on the grown cell without near-duplicates (infinite
+    /// multipliers), clarabel ends `AlmostSolved`; the enumeration of the reduced cell's faces finds the apex.
+    #[test]
+    fn a_degenerate_vertex_of_near_duplicate_planes_is_solved_by_enumeration() {
+        let planes: Vec<([f64; 3], f64)> = vec![
+            ([0.0, -1.0, 0.0], 40.0),
+            ([1.0, -0.0, 0.0], 32.09504830609204),
+            ([0.0, 1.0, 0.0], 26.76907301780147),
+            ([-1.0, -0.0, 0.0], 50.0),
+            ([0.0, 0.0, -1.0], -3.156767494607399e-7),
+            ([0.0, 0.0, 1.0], 123.97440751504803),
+            ([1.9842073519859255e-16, 1.0, -3.2714562742152126e-18], 7.211700682241288),
+            ([1.0, 0.0, 1.7991069155934705e-23], -4.874683606837523),
+            ([1.0, -1.1398412570493276e-16, 1.7991069206553913e-23], -4.874683606837524),
+            ([1.0, -2.664299418895067e-16, 4.2052869148118717e-23], -4.874683606837522),
+            ([-1.9842073533816014e-16, -1.0, 0.0], 22.183402829152506),
+            ([-1.9842073505902486e-16, -0.9999999999999999, 1.5085360748639663e-8], 22.18340280289229),
+            ([0.0, -1.0, 4.314610695227751e-17], 22.183402829152506),
+            ([1.813426340845264e-7, 1.813426317201695e-7, 0.9999999999999671], 26.025591140774367),
+            ([1.813426344474069e-7, -2.7175933290703456e-23, 0.9999999999999836], 26.025591916640323),
+            ([1.0, -1.8163162403408531e-16, 7.316919560315212e-10], -4.874683587794807),
+            ([1.0, 0.0, 7.316919604908517e-10], -4.874683587794808),
+            ([-3.5462053374404384e-16, 0.0, 1.0], 26.025593116305476),
+            ([3.288515003507369e-14, -0.9999999999999836, 1.8134263015603024e-7], 22.18340723302469),
+            ([1.8134263079991472e-7, -2.717593329070343e-23, 0.9999999999999836], 26.025591916640344),
+            ([-0.7071067807183419, -0.7071067816547416, 1.282286055605642e-7], 33.02458620080326),
+            ([-1.984207351985925e-16, -1.0, 0.0], 22.183402829152506),
+            ([0.0, -0.9999999999999836, 1.8134263079991477e-7], 22.183407233024916),
+            ([-1.9842067041846145e-16, -0.9999999999999836, 1.8134263079991477e-7], 22.183407233024916),
+            ([-0.9999999999999836, 4.87939979082215e-16, 1.813426317444236e-7], 24.520415185006932),
+            ([-0.7071067813298919, -0.7071067810431917, 1.2822860333858611e-7], 33.024586202232435),
+            ([-0.9999999999999837, 0.0, 1.8134263160791512e-7], 24.520415185006936),
+            ([-1.0, -3.331825836640595e-22, 0.0], 24.520415185007224),
+            ([5.526005053419141e-16, 1.8134263172017258e-7, 0.9999999999999836], 26.02559234043951),
+            ([-0.9999999999999836, 3.293138405461407e-14, 1.813426317444236e-7], 24.520415185006794),
+            ([-1.0, 7.104798450386838e-16, -1.1214098407946668e-22], 24.52041518500722),
+            ([-1.0, 8.468129764666714e-16, -1.1214098376395024e-22], 24.520415185007224),
+            ([-0.9999999999999837, 3.345541937886465e-14, 1.813426316079151e-7], 24.520415185006794),
+            ([0.0, 1.0, 0.0], 7.211700682241292),
+            ([1.9842073519859255e-16, 1.0, 0.0], 7.211700682241288),
+            ([-1.9842073519859255e-16, -1.0, -5.028453565195011e-9], -7.211700813109764),
+        ];
+        let hs = planes.iter().enumerate().map(|(k, (n, d))| Halfspace::new(*n, *d, Tag::User(k as u64))).collect();
+        let cell = Cell::new(hs, Tolerance { linear: 3.4248739828041275e-8 }).expect("cell");
+        let (h, c) = (
+            [1.148418868072217, 1.148418868072217, 1.7031622638555661],
+            [-8.952475846953979, -6.615463491099263, -9.293874636785603],
+        );
+        let cost =
+            SeparableCost::new(std::array::from_fn(|i| 2.0 * h[i]), std::array::from_fn(|i| -2.0 * h[i] * c[i]), 0.0)
+                .expect("cost");
+        assert!(minimize_exact(&cell, &cost).is_err());
+        let (reduced, index) = cell.grown_without_near_duplicates().expect("reduced");
+        assert_eq!(reduced.len(), 11);
+        assert!(minimize_exact(&reduced, &cost).is_err());
+        let enumerated = minimize_enumerated(&reduced, &cost).expect("enumerated");
+        verify_kkt(&reduced, &cost, &enumerated).expect("KKT on the reduced cell, multipliers near 1.5e10");
+        let s = minimize(&cell, &cost).expect("solved");
+        assert_eq!(s.point, enumerated.point);
+        assert_eq!(
+            s.active.iter().copied().collect::<Vec<_>>(),
+            enumerated.active.iter().map(|&j| index[j]).collect::<Vec<_>>()
+        );
+        let tol = cell.tolerance().linear;
+        for hs in cell.halfspaces() {
+            assert!(hs.excess(&s.point) <= 3.0 * tol, "{hs:?} violated by {}", hs.excess(&s.point));
+        }
+        // the apex: the upper y side and the tilted lower one meet at z = 12.4036..., x at the cost's centre
+        assert!((s.point[2] - 12.40361385829693).abs() < 1e-6 && (s.point[0] - c[0]).abs() < 1e-9, "{:?}", s.point);
+        // cheaper than the points the solvers stopped at before (on the cell's top, z = 26.03)
+        let top = [c[0], 7.211700647994338, 26.025579816179977];
+        assert!(s.cost < cost.evaluate(&top));
     }
 
     #[test]

@@ -136,7 +136,17 @@ pub fn minimise<const D: usize>(cell: &Cell<D>, q: &Quadratic<D>) -> Result<Opti
         Err(QpError::EmptyCell) => return Ok(None),
         Err(e) => {
             tracing::warn!(error = %e, "exact placement QP failed; using clarabel");
-            minimize_clarabel(cell, &cost).map_err(|e2| format!("{e}; clarabel: {e2}"))?
+            match minimize_clarabel(cell, &cost) {
+                Ok(s) => s,
+                // a cell thinner than the tolerance with nearly opposite planes: clarabel on the tolerance-grown
+                // cell, where the inequalities have a common point (its answer lies within twice the tolerance of
+                // the cell's inequalities)
+                Err(e2) => cell
+                    .grown_by_tolerance()
+                    .map_err(|e3| e3.to_string())
+                    .and_then(|grown| minimize_clarabel(&grown, &cost).map_err(|e3| e3.to_string()))
+                    .map_err(|e3| format!("{e}; clarabel: {e2}; clarabel on the grown cell: {e3}"))?,
+            }
         }
     };
     // the certificate: r = grad f(p*) + sum_j lambda_j a_j over the positive multipliers of the working set (the
