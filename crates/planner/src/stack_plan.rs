@@ -17,7 +17,10 @@
 //!    the new part's report of [`stackplan_stability::check::check_stack`], without re-checking the parts that
 //!    passed before, up to the first that fails, with the placed parts' contacts and the memos kept from candidate
 //!    to candidate): the new part statically stable on its supports (friction cones), the whole stack stable, a
-//!    suction face for the cup, insertable from above; the first that passes is taken;
+//!    suction face for the cup, insertable from above, and (with a clearance) the horizontal clearance at the release
+//!    position as `stackplan check` measures it ([`GrowingStack::keeps_clearance`]: the search guarantees it up to its
+//!    tolerance along obstacle face normals, a few 1e-5 mm horizontally next to faces tilted by about 1e-5 rad); the
+//!    first that passes is taken;
 //! 4. the seed's two stages: stage 1 searches within the stack's current floor footprint (its bounding rectangle
 //!    grown by `nest_allowance`, clipped to the floor), so the stack's bounding box is not enlarged, or only
 //!    slightly to nest; stage 2 searches the whole floor, and when stage 1 accepted a part it searches only outside
@@ -178,6 +181,11 @@ pub struct PlanStats {
     /// Candidates rejected because they cannot be lowered straight down into place.
     #[serde(default)]
     pub rejected_not_insertable: usize,
+    /// Candidates that passed every other test but not the horizontal clearance at their release position as
+    /// `stackplan check` measures it (the search guarantees it up to its tolerance, which near faces tilted by about
+    /// 1e-5 rad is a few 1e-5 mm horizontally; see the planner README).
+    #[serde(default)]
+    pub rejected_clearance: usize,
     /// Of the rejections as not stable (on its supports, or the stack with it), those where the equilibrium solver
     /// ended undecided ([`stackplan_stability::Verdict::Unknown`], read as not stable) instead of proving instability.
     #[serde(default)]
@@ -435,7 +443,24 @@ pub fn plan_stack_with_progress(
                 let started = std::time::Instant::now();
                 stats.candidates_checked += 1;
                 let candidate = settled(part, &rests, candidate, search.scene(), &cache, tol, &request.cost)?;
-                let verdict = accept(&mut growing, part, &candidate.0, &mut stats)?;
+                let mut verdict = accept(&mut growing, part, &candidate.0, &mut stats)?;
+                // the clearance at the release position as the plan's check measures it
+                if verdict.is_ok() && options.clearance > 0.0 {
+                    let pose = candidate.0.pose();
+                    let keeps = growing
+                        .keeps_clearance(
+                            PlacedPart { part, rotation: pose.rotation, position: pose.position },
+                            candidate.1,
+                            options.clearance,
+                        )
+                        .map_err(|e| PlanError::Check(e.to_string()))?;
+                    if !keeps {
+                        stats.rejected_clearance += 1;
+                        verdict = Err("the best interference-free positions were rejected (last: closer to a placed \
+                                       part than the clearance)"
+                            .into());
+                    }
+                }
                 stats.seconds_checks += started.elapsed().as_secs_f64();
                 tracing::trace!(
                     index,

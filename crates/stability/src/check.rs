@@ -446,7 +446,7 @@ pub(crate) fn patch_within(p: &ContactPatch, i: usize) -> bool {
 
 /// Smallest horizontal distance from `part` to the `others`' components sharing its height range, and whether it
 /// meets `delta`.
-fn clearance_of<'p>(
+pub(crate) fn clearance_of<'p>(
     part: &WorldPart,
     others: impl Iterator<Item = &'p WorldPart>,
     delta: f64,

@@ -217,6 +217,36 @@ impl<'a> GrowingStack<'a> {
         (lo.min(part.aabb.0), hi.max(part.aabb.1))
     }
 
+    /// Whether `candidate` (at rest), released `release_drop` above its position, keeps the horizontal clearance
+    /// `delta` from the placed parts: `check_stack`'s `clearance_met` for the last part of a plan with release drops
+    /// (the same function, the part at its release position against the parts placed before it). The tolerance is
+    /// the policy's for the box of the placed parts and the candidate at rest, not rounded (at most the finished
+    /// stack's, whose check therefore passes too); [`CheckOptions::contact_tolerance`] when set. The placement search
+    /// guarantees the clearance up to its length tolerance measured along obstacle face normals, which is longer
+    /// horizontally for nearly horizontal faces; this test makes the plan's own check hold. Errors: a bad pose.
+    /// O(component pairs whose boxes come within `delta`), an SOCP per pair closer than `delta` in projection.
+    pub fn keeps_clearance(
+        &self,
+        candidate: PlacedPart<'_>,
+        release_drop: f64,
+        delta: f64,
+    ) -> Result<bool, StabilityError> {
+        if delta <= 0.0 {
+            return Ok(true);
+        }
+        let at_rest = WorldPart::new(&candidate, self.world.len())?;
+        let tol = match self.options.contact_tolerance {
+            Some(t) => t,
+            None => {
+                let (lo, hi) = self.bounds_with(&at_rest);
+                Tolerance::for_scale((hi - lo).length()).linear
+            }
+        };
+        let released = PlacedPart { position: candidate.position + DVec3::Z * release_drop, ..candidate };
+        let released = WorldPart::new(&released, self.world.len())?;
+        Ok(crate::check::clearance_of(&released, self.world.iter(), delta, tol).1)
+    }
+
     /// Tests `candidate` as the next part (see the module documentation): `Ok(Ok(_))` when it passes, `Ok(Err(why))`
     /// at the first test it fails. The placed stack must have passed (the precondition of
     /// [`crate::check_added_part`]). Errors: a bad pose, or an equilibrium problem that cannot be set up.
