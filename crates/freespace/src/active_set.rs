@@ -198,7 +198,7 @@ impl Basis {
 /// Cholesky factorisation of a symmetric positive (semi)definite matrix of order `k <= 4`, in place (lower).
 /// Pivots that rounding made non-positive are floored at a tiny positive value (the step then becomes long and the
 /// ratio test cuts it).
-fn cholesky(a: &mut [[f64; MAX_N]; MAX_N], k: usize) {
+pub(crate) fn cholesky(a: &mut [[f64; MAX_N]; MAX_N], k: usize) {
     for j in 0..k {
         let mut d = a[j][j];
         for l in 0..j {
@@ -217,7 +217,7 @@ fn cholesky(a: &mut [[f64; MAX_N]; MAX_N], k: usize) {
 }
 
 /// Solves `L L^T x = b` for the factor of [`cholesky`].
-fn cholesky_solve(l: &[[f64; MAX_N]; MAX_N], k: usize, b: &V4) -> V4 {
+pub(crate) fn cholesky_solve(l: &[[f64; MAX_N]; MAX_N], k: usize, b: &V4) -> V4 {
     let mut y = [0.0; MAX_N];
     for i in 0..k {
         let mut s = b[i];

@@ -524,8 +524,9 @@ impl<const D: usize> Cell<D> {
     }
 
     /// This cell with every offset grown by its tolerance: the cell on which emptiness is decided
-    /// ([`Cell::is_empty_with`]; a cell that is non-empty within the tolerance has an exact common point here). The QP
-    /// retries on it when a cell thinner than the tolerance defeats the solvers ([`crate::qp::minimize`]).
+    /// ([`Cell::is_empty_with`]; a cell that is non-empty within the tolerance has an exact common point here), for
+    /// solvers that fail on a cell thinner than the tolerance (the planner's clarabel fallback;
+    /// [`crate::qp::minimize`] retries on [`Cell::grown_without_near_duplicates`]).
     pub fn grown_by_tolerance(&self) -> Result<Self, CellError> {
         let tol = self.tolerance.linear;
         let grown = self.halfspaces.iter().map(|h| Halfspace { offset: h.offset + tol, ..*h }).collect();

@@ -19,7 +19,7 @@
 //! * [`minimize_clarabel`]: clarabel's interior-point QP (general path and cross-check; statuses other than
 //!   `Solved` are errors). Its point is some minimiser (no tie-break); its `active` list is the tight inequalities.
 
-use crate::active_set::{ActiveSetError, MAX_N, Outcome, Problem};
+use crate::active_set::{ActiveSetError, MAX_N, Outcome, Problem, cholesky, cholesky_solve};
 use crate::cell::{Cell, default_tie, from_v4, to_v4};
 use crate::cost::SeparableQuadratic;
 use clarabel::algebra::CscMatrix;
@@ -199,39 +199,32 @@ fn problem<'c, const D: usize>(
 
 /// Exact minimum of `cost` over `cell`: see the module documentation.
 ///
-/// **Cells thinner than the tolerance.** A cell can be non-empty only within its tolerance ([`CellShape::Flat`],
-/// or a [`CellShape::Known`] cell that is: two obstacle faces a few nanometres apart with normals 1e-9 rad from
-/// opposite, as a part fitting exactly between two others gives). Its exact inequalities may then have no common
-/// point, and the working set of two nearly opposite planes gets multipliers near 1e265 that fail the KKT check.
-/// When both paths fail on a cell, the problem is solved once more on the cell with every offset grown by the
-/// tolerance (the cell on which emptiness is decided, [`Cell::is_empty_with`]), where the inequalities do have a
-/// common point; its answer, KKT-verified on that cell, lies within twice the tolerance of every original inequality
-/// (the search treats points within the tolerance of an obstacle face as touching). An error remains an error: the
-/// grown problem's own when it fails too.
+/// **Degenerate cells.** A cell can be non-empty only within its tolerance ([`CellShape::Flat`], or a
+/// [`CellShape::Known`] cell that is: two obstacle faces nanometres apart with normals 1e-9 rad from opposite, as a
+/// part fitting exactly between two others gives), or have a dozen planes through one vertex with normals 1e-16 to
+/// 1e-9 apart (parts whose faces are a sliver out of line). The working set of two nearly opposite planes then gets
+/// multipliers near 1e265 that fail the KKT check. When both paths fail, the problem is solved once more on the cell
+/// with every offset grown by the tolerance (the cell on which emptiness is decided, [`Cell::is_empty_with`], where
+/// the inequalities have a common point) and without its near-duplicate inequalities
+/// ([`Cell::grown_without_near_duplicates`]; indices mapped back to this cell's), by the same method and, if that
+/// fails too, by enumeration of its faces (strictly convex costs, at most 16 inequalities). The answer, KKT-verified on that cell,
+/// lies within three times the tolerance of every original inequality (the search treats points within the tolerance
+/// of an obstacle face as touching). An error remains an error: the retry's own when it fails too.
 ///
 /// [`CellShape::Flat`]: crate::cell::CellShape::Flat
 /// [`CellShape::Known`]: crate::cell::CellShape::Known
 pub fn minimize<const D: usize>(cell: &Cell<D>, cost: &impl SeparableQuadratic<D>) -> Result<QpSolution<D>, QpError> {
     match minimize_exact(cell, cost) {
         Err(e @ (QpError::Kkt { .. } | QpError::Solver(_))) => {
-            let grown = cell.grown_by_tolerance().map_err(|_| e.clone())?;
-            tracing::debug!(error = %e, "placement QP failed on a cell; solving it on the tolerance-grown cell");
-            match minimize_exact(&grown, cost) {
-                Ok(sol) => Ok(sol),
-                Err(e2 @ (QpError::Kkt { .. } | QpError::Solver(_))) => {
-                    // the grown cell without its near-duplicate inequalities; indices mapped back to this cell's
-                    let (reduced, index) = cell.grown_without_near_duplicates().map_err(|_| e2.clone())?;
-                    tracing::debug!(error = %e2, kept = reduced.len(), of = cell.len(), "QP on the reduced cell");
-                    let sol = match minimize_exact(&reduced, cost) {
-                        Ok(sol) => sol,
-                        Err(e3) => minimize_enumerated(&reduced, cost).ok_or(e3)?,
-                    };
-                    let map = |list: &[usize]| list.iter().map(|&j| index[j]).collect::<Vec<usize>>();
-                    let tight = tight_set_within(cell, &sol.point, 3.0 * cell.tolerance().linear);
-                    Ok(QpSolution { active: ShortList::from_slice(&map(&sol.active)), tight, ..sol })
-                }
-                Err(e2) => Err(e2),
-            }
+            let (reduced, index) = cell.grown_without_near_duplicates().map_err(|_| e.clone())?;
+            tracing::debug!(error = %e, kept = reduced.len(), of = cell.len(), "QP failed on a cell; grown and reduced");
+            let sol = match minimize_exact(&reduced, cost) {
+                Ok(sol) => sol,
+                Err(e2) => minimize_enumerated(&reduced, cost).ok_or(e2)?,
+            };
+            let active: Vec<usize> = sol.active.iter().map(|&j| index[j]).collect();
+            let tight = tight_set_within(cell, &sol.point, 3.0 * cell.tolerance().linear);
+            Ok(QpSolution { active: ShortList::from_slice(&active), tight, ..sol })
         }
         other => other,
     }
@@ -245,7 +238,7 @@ const ENUMERATE_MAX: usize = 16;
 
 /// The minimum of a strictly convex `cost` (every `h_i > 0`) over a small `cell` by enumeration, the last resort of
 /// [`minimize`] on degenerate cells: for every set `S` of at most `D` inequalities, the minimiser of the cost on
-/// `a_j . p = b_j (j in S)` (the KKT system `[H A^T; A 0]`, Gaussian elimination with partial pivoting); the cheapest
+/// `a_j . p = b_j (j in S)` by the null-space method ([`equality_qp`]); the cheapest
 /// that satisfies every inequality within the tolerance is the optimum (a convex QP's minimiser is the minimiser on
 /// the affine hull of the face it lies in, and that face is cut out by at most `D` of its tight inequalities). Its
 /// multipliers are those of its system when they pass the KKT check, else none (the caller's certificate is then
@@ -316,7 +309,8 @@ fn minimize_enumerated<const D: usize>(cell: &Cell<D>, cost: &impl SeparableQuad
 /// null-space method: the subset's normals orthonormalised by modified Gram-Schmidt (`a_j = sum_{i <= j} r_ji q_i`;
 /// a normal whose residual is below 1e-12 of its length is dependent: `None`, the face is another subset's), the
 /// point `Q^T c` with `R c = b` on the constraints, the basis `Z` of their orthogonal complement completed from the
-/// axes, and the reduced system `Z^T H Z y = -Z^T (H p0 + g)`; the multipliers from `R^T lambda = -Q (H p + g)`.
+/// axes, and the reduced system `Z^T H Z y = -Z^T (H p0 + g)` (the active set's Cholesky factor); the multipliers
+/// from `R^T lambda = -Q (H p + g)`.
 /// Nearly opposite normals (1e-9 rad) are independent here and give an accurate point: only the multipliers, which
 /// divide by the small residual, lose accuracy. `None` also when a result is not finite.
 fn equality_qp<const D: usize>(
@@ -384,16 +378,18 @@ fn equality_qp<const D: usize>(
     if k + z.len() != D {
         return None;
     }
-    // the reduced system over y: (Z^T H Z) y = -Z^T (H p0 + g)
+    // the reduced system over y: (Z^T H Z) y = -Z^T (H p0 + g), positive definite for a strictly convex cost
     let nz = z.len();
-    let mut m = [[0.0f64; MAX_N + 1]; MAX_N];
+    let mut m = [[0.0f64; MAX_N]; MAX_N];
+    let mut rhs = [0.0f64; MAX_N];
     for a in 0..nz {
         for b in 0..nz {
             m[a][b] = (0..D).map(|t| z[a][t] * h[t] * z[b][t]).sum();
         }
-        m[a][nz] = -(0..D).map(|t| z[a][t] * (h[t] * p[t] + g[t])).sum::<f64>();
+        rhs[a] = -(0..D).map(|t| z[a][t] * (h[t] * p[t] + g[t])).sum::<f64>();
     }
-    let y = solve_dense(&mut m, nz)?;
+    cholesky(&mut m, nz);
+    let y = cholesky_solve(&m, nz, &rhs);
     for a in 0..nz {
         for t in 0..D {
             p[t] += y[a] * z[a][t];
@@ -409,33 +405,7 @@ fn equality_qp<const D: usize>(
     (p.iter().all(|v| v.is_finite()) && lambda.iter().all(|v| v.is_finite())).then_some((p, lambda))
 }
 
-/// Solves the `n x n` system `m[..n][..n] x = m[..n][n]` (Gaussian elimination with partial pivoting); `None` when a
-/// pivot is not above 1e-14 of the largest entry.
-fn solve_dense(m: &mut [[f64; MAX_N + 1]; MAX_N], n: usize) -> Option<[f64; MAX_N]> {
-    let scale = (0..n).flat_map(|a| (0..n).map(move |b| (a, b))).map(|(a, b)| m[a][b].abs()).fold(0.0, f64::max);
-    for col in 0..n {
-        let pivot = (col..n).max_by(|&a, &b| m[a][col].abs().total_cmp(&m[b][col].abs()))?;
-        let size = m[pivot][col].abs();
-        if size.is_nan() || size <= 1e-14 * scale {
-            return None;
-        }
-        m.swap(col, pivot);
-        for row in col + 1..n {
-            let f = m[row][col] / m[col][col];
-            for c in col..=n {
-                m[row][c] -= f * m[col][c];
-            }
-        }
-    }
-    let mut x = [0.0; MAX_N];
-    for row in (0..n).rev() {
-        let tail: f64 = (row + 1..n).map(|c| m[row][c] * x[c]).sum();
-        x[row] = (m[row][n] - tail) / m[row][row];
-    }
-    Some(x)
-}
-
-/// [`minimize`] without the retry on the grown cell.
+/// [`minimize`] without the retry on degenerate cells.
 fn minimize_exact<const D: usize>(cell: &Cell<D>, cost: &impl SeparableQuadratic<D>) -> Result<QpSolution<D>, QpError> {
     let (prob, start, h, g) = problem(cell, cost)?;
     // strictly convex costs: the closed-form range-space iteration; a result that fails the KKT check (or a
@@ -810,7 +780,7 @@ mod tests {
     /// A cell thinner than the tolerance (found by `planner/tests/plans_vs_parry.rs`, an L whose outer faces are
     /// 1e-7 mm out of line, `w = 0`): its lower and upper planes, 1e-8 rad from opposite, have no exact common point
     /// (9e-9 mm apart), the working set gets multipliers near 1e265 and clarabel ends in a numerical error; the
-    /// retry on the tolerance-grown cell solves it.
+    /// retry on the tolerance-grown cell (without its near-duplicates) solves it.
     #[test]
     fn a_cell_thinner_than_the_tolerance_is_solved_on_the_grown_cell() {
         let flat: [([f64; 3], f64); 11] = [
@@ -838,15 +808,16 @@ mod tests {
         let s = minimize(&cell, &cost).expect("solved on the grown cell");
         let tol = cell.tolerance().linear;
         for hs in cell.halfspaces() {
-            assert!(hs.excess(&s.point) <= 2.0 * tol, "{:?} violated by {}", hs, hs.excess(&s.point));
+            assert!(hs.excess(&s.point) <= 3.0 * tol, "{:?} violated by {}", hs, hs.excess(&s.point));
         }
-        // verified on the grown cell: the lowest z there (the cost depends on z alone)
-        let grown: Vec<Halfspace<3>> =
-            cell.halfspaces().iter().map(|h| Halfspace { offset: h.offset + tol, ..*h }).collect();
-        let grown = Cell::new(grown, cell.tolerance()).expect("grown");
-        verify_kkt(&grown, &cost, &s).expect("KKT on the grown cell");
-        let lowest = grown.support(&[0.0, 0.0, -1.0]).expect("LP").expect("bounded").0;
-        assert!((-lowest - s.point[2]).abs() <= 2.0 * tol, "z {} against the lowest {}", s.point[2], -lowest);
+        // verified on the grown, reduced cell: the lowest z there (the cost depends on z alone)
+        let (reduced, index) = cell.grown_without_near_duplicates().expect("reduced");
+        let local: Vec<usize> = s.active.iter().map(|j| index.iter().position(|k| k == j).expect("kept")).collect();
+        verify_kkt(&reduced, &cost, &QpSolution { active: ShortList::from_slice(&local), ..s.clone() })
+            .expect("KKT on the reduced cell");
+        let lowest =
+            cell.grown_by_tolerance().expect("grown").support(&[0.0, 0.0, -1.0]).expect("LP").expect("bounded");
+        assert!((-lowest.0 - s.point[2]).abs() <= 2.0 * tol, "z {} against the lowest {}", s.point[2], -lowest.0);
     }
 
     /// A cell of 36 inequalities (found by `planner/tests/plans_vs_parry.rs`, nearly flush L-shapes, seed 7): a dozen

@@ -27,8 +27,8 @@ use parry3d_f64::math::Pose;
 use parry3d_f64::query::intersection_test;
 use parry3d_f64::shape::ConvexPolyhedron;
 use proptest::prelude::*;
-use stackplan_geom::Part;
 use stackplan_geom::io::{ReadOptions, read_part};
+use stackplan_geom::{ConvexPolytope, Part};
 use stackplan_planner::{FloorVolume, Plan, PlanOptions, plan_stack};
 use std::path::Path;
 
@@ -98,7 +98,9 @@ fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> f64 {
 }
 
 /// The horizontal distance of the module documentation, by brute force; `None` when the slice is empty (the
-/// z-ranges do not meet).
+/// z-ranges do not meet). The same construction as `stackplan_stability::clearance::horizontal_distance_by_slice`,
+/// written out on purpose: the reference does not call the code it checks (and near the clearance, where the test
+/// matters, the library decides by its SOCP, not by the slice).
 fn horizontal_distance(a: &[DVec3], b: &[DVec3]) -> Option<f64> {
     let diffs: Vec<DVec3> = b.iter().flat_map(|q| a.iter().map(move |p| *q - *p)).collect();
     let mut slice = Vec::new();
@@ -193,6 +195,31 @@ fn check_plan(part: &Part, plan: &Plan, options: &PlanOptions) {
     }
 }
 
+/// A plan of `count` parts on a `2 half x 1.6 half` floor (150 mm high) with a 4 mm cup, checked by [`check_plan`].
+fn plan_and_check(
+    part: &Part,
+    count: usize,
+    w: f64,
+    clearance: f64,
+    step_deg: f64,
+    half: f64,
+    insertion: bool,
+) -> Result<(), TestCaseError> {
+    let floor = FloorVolume::rectangle(-half, -half * 0.8, half, half * 0.8, 150.0);
+    let options = PlanOptions {
+        w,
+        clearance,
+        insertion,
+        dtheta: step_deg.to_radians(),
+        cup_diameter: 4.0,
+        ..PlanOptions::new(count, floor)
+    };
+    let plan = plan_stack(part, &options).expect("plan");
+    prop_assert!(!plan.parts.is_empty() || plan.stopped.is_some());
+    check_plan(part, &plan, &options);
+    Ok(())
+}
+
 fn cases(default: u32) -> u32 {
     std::env::var("PROPTEST_CASES").ok().and_then(|s| s.parse::<u32>().ok()).map_or(default, |n| (n / 4).max(1))
 }
@@ -211,18 +238,7 @@ proptest! {
         half in 50.0f64..120.0,
         insertion in any::<bool>(),
     ) {
-        let floor = FloorVolume::rectangle(-half, -half * 0.8, half, half * 0.8, 150.0);
-        let options = PlanOptions {
-            w,
-            clearance,
-            insertion,
-            dtheta: f64::to_radians(step_deg),
-            cup_diameter: 4.0,
-            ..PlanOptions::new(count, floor)
-        };
-        let plan = plan_stack(&part, &options).expect("plan");
-        prop_assert!(!plan.parts.is_empty() || plan.stopped.is_some());
-        check_plan(&part, &plan, &options);
+        plan_and_check(&part, count, w, clearance, step_deg, half, insertion)?;
     }
 }
 
@@ -259,17 +275,7 @@ proptest! {
         step_deg in prop_oneof![Just(30.0), Just(90.0)],
         half in 50.0f64..100.0,
     ) {
-        let floor = FloorVolume::rectangle(-half, -half * 0.8, half, half * 0.8, 150.0);
-        let options = PlanOptions {
-            w,
-            clearance,
-            dtheta: f64::to_radians(step_deg),
-            cup_diameter: 4.0,
-            ..PlanOptions::new(count, floor)
-        };
-        let plan = plan_stack(&part, &options).expect("plan");
-        prop_assert!(!plan.parts.is_empty() || plan.stopped.is_some());
-        check_plan(&part, &plan, &options);
+        plan_and_check(&part, count, w, clearance, step_deg, half, true)?;
     }
 }
 
@@ -293,17 +299,7 @@ fn fixture_plans_pass_the_independent_tests() {
 /// The brute-force horizontal distance itself, on boxes with known answers.
 #[test]
 fn horizontal_distance_of_boxes() {
-    let cuboid = |lo: DVec3, hi: DVec3| -> Vec<DVec3> {
-        (0..8)
-            .map(|k| {
-                DVec3::new(
-                    if k & 1 == 0 { lo.x } else { hi.x },
-                    if k & 2 == 0 { lo.y } else { hi.y },
-                    if k & 4 == 0 { lo.z } else { hi.z },
-                )
-            })
-            .collect()
-    };
+    let cuboid = |lo: DVec3, hi: DVec3| ConvexPolytope::cuboid(lo, hi).expect("box").vertices().to_vec();
     let a = cuboid(DVec3::ZERO, DVec3::splat(10.0));
     // 3 mm apart in x, overlapping in z
     let d = horizontal_distance(&a, &cuboid(DVec3::new(13.0, 0.0, 5.0), DVec3::new(20.0, 10.0, 15.0))).expect("meet");

@@ -52,7 +52,7 @@ pub fn horizontal_distance_at_least(a: &WorldComponent, b: &WorldComponent, delt
     // clearly above `delta` is one the SOCP would also put above it, so the SOCP is left out; near `delta` (and for
     // pairs with many vertices) the SOCP decides, as before
     if a.polytope.vertices().len() * b.polytope.vertices().len() <= SLICE_MAX_DIFFERENCES
-        && let Some(sliced) = horizontal_distance_by_slice(a, b)
+        && let Some(sliced) = horizontal_distance_by_slice(a, b, tol)
         && sliced >= delta + SLICE_MARGIN
     {
         return Some(sliced);
@@ -70,9 +70,10 @@ const SLICE_MAX_DIFFERENCES: usize = 256;
 /// The horizontal distance `d_h` of the module documentation by the slice of the Minkowski difference `B - A` at
 /// `z = 0`: `B - A` is the hull of the vertex differences `b - a`, and its slice is the hull of the points where the
 /// segments between differences on opposite sides of the plane cross it (and the differences on it); `d_h` is the
-/// distance from the origin to that polygon (0 when it holds the origin). `None` when no difference reaches the
+/// distance from the origin to that polygon (0 when it holds the origin; its hull drops points within `tol` of each
+/// other, as [`convex_hull_2d`] does). `None` when no difference reaches the
 /// plane (the z-ranges do not meet). O(N^2) for `N = V_A V_B` differences, no solver.
-pub fn horizontal_distance_by_slice(a: &WorldComponent, b: &WorldComponent) -> Option<f64> {
+pub fn horizontal_distance_by_slice(a: &WorldComponent, b: &WorldComponent, tol: f64) -> Option<f64> {
     let diffs: Vec<glam::DVec3> =
         b.polytope.vertices().iter().flat_map(|q| a.polytope.vertices().iter().map(move |p| *q - *p)).collect();
     let mut slice: Vec<DVec2> = Vec::new();
@@ -90,34 +91,7 @@ pub fn horizontal_distance_by_slice(a: &WorldComponent, b: &WorldComponent) -> O
     if slice.is_empty() {
         return None;
     }
-    Some(convex_distance(&monotone_hull(slice), &[DVec2::ZERO]))
-}
-
-/// The convex hull of `points` counter-clockwise (Andrew's monotone chain; exact duplicates and collinear points
-/// dropped): O(n log n), for the many crossing points of a slice ([`convex_hull_2d`]'s tolerant de-duplication is
-/// quadratic).
-fn monotone_hull(mut pts: Vec<DVec2>) -> Vec<DVec2> {
-    pts.retain(|p| p.is_finite());
-    pts.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
-    pts.dedup();
-    if pts.len() < 3 {
-        return pts;
-    }
-    let turn = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o);
-    let mut hull: Vec<DVec2> = Vec::with_capacity(2 * pts.len());
-    for pass in 0..2 {
-        let start = hull.len();
-        let ordered: Box<dyn Iterator<Item = &DVec2>> =
-            if pass == 0 { Box::new(pts.iter()) } else { Box::new(pts.iter().rev()) };
-        for &p in ordered {
-            while hull.len() >= start + 2 && turn(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0 {
-                hull.pop();
-            }
-            hull.push(p);
-        }
-        hull.pop();
-    }
-    hull
+    Some(convex_distance(&convex_hull_2d(&slice, tol), &[DVec2::ZERO]))
 }
 
 /// The exact horizontal distance `d_h` of the module documentation (SOCP). `None` when not `Solved`.

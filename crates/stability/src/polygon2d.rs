@@ -25,10 +25,13 @@ pub fn convex_hull_2d(points: &[DVec2], tol: f64) -> Vec<DVec2> {
         return pts;
     }
     pts.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
-    // drop points within tol of their predecessor (duplicates of computed coordinates)
+    // drop points within tol of a point kept before (duplicates of computed coordinates); the points are sorted by x,
+    // so only the kept points with x >= p.x - tol can be that close (the same points as comparing with all of them,
+    // in O(n k) for k points in a strip of width tol instead of O(n^2))
     let mut unique: Vec<DVec2> = Vec::with_capacity(pts.len());
     for p in pts {
-        if unique.iter().all(|q: &DVec2| (*q - p).length() > tol) {
+        let near = unique.iter().rev().take_while(|q| q.x >= p.x - tol).any(|q: &DVec2| (*q - p).length() <= tol);
+        if !near {
             unique.push(p);
         }
     }

@@ -55,7 +55,7 @@ proptest! {
         ];
         let parts = world_stack(&stack).expect("world");
         let (ca, cb) = (&parts[0].components[0], &parts[1].components[0]);
-        let sliced = horizontal_distance_by_slice(ca, cb);
+        let sliced = horizontal_distance_by_slice(ca, cb, 1e-9);
         // the slice is empty iff the z-ranges do not meet (away from touching)
         let (za, zb) = (ca.aabb, cb.aabb);
         let overlap = za.1.z.min(zb.1.z) - za.0.z.max(zb.0.z);
