@@ -33,38 +33,51 @@ const PASSES: usize = 1;
 /// `grow` the cell's tolerance, the box contains the tolerance-grown cell on which emptiness is decided
 /// ([`Cell::is_empty_with`]).
 pub fn outer_box<const D: usize>(halfspaces: &[Halfspace<D>], grow: f64) -> ([f64; D], [f64; D]) {
-    let mut lo = [f64::NEG_INFINITY; D];
-    let mut hi = [f64::INFINITY; D];
+    let mut bounds = ([f64::NEG_INFINITY; D], [f64::INFINITY; D]);
     for _ in 0..PASSES {
         for h in halfspaces {
-            let b = h.offset + grow;
-            for i in 0..D {
-                let a = h.normal[i];
-                if a == 0.0 {
-                    continue;
-                }
-                // the least the other variables can contribute (a zero coefficient contributes nothing, also
-                // against an infinite bound)
-                let mut rest = 0.0;
-                for j in 0..D {
-                    let c = h.normal[j];
-                    if j != i && c != 0.0 {
-                        rest += (c * lo[j]).min(c * hi[j]);
-                    }
-                }
-                if !rest.is_finite() {
-                    continue;
-                }
-                let bound = (b - rest) / a;
-                if a > 0.0 {
-                    hi[i] = hi[i].min(bound);
-                } else {
-                    lo[i] = lo[i].max(bound);
-                }
-            }
+            tighten_box(&mut bounds, &h.normal, h.offset + grow);
         }
     }
-    (lo, hi)
+    bounds
+}
+
+/// One step of the propagation: the box `[lo, hi]` tightened by the inequality `normal . p <= offset` (the bounds it
+/// implies for each variable given the others' bounds). Every point of the box that satisfies the inequality stays
+/// in it. An infinite bound of another variable that the inequality reaches leaves the variable as it is. O(D^2).
+#[inline]
+pub fn tighten_box<const D: usize>((lo, hi): &mut ([f64; D], [f64; D]), normal: &[f64; D], offset: f64) {
+    for i in 0..D {
+        let a = normal[i];
+        if a == 0.0 {
+            continue;
+        }
+        // the least the other variables can contribute (a zero coefficient contributes nothing, also against an
+        // infinite bound)
+        let mut rest = 0.0;
+        for j in 0..D {
+            let c = normal[j];
+            if j != i && c != 0.0 {
+                rest += (c * lo[j]).min(c * hi[j]);
+            }
+        }
+        if !rest.is_finite() {
+            continue;
+        }
+        let bound = (offset - rest) / a;
+        if a > 0.0 {
+            hi[i] = hi[i].min(bound);
+        } else {
+            lo[i] = lo[i].max(bound);
+        }
+    }
+}
+
+/// Whether the box `[lo, hi]` is empty by more than `2 slack` in some variable (with a box that contains a
+/// tolerance-grown cell and `slack` the tolerance: that cell is empty, and [`Cell::is_empty_with`] finds it so; the
+/// margin covers the propagation's rounding, as in [`box_misses_halfspace`]).
+pub fn box_is_empty<const D: usize>((lo, hi): &([f64; D], [f64; D]), slack: f64) -> bool {
+    (0..D).any(|i| lo[i] > hi[i] + 2.0 * slack)
 }
 
 impl<const D: usize> Cell<D> {
@@ -235,6 +248,24 @@ mod tests {
     }
 
     #[test]
+    fn tightening_a_box_by_an_inequality() {
+        // x + y <= 0 over [-1, 1] x [-2, 2]: y <= 1, x unchanged (x <= 2 is looser); then y >= 1.5 empties it
+        let mut b = ([-1.0, -2.0], [1.0, 2.0]);
+        tighten_box(&mut b, &[1.0, 1.0], 0.0);
+        assert_eq!(b, ([-1.0, -2.0], [1.0, 1.0]));
+        assert!(!box_is_empty(&b, 1e-9));
+        tighten_box(&mut b, &[0.0, -1.0], -1.5);
+        assert!(box_is_empty(&b, 1e-9));
+        // empty by less than twice the slack: not declared empty
+        let touching = ([0.0, 1.0 + 1e-10], [1.0, 1.0]);
+        assert!(!box_is_empty(&touching, 1e-9));
+        // an infinite bound the inequality reaches leaves the other variable alone
+        let mut open = ([0.0, f64::NEG_INFINITY], [1.0, 1.0]);
+        tighten_box(&mut open, &[1.0, 1.0], 0.0);
+        assert_eq!(open.1[0], 1.0);
+    }
+
+    #[test]
     fn pruning_drops_the_far_cuts_and_keeps_the_ones_that_bound() {
         let tol = Tolerance::for_scale(10.0);
         let mut list = unit_box();
@@ -282,6 +313,41 @@ mod tests {
                 prop_assert!(cell.is_empty_with([outside], &start).expect("phase 1"));
                 let (h, _) = cell.support(&normal).expect("support LP").expect("non-empty cell");
                 prop_assert!(h < probe.3);
+            }
+        }
+
+        /// The planner's child box: the cell's grown box tightened by further inequalities (each grown by the
+        /// tolerance, as the planner does) against the exact support LPs of the cell with them added (it holds
+        /// that cell), and whenever it is empty by the margin, the exact phase 1 finds the cell with them added
+        /// empty.
+        #[test]
+        fn a_tightened_box_holds_the_cut_cell_and_its_emptiness_is_exact(
+            cuts in proptest::collection::vec(
+                (-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0, -0.5f64..2.0), 0..6),
+            extra in proptest::collection::vec(
+                (-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0, -2.0f64..2.0), 1..4),
+        ) {
+            let tol = Tolerance::for_scale(10.0);
+            let cell = box_with_cuts(&cuts, tol);
+            prop_assume!(!cell.is_empty());
+            let mut b = cell.grown_outer_box();
+            let extra: Vec<Halfspace<3>> = extra.iter().map(|&(x, y, z, d)| hs([x, y, z], d)).collect();
+            for h in &extra {
+                tighten_box(&mut b, &h.normal, h.offset + tol.linear);
+            }
+            let start = cell.interior_point().expect("non-empty cell");
+            if box_is_empty(&b, tol.linear) {
+                prop_assert!(cell.is_empty_with(extra.iter().copied(), &start).expect("phase 1"));
+            } else if let Some(cut) = cell.with_halfspaces_from(&extra, &start).expect("phase 1") {
+                for i in 0..3 {
+                    for sign in [1.0, -1.0] {
+                        let mut e = [0.0; 3];
+                        e[i] = sign;
+                        let Some((h, _)) = cut.support(&e).expect("support LP") else { continue };
+                        let bound = if sign > 0.0 { b.1[i] } else { -b.0[i] };
+                        prop_assert!(h <= bound + 1e-12, "support {h} beyond the box {bound} on axis {i}");
+                    }
+                }
             }
         }
 

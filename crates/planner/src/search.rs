@@ -101,7 +101,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use stackplan_cspace::ObstacleCache;
 use stackplan_freespace::cell::{Cell, Halfspace, Tag};
-use stackplan_freespace::outer_box::box_misses_halfspace;
+use stackplan_freespace::outer_box::{box_is_empty, box_misses_halfspace, tighten_box};
 use stackplan_geom::{Pose, Tolerance};
 use std::collections::{HashMap, VecDeque};
 use std::sync::Arc;
@@ -275,13 +275,25 @@ struct Family<const D: usize> {
     applied: Arc<[u32]>,
     obstacle: u32,
     start: [f64; D],
-    /// The box around the parent cell (`Cell::grown_outer_box_pruned`) when the obstacle's planes are finite: the
-    /// inside cuts it proves redundant are left out of the children ([`Search::child_inequalities`]).
-    reach: Option<([f64; D], [f64; D])>,
+    /// Which inside cuts the children keep ([`Search::child_inequalities`]).
+    cuts: InsideCuts<D>,
     /// The family's children are `NodeHeap::children[first..first + left]` (`(key, id, face)`), the cheapest (by
     /// [`HeapKey`]'s order) last; popping one decrements `left`.
     first: usize,
     left: u32,
+}
+
+/// The inside cuts `n_j . p <= d_j` that a family's children keep: those the box around the parent cell
+/// (`Cell::grown_outer_box_pruned`, when the obstacle's planes are finite) does not prove redundant. The test is
+/// the one that drops the empty outside child of the same face at the split (`box_misses_halfspace` with the same
+/// arguments), so the kept cuts are recorded there as a mask; an obstacle with more faces than the mask's bits keeps
+/// the box and repeats the test per child.
+#[derive(Clone, Copy)]
+enum InsideCuts<const D: usize> {
+    /// Bit `j`: face `j`'s inside cut is kept (its outside half-space meets the box).
+    Kept(u128),
+    /// The box (`None`: no finite box, every cut kept).
+    Reach(Option<([f64; D], [f64; D])>),
 }
 
 /// The state of the search's loop between calls ([`Search::advance`]): the open nodes, the next node id, the
@@ -313,11 +325,13 @@ struct Buffers<const D: usize> {
     extra: Vec<Halfspace<D>>,
     outside: Vec<Outside<D>>,
     children: Vec<(f64, u64, u32)>,
+    /// The kept inside cuts of the split being pushed (the faces before the current one whose cuts the children keep).
+    kept_cuts: Vec<([f64; D], f64)>,
 }
 
 impl<const D: usize> Default for Buffers<D> {
     fn default() -> Self {
-        Self { extra: Vec::new(), outside: Vec::new(), children: Vec::new() }
+        Self { extra: Vec::new(), outside: Vec::new(), children: Vec::new(), kept_cuts: Vec::new() }
     }
 }
 
@@ -1673,7 +1687,7 @@ impl Search<'_, '_> {
                             reason: "a pending child's family has no cell (inconsistent heap)".into(),
                         });
                     };
-                    self.child_inequalities::<D>(f.obstacle, face, fixed_z, f.reach.as_ref(), &mut buffers.extra);
+                    self.child_inequalities::<D>(f.obstacle, face, fixed_z, f.cuts, &mut buffers.extra);
                     let solved = self.solve_child::<D>(orientation, parent, &buffers.extra, &f.start, fixed_z)?;
                     // the path is shared by the family's children: one more reference for a non-empty one
                     let applied = solved.as_ref().map(|_| Arc::clone(&f.applied));
@@ -1819,18 +1833,14 @@ impl Search<'_, '_> {
             let finite = buffers.outside.iter().all(|((n, d), _)| d.is_finite() && n.iter().all(|c| c.is_finite()));
             // (the children are built from the cell without the inequalities that box proves redundant)
             let (reach, pruned) = node.cell.grown_outer_box_pruned();
-            let family = Family {
-                orientation: node.orientation,
-                cell: Some(pruned.map_or_else(|| Arc::clone(&node.cell), Arc::new)),
-                applied,
-                obstacle: id,
-                start: optimum.point,
-                reach: finite.then_some(reach),
-                first: 0,
-                left: 0,
-            };
+            let masked = self.obstacles[id as usize].planes.len() <= 128;
+            let family_cuts =
+                |kept: u128| if masked { InsideCuts::Kept(kept) } else { InsideCuts::Reach(finite.then_some(reach)) };
+            let mut kept_faces = 0u128;
             let children = &mut buffers.children;
             children.clear();
+            let kept_cuts = &mut buffers.kept_cuts;
+            kept_cuts.clear();
             for &(outside, face) in &buffers.outside {
                 if finite && box_misses_halfspace(&reach, &outside.0, outside.1, tol) {
                     // the id is still taken: the other children's ids, hence the search's order, are unchanged
@@ -1838,21 +1848,62 @@ impl Search<'_, '_> {
                     *next_id += 1;
                     continue;
                 }
+                // the box of the child: the parent's tightened by the inside cuts kept before this face and by its
+                // outside half-space, each grown by the tolerance, so that it holds the child grown by the
+                // tolerance (the set on which its phase 1 decides emptiness)
+                let child_box = finite.then(|| {
+                    let mut b = reach;
+                    for (n, d) in kept_cuts.iter() {
+                        tighten_box(&mut b, n, d + tol);
+                    }
+                    tighten_box(&mut b, &outside.0.map(|c| -c), tol - outside.1);
+                    b
+                });
+                // this face's inside cut is kept by the later children (`InsideCuts`)
+                if masked {
+                    kept_faces |= 1 << face;
+                }
+                if finite {
+                    kept_cuts.push(outside);
+                }
+                if child_box.is_some_and(|b| box_is_empty(&b, tol)) {
+                    // empty (the box propagation is a relaxation of the phase 1): never pushed, its id still taken
+                    debug_assert!(
+                        self.child_is_empty(&node, id, face, fixed_z, family_cuts(kept_faces), reach),
+                        "a child the box proves empty is not empty"
+                    );
+                    self.stats.cells_empty += 1;
+                    *next_id += 1;
+                    continue;
+                }
                 self.stats.nodes_pushed += 1;
                 // key: a lower bound of the child's cost, the largest of the parent's cost, the cost's minimum over
-                // the child's half-space outside the obstacle face (slack: twice the cell tolerance) and the bound
+                // the child's half-space outside the obstacle face (slack: twice the cell tolerance), the bound
                 // from the parent's optimality conditions, which grows with the face's distance from p*
-                // (`Quadratic::lower_bound_beyond`: the child lies in the parent's cell)
-                let bound = q.halfspace_lower_bound(&outside.0, outside.1, 2.0 * tol).max(q.lower_bound_beyond(
-                    optimum,
-                    &outside.0,
-                    outside.1,
-                    2.0 * tol,
-                    tol,
-                ));
+                // (`Quadratic::lower_bound_beyond`: the child lies in the parent's cell), and the cost's minimum over
+                // the child's box (`Quadratic::box_lower_bound`)
+                let bound = q
+                    .halfspace_lower_bound(&outside.0, outside.1, 2.0 * tol)
+                    .max(q.lower_bound_beyond(optimum, &outside.0, outside.1, 2.0 * tol, tol))
+                    .max(child_box.map_or(f64::NEG_INFINITY, |b| q.box_lower_bound(&b.0, &b.1)));
+                debug_assert!(
+                    *next_id % 8 != 0
+                        || self.child_cost_is_at_least(&node, id, face, fixed_z, family_cuts(kept_faces), bound),
+                    "a child's key is above its cost"
+                );
                 children.push((node.cost.max(bound), *next_id, face));
                 *next_id += 1;
             }
+            let family = Family {
+                orientation: node.orientation,
+                cell: Some(pruned.map_or_else(|| Arc::clone(&node.cell), Arc::new)),
+                applied,
+                obstacle: id,
+                start: optimum.point,
+                cuts: family_cuts(kept_faces),
+                first: 0,
+                left: 0,
+            };
             heap.push_family(family, children);
             self.stats.time_cells_ms += ms(t_cells);
         }
@@ -1951,37 +2002,94 @@ impl Search<'_, '_> {
     }
 
     /// The extra inequalities of child `face` of obstacle `id`: the inside cuts `n_j . p <= d_j` of the faces before
-    /// it (restricted to the `D` variables; planes that do not depend on them are skipped, as in [`Search::split`])
-    /// and the outside `n_face . p >= d_face`, into `extra` (cleared first). An inside cut that the box `reach`
-    /// around the parent cell proves redundant (the box lies strictly inside it, the test that drops the empty
-    /// outside child of that face at the split) is left out: the child is the same set. O(faces); the same values
-    /// every time.
+    /// it that the family keeps ([`InsideCuts`]; restricted to the `D` variables; planes that do not depend on them
+    /// are skipped, as in [`Search::split`]) and the outside `n_face . p >= d_face`, into `extra` (cleared first).
+    /// The cuts left out are those the box around the parent cell proves redundant (it lies strictly inside them):
+    /// the child is the same set. O(kept faces) with the mask, O(faces) with the box; the same values every time.
     fn child_inequalities<const D: usize>(
         &self,
         id: u32,
         face: u32,
         fixed_z: f64,
-        reach: Option<&([f64; D], [f64; D])>,
+        cuts: InsideCuts<D>,
         extra: &mut Vec<Halfspace<D>>,
     ) {
         let tol = self.tol.linear;
         let planes = &self.obstacles[id as usize].planes;
         extra.clear();
-        for (k, plane) in planes.iter().enumerate().take(face as usize + 1) {
-            let Ok((normal, offset)) = restrict::<D>(plane.normal, plane.offset, fixed_z, tol) else {
-                continue;
-            };
-            let tag_face = k as u32;
-            if tag_face == face {
-                let keep = Halfspace::new(normal, offset, Tag::ObstacleFace { obstacle: u64::from(id), face });
-                extra.push(keep.flipped(Tag::ObstacleFace { obstacle: u64::from(id), face }));
-            } else if !reach.is_some_and(|b| box_misses_halfspace(b, &normal, offset, tol)) {
+        let mut inside_cut = |k: usize| {
+            if let Ok((normal, offset)) = restrict::<D>(planes[k].normal, planes[k].offset, fixed_z, tol) {
                 extra.push(Halfspace::new(
                     normal,
                     offset,
-                    Tag::ObstacleCut { obstacle: u64::from(id), face: tag_face },
+                    Tag::ObstacleCut { obstacle: u64::from(id), face: k as u32 },
                 ));
             }
+        };
+        match cuts {
+            InsideCuts::Kept(mask) => {
+                // the faces before `face` whose children were pushed, in increasing order
+                let mut before = mask & ((1u128 << face) - 1);
+                while before != 0 {
+                    inside_cut(before.trailing_zeros() as usize);
+                    before &= before - 1;
+                }
+            }
+            InsideCuts::Reach(reach) => {
+                for (k, plane) in planes.iter().enumerate().take(face as usize) {
+                    if let Ok((normal, offset)) = restrict::<D>(plane.normal, plane.offset, fixed_z, tol)
+                        && !reach.as_ref().is_some_and(|b| box_misses_halfspace(b, &normal, offset, tol))
+                    {
+                        inside_cut(k);
+                    }
+                }
+            }
+        }
+        let plane = &planes[face as usize];
+        if let Ok((normal, offset)) = restrict::<D>(plane.normal, plane.offset, fixed_z, tol) {
+            let tag = Tag::ObstacleFace { obstacle: u64::from(id), face };
+            extra.push(Halfspace::new(normal, offset, tag).flipped(tag));
+        }
+    }
+
+    /// Debug check of a child that the box propagation drops at a split (`cuts`: the family's): the exact phase 1
+    /// finds it empty, and its inside cuts are those that the box test per face keeps.
+    fn child_is_empty<const D: usize>(
+        &self,
+        node: &Node<D>,
+        id: u32,
+        face: u32,
+        fixed_z: f64,
+        cuts: InsideCuts<D>,
+        reach: ([f64; D], [f64; D]),
+    ) -> bool {
+        let mut extra = Vec::new();
+        self.child_inequalities::<D>(id, face, fixed_z, cuts, &mut extra);
+        let mut by_box = Vec::new();
+        self.child_inequalities::<D>(id, face, fixed_z, InsideCuts::Reach(Some(reach)), &mut by_box);
+        extra == by_box && node.cell.is_empty_with(extra, &node.optimum.point).unwrap_or(false)
+    }
+
+    /// Debug check of a child's key (`cuts`: the family's): the child's cost, when it is not empty, is not below
+    /// `bound`, up to the relative rounding that the heap's order ignores.
+    fn child_cost_is_at_least<const D: usize>(
+        &self,
+        node: &Node<D>,
+        id: u32,
+        face: u32,
+        fixed_z: f64,
+        cuts: InsideCuts<D>,
+        bound: f64,
+    ) -> bool {
+        let mut extra = Vec::new();
+        self.child_inequalities::<D>(id, face, fixed_z, cuts, &mut extra);
+        let q = restrict_quadratic::<D>(&self.orientations[node.orientation].quadratic, fixed_z);
+        match node.cell.with_halfspaces_from(&extra, &node.optimum.point) {
+            Ok(Some(cell)) => match minimise(&cell, &q) {
+                Ok(Some(opt)) => opt.value >= bound - 1e-12 * (bound.abs() + opt.value.abs()),
+                _ => true,
+            },
+            _ => true,
         }
     }
 
