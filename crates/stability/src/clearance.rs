@@ -13,10 +13,14 @@
 //! must be at least `delta`. With `a = sum lambda_i a_i`, `b = sum mu_j b_j` (convex combinations of the vertices)
 //! this is a small SOCP (one `SecondOrderConeT(3)`), solved by clarabel. Cheap filters run first: the gap between
 //! the boxes in x or in y, and the distance between the vertical projections (both lower bounds of `d_h`), then the
+//! separating axes' bound ([`horizontal_distance_bound_by_axes`]: the gap along a facet normal of the Minkowski
+//! difference over its horizontal part, exact when the nearest point of the slice lies on one of its edges), then the
 //! exact `d_h` from the slice of the Minkowski difference at `z = 0` ([`horizontal_distance_by_slice`], for pairs of
-//! at most 256 vertex differences), which stands for the SOCP when it is above `delta` by more than 1e-6 mm.
-//! Cost: O(1) filters per pair, O((V_A V_B)^2) for the slice; one SOCP with `V_A + V_B + 1` variables for the pairs
-//! the slice leaves within 1e-6 mm of `delta` or below it.
+//! at most 256 vertex differences); either stands for the SOCP when it is above `delta` by more than 1e-6 mm (a pair
+//! farther than `delta` is only known to keep its clearance: [`horizontal_distance_at_least`] returns a value at
+//! least `delta`, not the distance). Cost: O(1) filters per pair, O((F_A + F_B + E_A E_B)(V_A + V_B)) for the axes,
+//! O((V_A V_B)^2) for the slice; one SOCP with `V_A + V_B + 1` variables for the pairs the filters leave within 1e-6 mm
+//! of `delta` or below it.
 
 use crate::polygon2d::{convex_distance, convex_hull_2d};
 use crate::world::WorldComponent;
@@ -48,6 +52,11 @@ pub fn horizontal_distance_at_least(a: &WorldComponent, b: &WorldComponent, delt
     if projected >= delta {
         return Some(projected);
     }
+    // the separating axes' bound (a few dozen projections): clearly above `delta`, the pair keeps its clearance
+    let by_axes = horizontal_distance_bound_by_axes(a, b, tol);
+    if by_axes >= delta + SLICE_MARGIN {
+        return Some(by_axes);
+    }
     // the exact distance from the slice of the Minkowski difference (cheap for a component's few vertices): a value
     // clearly above `delta` is one the SOCP would also put above it, so the SOCP is left out; near `delta` (and for
     // pairs with many vertices) the SOCP decides, as before
@@ -66,6 +75,50 @@ const SLICE_MARGIN: f64 = 1e-6;
 
 /// The most vertex differences the slice takes (its cost is quadratic in them).
 const SLICE_MAX_DIFFERENCES: usize = 256;
+
+/// A lower bound of the horizontal distance `d_h` from separating axes: for any direction `w` with a horizontal part,
+/// every horizontal `e = b - a` has `w . e = w_xy . e_xy <= |w_xy| |e|` and `w . e >= gap_w` (the gap between the
+/// projections of `A` and `B` on `w`), so `|e| >= gap_w / |w_xy|` when `gap_w > 0`. The largest such value over the
+/// face normals of both and the cross products of their edge directions: these are the facet normals of the
+/// Minkowski difference, so the bound is `d_h` itself when the nearest point of the slice lies on an edge of the
+/// slice, and below it when it is a vertex of the slice. Each gap is taken `tol` smaller (unit axes), so that
+/// its rounding, magnified by `1 / |w_xy|` for nearly vertical axes, never lifts the bound above `d_h`.
+/// `-inf` when no axis separates. O((F_A + F_B + E_A E_B) (V_A + V_B)), no solver.
+pub fn horizontal_distance_bound_by_axes(a: &WorldComponent, b: &WorldComponent, tol: f64) -> f64 {
+    let (va, vb) = (a.polytope.vertices(), b.polytope.vertices());
+    let project = |vs: &[glam::DVec3], w: glam::DVec3| {
+        vs.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            let x = w.dot(*v);
+            (lo.min(x), hi.max(x))
+        })
+    };
+    let mut best = f64::NEG_INFINITY;
+    let mut test = |w: glam::DVec3| {
+        let horizontal = w.truncate().length();
+        if horizontal.is_nan() || horizontal <= 0.0 {
+            return;
+        }
+        let (a_lo, a_hi) = project(va, w);
+        let (b_lo, b_hi) = project(vb, w);
+        let gap = (b_lo - a_hi).max(a_lo - b_hi) - tol;
+        if gap > 0.0 {
+            best = best.max(gap / horizontal);
+        }
+    };
+    for &n in a.normals.iter().chain(&b.normals) {
+        test(n);
+    }
+    for &da in &a.edge_directions {
+        for &db in &b.edge_directions {
+            let c = da.cross(db);
+            let length = c.length();
+            if length > 1e-9 {
+                test(c / length);
+            }
+        }
+    }
+    best
+}
 
 /// The horizontal distance `d_h` of the module documentation by the slice of the Minkowski difference `B - A` at
 /// `z = 0`: `B - A` is the hull of the vertex differences `b - a`, and its slice is the hull of the points where the

@@ -1,6 +1,7 @@
 //! The horizontal distance by the slice of the Minkowski difference (`clearance::horizontal_distance_by_slice`, the
 //! filter that spares the SOCP) against the SOCP (`clearance::horizontal_distance`) on random pairs of convex hulls:
-//! random points, boxes tilted by up to a few degrees and slivers, placed so that their z-ranges overlap.
+//! random points, boxes tilted by up to a few degrees and slivers, placed so that their z-ranges overlap; and the
+//! separating axes' lower bound (`clearance::horizontal_distance_bound_by_axes`) against both.
 
 mod common;
 
@@ -8,7 +9,9 @@ use glam::{DMat3, DVec3};
 use proptest::prelude::*;
 use stackplan_geom::{Part, PartOrigin, convex_hull};
 use stackplan_stability::PlacedPart;
-use stackplan_stability::clearance::{horizontal_distance, horizontal_distance_by_slice};
+use stackplan_stability::clearance::{
+    horizontal_distance, horizontal_distance_bound_by_axes, horizontal_distance_by_slice,
+};
 use stackplan_stability::world::world_stack;
 
 fn hull_part(points: &[DVec3]) -> Option<Part> {
@@ -66,6 +69,54 @@ proptest! {
             let s = sliced.expect("the z-ranges meet: a slice");
             let d = horizontal_distance(ca, cb).expect("the SOCP solves");
             prop_assert!((s - d).abs() <= 1e-6 * (1.0 + d), "slice {} against the SOCP {}", s, d);
+            // the separating axes' bound never exceeds the distance (by both exact methods)
+            let bound = horizontal_distance_bound_by_axes(ca, cb, 1e-9);
+            prop_assert!(bound <= d + 1e-6 * (1.0 + d) && bound <= s + 1e-9 * (1.0 + s),
+                "axes {} above the SOCP {} / slice {}", bound, d, s);
         }
     }
+}
+
+/// Two components of a stack of two hull parts (the second turned by `turn` about z and moved by `shift`).
+fn pair_distances(pa: &[DVec3], pb: &[DVec3], turn: f64, shift: DVec3) -> (f64, f64) {
+    let (a, b) = (hull_part(pa).expect("hull"), hull_part(pb).expect("hull"));
+    let stack = [
+        PlacedPart { part: &a, rotation: DMat3::IDENTITY, position: DVec3::ZERO },
+        PlacedPart { part: &b, rotation: DMat3::from_rotation_z(turn), position: shift },
+    ];
+    let parts = world_stack(&stack).expect("world");
+    let (ca, cb) = (&parts[0].components[0], &parts[1].components[0]);
+    (horizontal_distance_bound_by_axes(ca, cb, 1e-9), horizontal_distance(ca, cb).expect("the SOCP solves"))
+}
+
+fn cube(lo: DVec3, hi: DVec3) -> Vec<DVec3> {
+    (0..8)
+        .map(|k| {
+            DVec3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn the_axes_bound_is_the_distance_to_an_edge_of_the_slice_and_below_it_at_a_vertex() {
+    let a = cube(DVec3::ZERO, DVec3::splat(10.0));
+    // side by side, 3 mm apart in x, z-ranges overlapping: the nearest point of the slice is on an edge (x axis)
+    let (bound, d) =
+        pair_distances(&a, &cube(DVec3::new(13.0, 0.0, 5.0), DVec3::new(20.0, 10.0, 15.0)), 0.0, DVec3::ZERO);
+    assert!((d - 3.0).abs() < 1e-6 && (bound - 3.0).abs() < 1e-8, "bound {bound}, distance {d}");
+    // a diamond (a square turned 45 degrees) beside the square: the slice `B - A` is an octagon, and the diamond is
+    // placed so that the octagon's vertex `V` (its east corner plus the corner (0, 0) of `-A`) is the nearest point,
+    // 12 mm away in the direction 22.5 degrees between the normals of the two edges at `V`: each edge's line is
+    // 12 cos(22.5 deg) away, and that is the bound
+    let diamond = cube(DVec3::new(-5.0, -5.0, 2.0), DVec3::new(5.0, 5.0, 8.0));
+    let direction = DVec3::new(22.5f64.to_radians().cos(), 22.5f64.to_radians().sin(), 0.0);
+    let corner = -12.0 * direction;
+    let shift = corner - DVec3::new(50f64.sqrt(), 0.0, 0.0);
+    let (bound, d) = pair_distances(&a, &diamond, std::f64::consts::FRAC_PI_4, shift);
+    assert!((d - 12.0).abs() < 1e-6, "distance {d}");
+    assert!((bound - 12.0 * 22.5f64.to_radians().cos()).abs() < 1e-8, "bound {bound}");
 }
