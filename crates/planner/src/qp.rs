@@ -195,18 +195,22 @@ mod tests {
     use stackplan_freespace::cell::{Halfspace, Tag};
     use stackplan_geom::Tolerance;
 
+    /// A deterministic generator of numbers in `[0, 1)` (xorshift64).
+    fn xorshift(mut state: u64) -> impl FnMut() -> f64 {
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     /// The box bound against the cost at the grid points of the box (never above any of them) and at the centre
     /// clamped to the box (equal up to the relative shrink), on random costs (some curvatures zero) and boxes (some
     /// sides infinite, some empty).
     #[test]
     fn box_bound_is_the_minimum_over_the_box() {
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut rnd = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = xorshift(0x9e37_79b9_7f4a_7c15);
         for _ in 0..500 {
             let q = Quadratic::<3> {
                 h: std::array::from_fn(|_| if rnd() < 0.2 { 0.0 } else { 4.0 * rnd() }),
@@ -245,13 +249,7 @@ mod tests {
     /// and it is useful: above the parent's cost for half-spaces away from the optimum.
     #[test]
     fn bound_beyond_is_below_the_minimum_over_the_cut_cell() {
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut rnd = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = xorshift(0x2545_f491_4f6c_dd1d);
         let tol = Tolerance::for_scale(200.0);
         let (mut checked, mut useful) = (0, 0);
         for _ in 0..200 {

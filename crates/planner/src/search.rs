@@ -1875,7 +1875,7 @@ impl Search<'_, '_> {
                 if child_box.is_some_and(|b| box_is_empty(&b, tol)) {
                     // empty (the box propagation is a relaxation of the phase 1): never pushed, its id still taken
                     debug_assert!(
-                        self.child_is_empty(&node, id, face, fixed_z, family_cuts(kept_faces), reach),
+                        self.child_is_empty(&node, (id, face), fixed_z, family_cuts(kept_faces), reach),
                         "a child the box proves empty is not empty"
                     );
                     self.stats.cells_empty += 1;
@@ -1894,7 +1894,7 @@ impl Search<'_, '_> {
                     .max(child_box.map_or(f64::NEG_INFINITY, |b| q.box_lower_bound(&b.0, &b.1)));
                 debug_assert!(
                     *next_id % 8 != 0
-                        || self.child_cost_is_at_least(&node, id, face, fixed_z, family_cuts(kept_faces), bound),
+                        || self.child_cost_is_at_least(&node, (id, face), fixed_z, family_cuts(kept_faces), bound),
                     "a child's key is above its cost"
                 );
                 children.push((node.cost.max(bound), *next_id, face));
@@ -2058,22 +2058,26 @@ impl Search<'_, '_> {
         }
     }
 
+    /// [`Search::child_inequalities`] into a new list (the debug checks below).
+    fn child_list<const D: usize>(&self, id: u32, face: u32, fixed_z: f64, cuts: InsideCuts<D>) -> Vec<Halfspace<D>> {
+        let mut extra = Vec::new();
+        self.child_inequalities::<D>(id, face, fixed_z, cuts, &mut extra);
+        extra
+    }
+
     /// Debug check of a child that the box propagation drops at a split (`cuts`: the family's): the exact phase 1
     /// finds it empty, and its inside cuts are those that the box test per face keeps.
     fn child_is_empty<const D: usize>(
         &self,
         node: &Node<D>,
-        id: u32,
-        face: u32,
+        (id, face): (u32, u32),
         fixed_z: f64,
         cuts: InsideCuts<D>,
         reach: ([f64; D], [f64; D]),
     ) -> bool {
-        let mut extra = Vec::new();
-        self.child_inequalities::<D>(id, face, fixed_z, cuts, &mut extra);
-        let mut by_box = Vec::new();
-        self.child_inequalities::<D>(id, face, fixed_z, InsideCuts::Reach(Some(reach)), &mut by_box);
-        extra == by_box && node.cell.is_empty_with(extra, &node.optimum.point).unwrap_or(false)
+        let extra = self.child_list(id, face, fixed_z, cuts);
+        extra == self.child_list(id, face, fixed_z, InsideCuts::Reach(Some(reach)))
+            && node.cell.is_empty_with(extra, &node.optimum.point).unwrap_or(false)
     }
 
     /// Debug check of a child's key (`cuts`: the family's): the child's cost, when it is not empty, is not below
@@ -2081,14 +2085,12 @@ impl Search<'_, '_> {
     fn child_cost_is_at_least<const D: usize>(
         &self,
         node: &Node<D>,
-        id: u32,
-        face: u32,
+        (id, face): (u32, u32),
         fixed_z: f64,
         cuts: InsideCuts<D>,
         bound: f64,
     ) -> bool {
-        let mut extra = Vec::new();
-        self.child_inequalities::<D>(id, face, fixed_z, cuts, &mut extra);
+        let extra = self.child_list(id, face, fixed_z, cuts);
         let q = restrict_quadratic::<D>(&self.orientations[node.orientation].quadratic, fixed_z);
         match node.cell.with_halfspaces_from(&extra, &node.optimum.point) {
             Ok(Some(cell)) => match minimise(&cell, &q) {

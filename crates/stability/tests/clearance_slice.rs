@@ -19,23 +19,26 @@ fn hull_part(points: &[DVec3]) -> Option<Part> {
     Part::from_components("h", vec![hull.polytope], 1.0, PartOrigin::ConvexPieces).ok()
 }
 
+/// The corners of the box `[lo, hi]`.
+fn cube(lo: DVec3, hi: DVec3) -> Vec<DVec3> {
+    (0..8)
+        .map(|k| {
+            DVec3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            )
+        })
+        .collect()
+}
+
 fn points() -> impl Strategy<Value = Vec<DVec3>> {
     prop_oneof![
         // a random hull of 4-10 points
         prop::collection::vec((-10.0f64..10.0, -10.0f64..10.0, 0.0f64..15.0), 4..10)
             .prop_map(|v| v.into_iter().map(|(x, y, z)| DVec3::new(x, y, z)).collect()),
         // a box, a sliver (one side 1e-4 .. 1e-2 mm) or a plate
-        (1.0f64..20.0, 1e-4f64..20.0, 1.0f64..15.0).prop_map(|(a, b, c)| {
-            (0..8)
-                .map(|k| {
-                    DVec3::new(
-                        if k & 1 == 0 { 0.0 } else { a },
-                        if k & 2 == 0 { 0.0 } else { b },
-                        if k & 4 == 0 { 0.0 } else { c },
-                    )
-                })
-                .collect()
-        }),
+        (1.0f64..20.0, 1e-4f64..20.0, 1.0f64..15.0).prop_map(|(a, b, c)| cube(DVec3::ZERO, DVec3::new(a, b, c))),
     ]
 }
 
@@ -87,18 +90,6 @@ fn pair_distances(pa: &[DVec3], pb: &[DVec3], turn: f64, shift: DVec3) -> (f64, 
     let parts = world_stack(&stack).expect("world");
     let (ca, cb) = (&parts[0].components[0], &parts[1].components[0]);
     (horizontal_distance_bound_by_axes(ca, cb, 1e-9), horizontal_distance(ca, cb).expect("the SOCP solves"))
-}
-
-fn cube(lo: DVec3, hi: DVec3) -> Vec<DVec3> {
-    (0..8)
-        .map(|k| {
-            DVec3::new(
-                if k & 1 == 0 { lo.x } else { hi.x },
-                if k & 2 == 0 { lo.y } else { hi.y },
-                if k & 4 == 0 { lo.z } else { hi.z },
-            )
-        })
-        .collect()
 }
 
 #[test]
