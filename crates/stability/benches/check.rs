@@ -3,10 +3,11 @@
 //! * bricks staggered in a pyramid (one connected group: the worst case for the group decomposition);
 //! * 15 Channel parts as planned by `stackplan plan example:channel` (w = 0.5; `stacks/channel-plan-15.json`);
 //! * 15 copies of each fixture part (Channel, Triangle, Complex, Cube, L-corner, Block) in 5 columns of 3 (lowest resting pose, each part lowered straight onto
-//!   the one below until they touch: Channel 51 mm apart, Triangle nested 4.47 mm apart, Complex 151 mm apart). The
-//!   planner gives no 15-part plan of the Triangle or Complex part yet, so these columns stand in for plans;
+//!   the one below until they touch: Channel 51 mm apart, Triangle nested 4.47 mm apart, Complex 151 mm apart; fixed
+//!   stacks written before the planner planned these parts, kept so that the figures stay comparable);
 //!
-//! then the contact analysis, and equilibrium solves for one added part and for the whole brick stack.
+//! then the contact analysis, equilibrium solves for one added part and for the whole brick stack, and the horizontal
+//! clearance test of the pairs of a planned 15-part Triangle stack (`stacks/triangle-plan-15.json`).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{DMat3, DVec3};
@@ -15,10 +16,13 @@ use stackplan_geom::io::stack::read_stack;
 use stackplan_geom::sheet_metal::Decomposition;
 use stackplan_geom::{Part, PartOrigin, convex_hull};
 use stackplan_stability::check::{CheckOptions, check_stack};
+use stackplan_stability::clearance::{
+    horizontal_distance_at_least, horizontal_distance_bound_by_axes, horizontal_distance_by_slice, vertically_separated,
+};
 use stackplan_stability::contacts::analyse_contacts;
 use stackplan_stability::equilibrium::{EquilibriumOptions, solve_equilibrium};
 use stackplan_stability::resting_poses::resting_poses;
-use stackplan_stability::world::{PlacedPart, stack_tolerance, world_stack};
+use stackplan_stability::world::{PlacedPart, WorldComponent, stack_tolerance, world_stack};
 use std::hint::black_box;
 
 fn box_part(size: DVec3) -> Part {
@@ -150,5 +154,62 @@ fn bench(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, bench, bench_fixtures);
+/// The horizontal clearance test (5 mm) of the 15-part Triangle plan (`stackplan plan example:triangle --w 0.5`,
+/// `stacks/triangle-plan-15.json`: the parts nest, so many pairs come near the clearance), on the pairs `check_stack`
+/// tests: each part at its release position (lifted by its `release_drop`) against the components of the parts
+/// placed before it whose boxes come within the clearance and whose z-ranges overlap. The whole test
+/// (`horizontal_distance_at_least`), and its two filters alone: the separating axes' bound (session 28) and the slice
+/// of the Minkowski difference (which decided these pairs before it).
+fn bench_clearance(c: &mut Criterion) {
+    let plan = read_stack(concat!(env!("CARGO_MANIFEST_DIR"), "/benches/stacks/triangle-plan-15.json")).expect("plan");
+    let placed = |lift: &dyn Fn(usize) -> f64| -> Vec<PlacedPart<'_>> {
+        (plan.placements.iter().enumerate())
+            .map(|(k, p)| PlacedPart {
+                part: &plan.part,
+                rotation: p.rotation,
+                position: p.position + DVec3::Z * lift(k),
+            })
+            .collect()
+    };
+    let drop = |k: usize| plan.extras[k].get("release_drop").and_then(|v| v.as_f64()).expect("release_drop");
+    let rest = world_stack(&placed(&|_| 0.0)).expect("world");
+    let released = world_stack(&placed(&drop)).expect("world");
+    let tol = stack_tolerance(&rest).linear;
+    let delta = 5.0;
+    let near = |a: &(DVec3, DVec3), b: &(DVec3, DVec3)| {
+        (a.0 - b.1).max_element() <= delta && (b.0 - a.1).max_element() <= delta
+    };
+    let mut pairs = Vec::new();
+    for (i, lifted) in released.iter().enumerate() {
+        for below in &rest[..i] {
+            for a in &lifted.components {
+                for b in &below.components {
+                    if near(&a.aabb, &b.aabb) && !vertically_separated(a, b, tol) {
+                        pairs.push((a, b));
+                    }
+                }
+            }
+        }
+    }
+    // the plan keeps its clearance (up to the tolerance), so the test finds no pair closer
+    let closer = |pairs: &[(&WorldComponent, &WorldComponent)]| {
+        let too_close = |(a, b): &&(&WorldComponent, &WorldComponent)| {
+            horizontal_distance_at_least(a, b, delta, tol).is_some_and(|d| d < delta - tol)
+        };
+        pairs.iter().filter(too_close).count()
+    };
+    assert_eq!(closer(&pairs), 0);
+    let name = format!("clearance 15 Triangle (planned, {} pairs)", pairs.len());
+    c.bench_function(&format!("{name}: horizontal_distance_at_least"), |bench| {
+        bench.iter(|| black_box(closer(&pairs)))
+    });
+    c.bench_function(&format!("{name}: separating axes' bound only"), |bench| {
+        bench.iter(|| pairs.iter().map(|(a, b)| horizontal_distance_bound_by_axes(a, b, tol)).fold(0.0, f64::max))
+    });
+    c.bench_function(&format!("{name}: slice only"), |bench| {
+        bench.iter(|| pairs.iter().filter_map(|(a, b)| horizontal_distance_by_slice(a, b, tol)).fold(0.0, f64::max))
+    });
+}
+
+criterion_group!(benches, bench, bench_fixtures, bench_clearance);
 criterion_main!(benches);
