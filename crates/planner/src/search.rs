@@ -2034,7 +2034,7 @@ impl Search<'_, '_> {
         };
         match cuts {
             InsideCuts::Kept(mask) => {
-                // the faces before `face` whose children were pushed, in increasing order
+                // the faces before `face` whose inside cuts are kept, in increasing order
                 let mut before = mask & ((1u128 << face) - 1);
                 while before != 0 {
                     inside_cut(before.trailing_zeros() as usize);
