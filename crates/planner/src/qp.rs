@@ -87,7 +87,7 @@ impl<const D: usize> Quadratic<D> {
     /// relative `1e-9` against rounding, as the other bounds. The constant for an empty, non-finite or NaN box
     /// (a valid bound of any cost). O(D).
     pub fn box_lower_bound(&self, lo: &[f64; D], hi: &[f64; D]) -> f64 {
-        if (0..D).any(|i| lo[i].partial_cmp(&hi[i]).is_none_or(|o| o == std::cmp::Ordering::Greater)) {
+        if (0..D).any(|i| lo[i].is_nan() || hi[i].is_nan() || lo[i] > hi[i]) {
             return self.constant;
         }
         let mut rise = 0.0;

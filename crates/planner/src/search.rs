@@ -331,13 +331,11 @@ struct Buffers<const D: usize> {
     extra: Vec<Halfspace<D>>,
     outside: Vec<Outside<D>>,
     children: Vec<(f64, u64, u32)>,
-    /// The kept inside cuts of the split being pushed (the faces before the current one whose cuts the children keep).
-    kept_cuts: Vec<([f64; D], f64)>,
 }
 
 impl<const D: usize> Default for Buffers<D> {
     fn default() -> Self {
-        Self { extra: Vec::new(), outside: Vec::new(), children: Vec::new(), kept_cuts: Vec::new() }
+        Self { extra: Vec::new(), outside: Vec::new(), children: Vec::new() }
     }
 }
 
@@ -1845,8 +1843,8 @@ impl Search<'_, '_> {
             let mut kept_faces = 0u128;
             let children = &mut buffers.children;
             children.clear();
-            let kept_cuts = &mut buffers.kept_cuts;
-            kept_cuts.clear();
+            // the parent's box tightened by the inside cuts kept so far (in face order)
+            let mut inside_box = reach;
             for &(outside, face) in &buffers.outside {
                 if finite && box_misses_halfspace(&reach, &outside.0, outside.1, tol) {
                     // the id is still taken: the other children's ids, hence the search's order, are unchanged
@@ -1858,10 +1856,7 @@ impl Search<'_, '_> {
                 // outside half-space, each grown by the tolerance, so that it holds the child grown by the
                 // tolerance (the set on which its phase 1 decides emptiness)
                 let child_box = finite.then(|| {
-                    let mut b = reach;
-                    for (n, d) in kept_cuts.iter() {
-                        tighten_box(&mut b, n, d + tol);
-                    }
+                    let mut b = inside_box;
                     tighten_box(&mut b, &outside.0.map(|c| -c), tol - outside.1);
                     b
                 });
@@ -1870,7 +1865,7 @@ impl Search<'_, '_> {
                     kept_faces |= 1 << face;
                 }
                 if finite {
-                    kept_cuts.push(outside);
+                    tighten_box(&mut inside_box, &outside.0, outside.1 + tol);
                 }
                 if child_box.is_some_and(|b| box_is_empty(&b, tol)) {
                     // empty (the box propagation is a relaxation of the phase 1): never pushed, its id still taken

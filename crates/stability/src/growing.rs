@@ -224,7 +224,8 @@ impl<'a> GrowingStack<'a> {
     /// stack's, whose check therefore passes too); [`CheckOptions::contact_tolerance`] when set. The placement search
     /// guarantees the clearance up to its length tolerance measured along obstacle face normals, which is longer
     /// horizontally for nearly horizontal faces; this test makes the plan's own check hold. Errors: a bad pose.
-    /// O(component pairs whose boxes come within `delta`), an SOCP per pair closer than `delta` in projection.
+    /// O(component pairs whose boxes come within `delta`); an SOCP only for the pairs that the cheap filters of
+    /// [`crate::clearance::horizontal_distance_at_least`] leave near or below `delta`.
     pub fn keeps_clearance(
         &self,
         candidate: PlacedPart<'_>,

@@ -7,6 +7,7 @@ mod common;
 
 use glam::{DMat3, DVec3};
 use proptest::prelude::*;
+use stackplan_geom::polytope::ConvexPolytope;
 use stackplan_geom::{Part, PartOrigin, convex_hull};
 use stackplan_stability::PlacedPart;
 use stackplan_stability::clearance::{
@@ -21,15 +22,7 @@ fn hull_part(points: &[DVec3]) -> Option<Part> {
 
 /// The corners of the box `[lo, hi]`.
 fn cube(lo: DVec3, hi: DVec3) -> Vec<DVec3> {
-    (0..8)
-        .map(|k| {
-            DVec3::new(
-                if k & 1 == 0 { lo.x } else { hi.x },
-                if k & 2 == 0 { lo.y } else { hi.y },
-                if k & 4 == 0 { lo.z } else { hi.z },
-            )
-        })
-        .collect()
+    ConvexPolytope::cuboid(lo, hi).expect("box").vertices().to_vec()
 }
 
 fn points() -> impl Strategy<Value = Vec<DVec3>> {
