@@ -190,4 +190,8 @@ fn plan_rejects_bad_requests_without_writing_anything() {
         assert!(stderr(&o).starts_with("error:"), "{args:?}: {}", stderr(&o));
         assert!(!dir.path().join("x").join("plan.json").exists(), "{args:?} wrote a partial plan");
     }
+    // a request the planner cannot meet names the part it was planning
+    let o = run_in(dir.path(), &["plan", "example:channel", "--floor", "0,0,50,50", "--out", "x"]);
+    assert!(stderr(&o).starts_with("error: planning example:channel: "), "{}", stderr(&o));
+    assert!(stderr(&o).contains("too small"), "{}", stderr(&o));
 }

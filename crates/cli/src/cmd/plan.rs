@@ -159,7 +159,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     );
     let planned = run_planner(&part, &options, &mut |done| bar.set_position(done as u64));
     bar.finish_and_clear();
-    let (plan, seconds) = planned?;
+    let (plan, seconds) = planned.with_context(|| format!("planning {}", args.part))?;
 
     // the pictures are drawn from the plan file's text, exactly as `stackplan render` draws them; every output is
     // prepared first, then written atomically: a failure leaves no partial set behind

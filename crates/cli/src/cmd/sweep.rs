@@ -136,7 +136,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
             Ok(p) => p,
             Err(e) => {
                 bar.finish_and_clear();
-                return Err(e.context(format!("sweep at w = {}", options.w)));
+                return Err(e.context(format!("sweeping {} at w = {}", args.part, options.w)));
             }
         };
         let name = format!("plan-w{}.json", options.w);
