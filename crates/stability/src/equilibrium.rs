@@ -16,8 +16,9 @@
 //! so that clarabel sees O(1) data.
 //!
 //! * Equilibrium (`alpha = 0`): minimise `1/2 sum ||f_k||^2` (a unique, minimum-norm force distribution). Solved ->
-//!   [`Verdict::Stable`]; `PrimalInfeasible` -> [`Verdict::Unstable`]; any other status -> [`Verdict::Unknown`],
-//!   never stable.
+//!   [`Verdict::Stable`]; `PrimalInfeasible` -> [`Verdict::Unstable`]; any other status, after the retries of
+//!   `VERDICT_RETRIES` (other solver settings, more iterations) decided neither -> [`Verdict::Unknown`], never
+//!   stable.
 //! * Robustness margin: the largest horizontal load factor `alpha` (a horizontal force `alpha m_i g` at every
 //!   movable part's c.g., the same direction `d` for all — a quasi-static horizontal acceleration of `alpha g`) that
 //!   the stack still resists, minimised over `directions` evenly spaced horizontal directions (8 by default), capped
@@ -110,6 +111,36 @@ const MARGIN_TOLERANCE: f64 = 1e-10;
 
 /// clarabel's default tolerances (`tol_feas`, `tol_gap_abs`, `tol_gap_rel`).
 const DEFAULT_TOLERANCE: f64 = 1e-8;
+
+/// clarabel's default iteration limit.
+const DEFAULT_MAX_ITER: u32 = 200;
+
+/// One configuration of clarabel for a problem: its iterative refinement, its equilibration (Ruiz scaling) and its
+/// iteration limit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Attempt {
+    refine: bool,
+    equilibrate: bool,
+    max_iter: u32,
+}
+
+/// The configurations the equilibrium verdict tries, in order, after a solve that neither solved nor proved
+/// infeasibility (`AlmostSolved`, `AlmostPrimalInfeasible`, `InsufficientProgress`, `MaxIterations`,
+/// `NumericalError`; the first attempt's own configuration is skipped): with refinement, without it, without
+/// equilibration, and with five times the iterations. The same ladder as the margins' ([`Problem::retry_margin`])
+/// plus the longer run; a verdict is `Stable` or `Unstable` only from a `Solved` or `PrimalInfeasible` status at
+/// clarabel's default tolerances, never from an "almost" one.
+const VERDICT_RETRIES: [Attempt; 4] = [
+    Attempt { refine: true, equilibrate: true, max_iter: DEFAULT_MAX_ITER },
+    Attempt { refine: false, equilibrate: true, max_iter: DEFAULT_MAX_ITER },
+    Attempt { refine: true, equilibrate: false, max_iter: DEFAULT_MAX_ITER },
+    Attempt { refine: true, equilibrate: true, max_iter: 5 * DEFAULT_MAX_ITER },
+];
+
+/// Whether a status decides the equilibrium verdict ([`verdict_of`]: stable or unstable).
+fn decides(status: SolverStatus) -> bool {
+    matches!(status, SolverStatus::Solved | SolverStatus::PrimalInfeasible)
+}
 
 /// The status of a margin solve: `Solved` when clarabel reports it, or when a solve at [`MARGIN_TOLERANCE`] stopped
 /// short of it (`AlmostSolved`, `InsufficientProgress`: a step of length 0 near 1e-9) at an iterate that meets
@@ -760,8 +791,33 @@ impl Problem {
     /// Solves the equilibrium problem (no load), with the solver's iterative refinement when `refine`. Returns the
     /// status, the primal solution (forces in the local frames) and the dual variables of the equality rows (after a
     /// `PrimalInfeasible`, the solver's certificate: see `instability::Mechanism::from_dual`).
+    /// A solve that decides nothing is tried again ([`VERDICT_RETRIES`]); the first deciding attempt's answer, or
+    /// the last attempt's.
     fn solve_verdict(&self, refine: bool) -> Result<(SolverStatus, Vec<f64>, Vec<f64>), EquilibriumError> {
-        let mut solver = self.solver_with(None, MARGIN_CAP, refine, true)?;
+        self.solve_verdict_from(Attempt { refine, equilibrate: true, max_iter: DEFAULT_MAX_ITER })
+    }
+
+    /// [`Problem::solve_verdict`] with `first` as the first attempt.
+    fn solve_verdict_from(&self, first: Attempt) -> Result<(SolverStatus, Vec<f64>, Vec<f64>), EquilibriumError> {
+        let mut result = self.attempt_verdict(first)?;
+        for attempt in VERDICT_RETRIES {
+            if decides(result.0) {
+                break;
+            }
+            if attempt == first {
+                continue;
+            }
+            let undecided = result.0;
+            result = self.attempt_verdict(attempt)?;
+            tracing::debug!(?undecided, ?attempt, status = ?result.0, "equilibrium SOCP tried again");
+        }
+        Ok(result)
+    }
+
+    /// One solve of the equilibrium problem with the configuration `attempt`: its status, primal solution and the
+    /// dual variables of the equality rows.
+    fn attempt_verdict(&self, attempt: Attempt) -> Result<(SolverStatus, Vec<f64>, Vec<f64>), EquilibriumError> {
+        let mut solver = self.solver_for(None, MARGIN_CAP, attempt)?;
         solver.solve();
         let dual = solver.solution.z.iter().take(self.rhs.len()).copied().collect();
         Ok((solver.solution.status, solver.solution.x.clone(), dual))
@@ -848,6 +904,16 @@ impl Problem {
         refine: bool,
         equilibrate: bool,
     ) -> Result<DefaultSolver<f64>, EquilibriumError> {
+        self.solver_for(load, cap, Attempt { refine, equilibrate, max_iter: DEFAULT_MAX_ITER })
+    }
+
+    /// [`Problem::solver`] in the configuration `attempt`.
+    fn solver_for(
+        &self,
+        load: Option<DVec3>,
+        cap: f64,
+        attempt: Attempt,
+    ) -> Result<DefaultSolver<f64>, EquilibriumError> {
         let nf = 3 * self.n_points;
         let n = nf + usize::from(load.is_some());
         let (a, (b, cones)) = self.constraints(load, cap);
@@ -865,8 +931,9 @@ impl Problem {
         let tolerance = if load.is_some() { MARGIN_TOLERANCE } else { DEFAULT_TOLERANCE };
         let settings = DefaultSettingsBuilder::default()
             .verbose(false)
-            .iterative_refinement_enable(refine)
-            .equilibrate_enable(equilibrate)
+            .iterative_refinement_enable(attempt.refine)
+            .equilibrate_enable(attempt.equilibrate)
+            .max_iter(attempt.max_iter)
             .tol_feas(tolerance)
             .tol_gap_abs(tolerance)
             .tol_gap_rel(tolerance)
@@ -940,5 +1007,115 @@ impl Problem {
             row += 3;
         }
         (CscMatrix::new_from_triplets(row, n, ri, ci, vi), (b, cones))
+    }
+}
+
+#[cfg(test)]
+mod retry_tests {
+    use super::*;
+
+    fn body(cg: DVec3) -> Rigid {
+        Rigid { mass: 1.5, cg, aabb: (DVec3::new(-50.0, -50.0, 0.0), DVec3::new(50.0, 50.0, 60.0)) }
+    }
+
+    const SHORT: Attempt = Attempt { refine: true, equilibrate: true, max_iter: 1 };
+    const PLAIN: Attempt = Attempt { refine: true, equilibrate: true, max_iter: DEFAULT_MAX_ITER };
+
+    /// The largest violation, relative to the body's weight (and its weight times the problem's length unit for the
+    /// moments), of the balance of forces and moments and of the friction cones by the forces of a solve: checked
+    /// here from the forces alone, not from the solver's status.
+    fn violation(problem: &Problem, b: &Rigid, points: &[&Point], x: &[f64], mu: f64) -> f64 {
+        let (mut force, mut moment, mut cone) = (DVec3::ZERO, DVec3::ZERO, 0.0f64);
+        for (k, pt) in points.iter().enumerate() {
+            let (n, t1, t2) = (x[3 * k], x[3 * k + 1], x[3 * k + 2]);
+            let f = (pt.frame[0] * n + pt.frame[1] * t1 + pt.frame[2] * t2) * problem.force_scale;
+            force += f;
+            moment += (pt.p - b.cg).cross(f);
+            cone = cone.max((t1.hypot(t2) - mu * n) * problem.force_scale).max(-n * problem.force_scale);
+        }
+        let weight = b.mass;
+        ((force - weight * DVec3::Z).length() / weight)
+            .max(moment.length() / (weight * problem.length_scale))
+            .max(cone / weight)
+    }
+
+    /// A first attempt cut short (one iteration) decides nothing; the retries decide it as one default solve does:
+    /// a body over three supports (stable) and beside them (unstable).
+    #[test]
+    fn the_retries_decide_what_a_first_attempt_cut_short_leaves_open() {
+        let points = [
+            test_point(DVec3::new(-20.0, -20.0, 0.0), DVec3::Z),
+            test_point(DVec3::new(20.0, -20.0, 0.0), DVec3::Z),
+            test_point(DVec3::new(0.0, 20.0, 0.0), DVec3::Z),
+        ];
+        let refs: Vec<&Point> = points.iter().collect();
+        for (cg, stable) in [(DVec3::new(0.0, 0.0, 10.0), true), (DVec3::new(40.0, 0.0, 10.0), false)] {
+            let problem = Problem::new(&[body(cg)], &[0], &refs, 0.5);
+            let (alone, _, _) = problem.attempt_verdict(SHORT).expect("solve");
+            assert!(!decides(alone), "one iteration decided {alone:?}");
+            let (status, x, _) = problem.solve_verdict_from(SHORT).expect("solve");
+            let (reference, _, _) = problem.attempt_verdict(PLAIN).expect("solve");
+            assert_eq!(status, reference);
+            assert_eq!(verdict_of(status).is_stable(), stable, "{status:?}");
+            if stable {
+                assert!(violation(&problem, &body(cg), &refs, &x, 0.5) < 1e-6);
+            }
+        }
+    }
+
+    /// A deterministic sample of bodies on random supports (points up, inclined and on the side, as the certificates'
+    /// sample of `instability`): the retries decide every problem that one default solve decides, the same way, and
+    /// some that it leaves open (35 of 600 here, all on two support points: `AlmostPrimalInfeasible` or
+    /// `InsufficientProgress` after one solve). Each verdict is checked apart from the solver's status: the forces of
+    /// every stable one balance the body and lie in their cones, and every unstable one that the retries decided is
+    /// proved by the solver's certificate as a mechanism (`instability::Mechanism`).
+    #[test]
+    fn the_retries_decide_more_of_a_random_sample_and_agree_with_single_solves() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = |lo: f64, hi: f64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            lo + (hi - lo) * (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut single, mut retried, mut stable) = (0, 0, 0);
+        for _ in 0..600 {
+            let k = next(1.0, 8.0) as usize;
+            let points: Vec<Point> = (0..k)
+                .map(|_| {
+                    let p = DVec3::new(next(-30.0, 30.0), next(-30.0, 30.0), next(0.0, 30.0));
+                    let kind = next(0.0, 1.0);
+                    let n = if kind < 0.5 {
+                        DVec3::Z
+                    } else if kind < 0.8 {
+                        DVec3::new(next(-1.0, 1.0), next(-1.0, 1.0), 0.4)
+                    } else {
+                        DVec3::new(next(-1.0, 1.0), next(-1.0, 1.0), 0.05)
+                    };
+                    test_point(p, n)
+                })
+                .collect();
+            let b = body(DVec3::new(next(-45.0, 45.0), next(-45.0, 45.0), next(10.0, 50.0)));
+            let mu = next(0.0, 1.2);
+            let refs: Vec<&Point> = points.iter().collect();
+            let problem = Problem::new(&[b], &[0], &refs, mu);
+            let (once, _, _) = problem.attempt_verdict(PLAIN).expect("solve");
+            let (status, x, dual) = problem.solve_verdict(true).expect("solve");
+            if decides(once) {
+                single += 1;
+                assert_eq!(status, once, "a decided verdict changed");
+            } else if status == SolverStatus::PrimalInfeasible {
+                let mechanism = instability::Mechanism::from_dual(&[b], &[0], problem.length_scale, &dual);
+                assert!(mechanism.proves(&[b], &[0], &refs, mu), "a retried unstable verdict without a proof");
+            }
+            retried += usize::from(decides(status));
+            if status == SolverStatus::Solved {
+                stable += 1;
+                let v = violation(&problem, &b, &refs, &x, mu);
+                assert!(v < 1e-6, "a stable verdict's forces violate balance or cones by {v:e}");
+            }
+        }
+        assert!(stable >= 50, "only {stable} of 600 stable");
+        assert!(retried >= single + 20, "{retried} decided with retries, {single} without");
     }
 }
