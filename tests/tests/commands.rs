@@ -173,6 +173,15 @@ fn plan_writes_every_output_and_check_accepts_the_plan() {
     assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
     let html = std::fs::read_to_string(dir.path().join("p/report.html")).expect("html");
     assert!(html.contains("<table id=\"parts\">") && html.contains("stack.png"));
+    // a release drop that is not a finite non-negative number is an error that names the file and the placement
+    for bad in [serde_json::json!(-1.0), serde_json::json!("x"), serde_json::json!(null)] {
+        let mut edited = plan.clone();
+        edited["placements"][2]["release_drop"] = bad.clone();
+        std::fs::write(dir.path().join("bad.json"), edited.to_string()).expect("write");
+        let o = run_in(dir.path(), &["check", "bad.json"]);
+        assert_eq!(o.status.code(), Some(2), "{bad}: {}", stderr(&o));
+        assert!(stderr(&o).contains("bad.json: placements[2].release_drop"), "{bad}: {}", stderr(&o));
+    }
 }
 
 #[test]

@@ -10,7 +10,7 @@ use serde::Serialize;
 use stackplan::stability::check::{CheckOptions, StackCheck, check_stack};
 use stackplan::stability::grasp::GraspOptions;
 use stackplan::stability::world::PlacedPart;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Arguments of `check`.
 #[derive(Debug, clap::Args)]
@@ -51,15 +51,24 @@ pub struct CheckJson {
 }
 
 /// The placements' `release_drop` (a plan file's parts released above their supports), or none when no placement
-/// has one (then the clearance is checked symmetrically at the given positions).
-fn release_drops(extras: &[serde_json::Map<String, serde_json::Value>]) -> Vec<f64> {
+/// has one (then the clearance is checked symmetrically at the given positions); a placement without one drops 0.
+/// Errors name the file and the placement of a value that is not a finite non-negative number.
+fn release_drops(path: &Path, extras: &[serde_json::Map<String, serde_json::Value>]) -> anyhow::Result<Vec<f64>> {
     if extras.iter().all(|e| !e.contains_key("release_drop")) {
-        return Vec::new();
+        return Ok(Vec::new());
     }
-    // a malformed value is passed on as NaN, which the check rejects with a typed error
     extras
         .iter()
-        .map(|e| e.get("release_drop").map_or(Some(0.0), serde_json::Value::as_f64).unwrap_or(f64::NAN))
+        .enumerate()
+        .map(|(k, e)| match e.get("release_drop") {
+            None => Ok(0.0),
+            Some(value) => value.as_f64().filter(|d| d.is_finite() && *d >= 0.0).ok_or_else(|| {
+                anyhow::anyhow!(
+                    "{}: placements[{k}].release_drop must be a finite non-negative number (mm), got {value}",
+                    path.display()
+                )
+            }),
+        })
         .collect()
 }
 
@@ -90,7 +99,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         margin_directions: args.margin_directions,
         contact_tolerance: args.contact_tolerance,
         prefix_stability: true,
-        release_drops: release_drops(&file.extras),
+        release_drops: release_drops(&args.stack, &file.extras)?,
     };
     let report = check_stack(&stack, &options)?;
     let ok = report.ok;
