@@ -96,6 +96,18 @@ fn test_point(p: DVec3, normal: DVec3) -> Point {
     Point { patch: 0, p, frame: [n, t1, t2], a: None, b: 0 }
 }
 
+/// Uniform numbers in `[lo, hi)` from a xorshift64 sequence started at `state` (the deterministic samples of the
+/// certificates' and the verdict retries' tests).
+#[cfg(test)]
+fn test_uniform(mut state: u64) -> impl FnMut(f64, f64) -> f64 {
+    move |lo, hi| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        lo + (hi - lo) * (state >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 /// Margin directions solved one after the other with one reused solver (see `Problem::solve_loads`).
 const DIRECTIONS_PER_SOLVER: usize = 4;
 
@@ -1071,13 +1083,7 @@ mod retry_tests {
     /// proved by the solver's certificate as a mechanism (`instability::Mechanism`).
     #[test]
     fn the_retries_decide_more_of_a_random_sample_and_agree_with_single_solves() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = |lo: f64, hi: f64| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            lo + (hi - lo) * (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = test_uniform(0x2545_f491_4f6c_dd1du64);
         let (mut single, mut retried, mut stable) = (0, 0, 0);
         for _ in 0..600 {
             let k = next(1.0, 8.0) as usize;

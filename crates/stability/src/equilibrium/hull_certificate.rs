@@ -115,13 +115,7 @@ mod tests {
     /// the SOCP.
     #[test]
     fn certified_bodies_of_a_sample_are_stable_by_the_socp() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = |lo: f64, hi: f64| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            lo + (hi - lo) * (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = super::super::test_uniform(0x2545_f491_4f6c_dd1du64);
         let mut certified = 0;
         for _ in 0..300 {
             let k = next(3.0, 9.0) as usize;

@@ -457,13 +457,7 @@ mod tests {
     /// and many infeasible ones give a mechanism that proves them.
     #[test]
     fn certificates_of_a_sample_fire_and_agree_with_the_socp() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = |lo: f64, hi: f64| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            lo + (hi - lo) * (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = super::super::test_uniform(0x9e37_79b9_7f4a_7c15u64);
         let (mut tipped, mut infeasible, mut proved) = (0, 0, 0);
         for _ in 0..400 {
             let k = next(2.0, 8.0) as usize;
