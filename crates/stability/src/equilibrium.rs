@@ -136,17 +136,24 @@ struct Attempt {
     max_iter: u32,
 }
 
+/// clarabel's defaults (with iterative refinement and equilibration).
+const DEFAULT_ATTEMPT: Attempt = Attempt { refine: true, equilibrate: true, max_iter: DEFAULT_MAX_ITER };
+
+/// The configurations a margin solve tries, in order, after one that did not end `Solved` ([`Problem::retry_margin`]):
+/// clarabel's defaults on a fresh solver, without iterative refinement, without equilibration.
+const MARGIN_RETRIES: [Attempt; 3] =
+    [DEFAULT_ATTEMPT, Attempt { refine: false, ..DEFAULT_ATTEMPT }, Attempt { equilibrate: false, ..DEFAULT_ATTEMPT }];
+
 /// The configurations the equilibrium verdict tries, in order, after a solve that neither solved nor proved
 /// infeasibility (`AlmostSolved`, `AlmostPrimalInfeasible`, `InsufficientProgress`, `MaxIterations`,
-/// `NumericalError`; the first attempt's own configuration is skipped): with refinement, without it, without
-/// equilibration, and with five times the iterations. The same ladder as the margins' ([`Problem::retry_margin`])
-/// plus the longer run; a verdict is `Stable` or `Unstable` only from a `Solved` or `PrimalInfeasible` status at
-/// clarabel's default tolerances, never from an "almost" one.
+/// `NumericalError`; the first attempt's own configuration is skipped): the margins' ladder ([`MARGIN_RETRIES`]) and
+/// then five times the iterations. A verdict is `Stable` or `Unstable` only from a `Solved` or `PrimalInfeasible`
+/// status at clarabel's default tolerances, never from an "almost" one.
 const VERDICT_RETRIES: [Attempt; 4] = [
-    Attempt { refine: true, equilibrate: true, max_iter: DEFAULT_MAX_ITER },
-    Attempt { refine: false, equilibrate: true, max_iter: DEFAULT_MAX_ITER },
-    Attempt { refine: true, equilibrate: false, max_iter: DEFAULT_MAX_ITER },
-    Attempt { refine: true, equilibrate: true, max_iter: 5 * DEFAULT_MAX_ITER },
+    MARGIN_RETRIES[0],
+    MARGIN_RETRIES[1],
+    MARGIN_RETRIES[2],
+    Attempt { max_iter: 5 * DEFAULT_MAX_ITER, ..DEFAULT_ATTEMPT },
 ];
 
 /// Whether a status decides the equilibrium verdict ([`verdict_of`]: stable or unstable).
@@ -803,10 +810,11 @@ impl Problem {
     /// Solves the equilibrium problem (no load), with the solver's iterative refinement when `refine`. Returns the
     /// status, the primal solution (forces in the local frames) and the dual variables of the equality rows (after a
     /// `PrimalInfeasible`, the solver's certificate: see `instability::Mechanism::from_dual`).
+    ///
     /// A solve that decides nothing is tried again ([`VERDICT_RETRIES`]); the first deciding attempt's answer, or
     /// the last attempt's.
     fn solve_verdict(&self, refine: bool) -> Result<(SolverStatus, Vec<f64>, Vec<f64>), EquilibriumError> {
-        self.solve_verdict_from(Attempt { refine, equilibrate: true, max_iter: DEFAULT_MAX_ITER })
+        self.solve_verdict_from(Attempt { refine, ..DEFAULT_ATTEMPT })
     }
 
     /// [`Problem::solve_verdict`] with `first` as the first attempt.
@@ -888,11 +896,11 @@ impl Problem {
         fresh_already: bool,
     ) -> Result<(SolverStatus, f64), EquilibriumError> {
         let mut last = (SolverStatus::Unsolved, 0.0);
-        for (refine, equilibrate) in [(true, true), (false, true), (true, false)] {
-            if refine && equilibrate && fresh_already {
+        for attempt in MARGIN_RETRIES {
+            if attempt == DEFAULT_ATTEMPT && fresh_already {
                 continue;
             }
-            let mut solver = self.solver_with(Some(load), cap, refine, equilibrate)?;
+            let mut solver = self.solver_for(Some(load), cap, attempt)?;
             solver.solve();
             let x = &solver.solution.x;
             last = (margin_status(&solver), x[x.len() - 1]);
@@ -905,18 +913,7 @@ impl Problem {
 
     /// A clarabel solver for the equilibrium problem (`load = None`) or the margin problem for direction `d`.
     fn solver(&self, load: Option<DVec3>, cap: f64) -> Result<DefaultSolver<f64>, EquilibriumError> {
-        self.solver_with(load, cap, true, true)
-    }
-
-    /// [`Problem::solver`] with the solver's iterative refinement and its equilibration (Ruiz scaling) on or off.
-    fn solver_with(
-        &self,
-        load: Option<DVec3>,
-        cap: f64,
-        refine: bool,
-        equilibrate: bool,
-    ) -> Result<DefaultSolver<f64>, EquilibriumError> {
-        self.solver_for(load, cap, Attempt { refine, equilibrate, max_iter: DEFAULT_MAX_ITER })
+        self.solver_for(load, cap, DEFAULT_ATTEMPT)
     }
 
     /// [`Problem::solver`] in the configuration `attempt`.
@@ -1031,7 +1028,7 @@ mod retry_tests {
     }
 
     const SHORT: Attempt = Attempt { refine: true, equilibrate: true, max_iter: 1 };
-    const PLAIN: Attempt = Attempt { refine: true, equilibrate: true, max_iter: DEFAULT_MAX_ITER };
+    const PLAIN: Attempt = DEFAULT_ATTEMPT;
 
     /// The largest violation, relative to the body's weight (and its weight times the problem's length unit for the
     /// moments), of the balance of forces and moments and of the friction cones by the forces of a solve: checked
