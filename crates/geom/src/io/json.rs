@@ -10,8 +10,10 @@
 //! [`super::MAX_COORDINATE`]. Parsing is O(file size); building costs one hull per piece.
 //!
 //! The writer emits the convex-pieces form with every component's vertices. Floats are printed with the shortest
-//! representation that parses back to the same `f64` (serde_json uses ryu), and the hull of a polytope's vertices
-//! is the polytope itself, so any part round-trips exactly (its origin becomes `ConvexPieces`).
+//! representation that parses back to the same `f64` (serde_json uses ryu), so a part reads back as its exact form:
+//! the exact hull of each component's vertices, which has the component's vertices and faces (as sets; the order is
+//! the hull's) when its faces are exactly planar (parts read from files) and splits a face that is planar only to
+//! rounding (a rotated sheet-metal face) into its exact facets. Its origin becomes `ConvexPieces`.
 
 use super::{IoError, Place, ReadOptions, check_coordinate, resolve_density, stem_name};
 use crate::hull::convex_hull;

@@ -85,6 +85,31 @@ enum Defect {
 
 /// Splits triangles into closed shells. See the module documentation. Triangles with a repeated vertex are dropped.
 /// Returns the shells and, per shell, the first open edge found (a polygon index within the shell), if any.
+/// The faces a writer emits for a convex component with vertices `points`: those of the exact convex hull of the
+/// points (each face's vertex indices into `points`, counter-clockwise seen from outside, and its outward unit
+/// normal), which is what the readers rebuild, so that every written polygon lies exactly in a face plane of the
+/// hull the reader computes ([`convex_shell`]). A component's own faces can be coplanar only to rounding (a
+/// sheet-metal face after rotation: the Triangle example's quadrilaterals are 5e-11 out of plane); the hull splits
+/// such a face into its exact facets. `None` when the points have no 3-D hull (the caller then writes the
+/// component's own faces). O(n log n) expected.
+pub(crate) fn exact_hull_faces(points: &[DVec3]) -> Option<Vec<(Vec<usize>, DVec3)>> {
+    let hull = convex_hull(points).ok()?;
+    Some(
+        hull.polytope
+            .faces()
+            .iter()
+            .map(|f| (f.vertices.iter().map(|&v| hull.source[v]).collect(), f.plane.normal))
+            .collect(),
+    )
+}
+
+/// [`exact_hull_faces`] of a component, else its own faces.
+pub(crate) fn written_faces(component: &ConvexPolytope, points: &[DVec3]) -> Vec<(Vec<usize>, DVec3)> {
+    exact_hull_faces(points).unwrap_or_else(|| {
+        component.faces().iter().map(|f| (f.vertices.iter().copied().collect(), f.plane.normal)).collect()
+    })
+}
+
 pub(crate) fn split_shells(points: &[DVec3], triangles: Vec<MeshPolygon>) -> Vec<(Shell, Option<usize>)> {
     let triangles: Vec<MeshPolygon> = triangles
         .into_iter()

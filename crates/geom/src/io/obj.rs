@@ -8,11 +8,13 @@
 //! `vn`, `vp`, `s`, `usemtl`, `mtllib`, `l`, `p` and other statements are ignored; `#` starts a comment. Vertices are
 //! welded by exact coordinates. O(file size) parsing.
 //!
-//! **Writing.** One `o piece_<i>` per component with its vertices and polygonal faces (counter-clockwise seen from
-//! outside, 1-based absolute indices). Coordinates use Rust's shortest round-trip `f64` formatting, so a part read
-//! back is identical component by component.
+//! **Writing.** One `o piece_<i>` per component with its vertices and the faces of their exact convex hull
+//! (counter-clockwise seen from outside, 1-based absolute indices; [`super::mesh::exact_hull_faces`]), the faces the
+//! reader rebuilds. Coordinates use Rust's shortest round-trip `f64` formatting, so a part reads back as its exact
+//! form, component by component (the part's vertices and faces, as sets, when its faces are exactly planar; see the
+//! JSON writer).
 
-use super::mesh::{MeshPolygon, Shell, Welder, part_from_shells};
+use super::mesh::{MeshPolygon, Shell, Welder, part_from_shells, written_faces};
 use super::{IoError, Place, ReadOptions, check_coordinate, stem_name};
 use crate::part::Part;
 use crate::pose::Pose;
@@ -109,8 +111,8 @@ pub fn obj_string(part: &Part) -> String {
         for v in c.vertices() {
             let _ = writeln!(s, "v {:?} {:?} {:?}", v.x, v.y, v.z);
         }
-        for f in c.faces() {
-            let idx: Vec<String> = f.vertices.iter().map(|&v| (v + base).to_string()).collect();
+        for (face, _) in written_faces(c, c.vertices()) {
+            let idx: Vec<String> = face.iter().map(|&v| (v + base).to_string()).collect();
             let _ = writeln!(s, "f {}", idx.join(" "));
         }
         base += c.vertices().len();
@@ -129,12 +131,12 @@ pub fn obj_scene_string(items: &[(&Part, Pose)]) -> String {
         let name: String = part.name.chars().map(|c| if c.is_whitespace() { '_' } else { c }).collect();
         for (j, c) in part.components.iter().enumerate() {
             let _ = writeln!(s, "o {name}_{i}_piece_{j}");
-            for v in c.vertices() {
-                let w = pose.apply(*v);
+            let world: Vec<DVec3> = c.vertices().iter().map(|v| pose.apply(*v)).collect();
+            for w in &world {
                 let _ = writeln!(s, "v {:?} {:?} {:?}", w.x, w.y, w.z);
             }
-            for f in c.faces() {
-                let idx: Vec<String> = f.vertices.iter().map(|&v| (v + base).to_string()).collect();
+            for (face, _) in written_faces(c, &world) {
+                let idx: Vec<String> = face.iter().map(|&v| (v + base).to_string()).collect();
                 let _ = writeln!(s, "f {}", idx.join(" "));
             }
             base += c.vertices().len();

@@ -9,12 +9,14 @@
 //! is decomposed on request): see [`super::mesh`]. Binary coordinates are `f32`, widened exactly to `f64`. Normals in
 //! the file are ignored (the winding order defines the outside). O(file size) parsing.
 //!
-//! **Writing.** Every face of every component is fanned from its first vertex into triangles (faces are strictly
-//! convex, so no fan triangle is degenerate), with the face's outward normal. Binary STL stores `f32`, so it is exact
-//! only for coordinates representable in `f32`; ASCII STL is written with the shortest text that parses back to the
-//! same `f64`, so it round-trips any part exactly.
+//! **Writing.** Every face of the exact convex hull of each component's vertices (the faces the reader rebuilds;
+//! [`super::mesh::exact_hull_faces`]) is fanned from its first vertex into triangles (hull faces are strictly convex,
+//! so no fan triangle is degenerate), with the face's outward normal. ASCII STL is written with the shortest text
+//! that parses back to the same `f64`, so a part reads back as its exact form (see the JSON writer). Binary STL
+//! stores `f32`: the vertices are rounded first and the hull taken of the rounded points, so the file reads back as
+//! the exact form of the rounded part (the same as ASCII's for coordinates representable in `f32`).
 
-use super::mesh::{MeshPolygon, Welder, part_from_shells, split_shells};
+use super::mesh::{MeshPolygon, Welder, part_from_shells, split_shells, written_faces};
 use super::{IoError, Place, ReadOptions, check_coordinate, stem_name};
 use crate::part::Part;
 use glam::DVec3;
@@ -197,15 +199,17 @@ fn parse_ascii(bytes: &[u8], file: &Path, welder: &mut Welder) -> Result<(Option
     Ok((name, triangles))
 }
 
-/// Fan triangles `(a, b, c, outward normal)` of every face of every component.
-fn triangles(part: &Part) -> Vec<[DVec3; 4]> {
+/// Fan triangles `(a, b, c, outward normal)` of every written face ([`written_faces`]: those of the exact hull of the
+/// component's vertices) of every component; with `single`, of the vertices rounded to `f32` first (the binary
+/// format's coordinates), so that the triangles lie in face planes of the hull the reader computes from them.
+fn triangles(part: &Part, single: bool) -> Vec<[DVec3; 4]> {
     let mut out = Vec::new();
     for c in &part.components {
-        let v = c.vertices();
-        for f in c.faces() {
-            let idx = &f.vertices;
+        let v: Vec<DVec3> =
+            if single { c.vertices().iter().map(|p| p.as_vec3().as_dvec3()).collect() } else { c.vertices().to_vec() };
+        for (idx, normal) in written_faces(c, &v) {
             for w in idx[1..].windows(2) {
-                out.push([v[idx[0]], v[w[0]], v[w[1]], f.plane.normal]);
+                out.push([v[idx[0]], v[w[0]], v[w[1]], normal]);
             }
         }
     }
@@ -214,7 +218,7 @@ fn triangles(part: &Part) -> Vec<[DVec3; 4]> {
 
 /// The part as binary STL bytes (coordinates rounded to `f32`).
 pub fn stl_binary_bytes(part: &Part) -> Vec<u8> {
-    let tris = triangles(part);
+    let tris = triangles(part, true);
     let mut out = Vec::with_capacity(84 + 50 * tris.len());
     let mut header = format!("stackplan binary STL: {}", part.name).into_bytes();
     header.resize(80, 0);
@@ -236,7 +240,7 @@ pub fn stl_ascii_string(part: &Part) -> String {
     let name: String = part.name.chars().map(|c| if c.is_whitespace() { '_' } else { c }).collect();
     let mut s = String::new();
     let _ = writeln!(s, "solid {name}");
-    for [a, b, c, n] in triangles(part) {
+    for [a, b, c, n] in triangles(part, false) {
         let _ = writeln!(s, "  facet normal {:e} {:e} {:e}", n.x, n.y, n.z);
         let _ = writeln!(s, "    outer loop");
         for p in [a, b, c] {
