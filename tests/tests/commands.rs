@@ -82,7 +82,11 @@ fn cspace_extrapolated_obstacle_equals_the_built_one_inside_its_interval() {
     // the channel's box pieces change structure when their sides align (every 90 degrees): 100 is outside
     let outside = with(&["--theta-deg", "100", "--extrapolate-from", "10"]);
     assert!(!outside.status.success());
-    assert!(stderr(&outside).contains("outside the constant-structure interval"), "{}", stderr(&outside));
+    // in the options' unit, degrees, naming the options
+    let message = stderr(&outside);
+    assert!(message.contains("--theta-deg 100 is outside the constant-structure interval ["), "{message}");
+    assert!(message.contains("] degrees of the obstacle built at --extrapolate-from 10"), "{message}");
+    assert!(!message.contains("rad"), "{message}");
 }
 
 #[test]
@@ -150,6 +154,11 @@ fn check_accepts_a_column_and_rejects_an_overlap() {
     let stack = write_stack(dir.path(), &[[0.0, 0.0, 0.0], [0.0, 0.0, 0.5]]);
     let o = run(&["check", stack.to_str().expect("utf-8"), "--cup-diameter", "0.5", "--json"]);
     assert_eq!(o.status.code(), Some(1), "an interfering stack fails the check: {}", stdout(&o));
+    // -q: the exit status alone, without the table; JSON asked for is still printed
+    let o = run(&["check", stack.to_str().expect("utf-8"), "--cup-diameter", "0.5", "-q"]);
+    assert_eq!((o.status.code(), stdout(&o).as_str()), (Some(1), ""), "check -q prints nothing");
+    let o = run(&["check", stack.to_str().expect("utf-8"), "--cup-diameter", "0.5", "-q", "--json"]);
+    assert_eq!(json(&o)["ok"], false);
     let o = run(&["check", "no/such/stack.json"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("no/such/stack.json"), "{}", stderr(&o));
@@ -203,4 +212,27 @@ fn plan_rejects_bad_requests_without_writing_anything() {
     let o = run_in(dir.path(), &["plan", "example:channel", "--floor", "0,0,50,50", "--out", "x"]);
     assert!(stderr(&o).starts_with("error: planning example:channel: "), "{}", stderr(&o));
     assert!(stderr(&o).contains("too small"), "{}", stderr(&o));
+}
+
+/// The text table of `contacts` gives the extremal bounds in the JSON's units, mm and radians, and says so (the
+/// bounds on the command line are in degrees).
+#[test]
+fn contacts_table_names_its_units() {
+    let o = run(&[
+        "contacts",
+        "example:cube",
+        "example:cube",
+        "--t-min=-0.2,-0.2,0.99,-2,-2,-2",
+        "--t-max=0.2,0.2,1.05,2,2,2",
+        "--population",
+        "8",
+        "--generations",
+        "5",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    let header = text.lines().nth(1).expect("a header line");
+    assert!(header.contains("lower bounds [x y z (mm) rx ry rz (rad)]"), "{header}");
+    // a feasible cube-on-cube state tilts up to 2 degrees = 3.491e-2 rad
+    assert!(text.contains("3.491e-2") && !text.contains("2.000e0"), "{text}");
 }

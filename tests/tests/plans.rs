@@ -65,6 +65,23 @@ fn render_names_the_file_of_a_malformed_plan_and_writes_nothing() {
     let mut wrong_count = good.clone();
     wrong_count["plan"]["placed"] = Value::from(9);
     write("wrong-count.json", &wrong_count);
+    // a `plan` that is not an object is a malformed summary, not a missing one
+    for (name, summary) in [("plan-string.json", serde_json::json!("x")), ("plan-array.json", serde_json::json!([1]))] {
+        let mut v = good.clone();
+        v["plan"] = summary;
+        write(name, &v);
+    }
+    // `placed` must be there and be the number of placements
+    let mut no_placed = good.clone();
+    no_placed["plan"].as_object_mut().expect("summary").remove("placed");
+    write("no-placed.json", &no_placed);
+    for (name, placed) in
+        [("placed-text.json", serde_json::json!("abc")), ("placed-negative.json", serde_json::json!(-4))]
+    {
+        let mut v = good.clone();
+        v["plan"]["placed"] = placed;
+        write(name, &v);
+    }
     let mut bad_rotation = good.clone();
     bad_rotation["placements"][1]["rotation"][0][0] = Value::from(2.0);
     write("bad-rotation.json", &bad_rotation);
@@ -73,7 +90,15 @@ fn render_names_the_file_of_a_malformed_plan_and_writes_nothing() {
     let cases = [
         ("no-summary.json", "not a plan file"),
         ("bad-summary.json", "malformed plan: key `plan`"),
-        ("wrong-count.json", "there are 4 placements"),
+        (
+            "wrong-count.json",
+            "malformed plan: key `plan.placed`: the summary says 9 parts were placed, but there are 4",
+        ),
+        ("plan-string.json", "malformed plan: key `plan`: expected the plan summary (an object), got a string"),
+        ("plan-array.json", "malformed plan: key `plan`: expected the plan summary (an object), got an array"),
+        ("no-placed.json", "malformed plan: key `plan.placed`: missing"),
+        ("placed-text.json", "malformed plan: key `plan.placed`: expected the number of placed parts"),
+        ("placed-negative.json", "malformed plan: key `plan.placed`: expected the number of placed parts"),
         ("bad-rotation.json", "placement 1"),
         ("truncated.json", "truncated.json"),
         ("missing.json", "cannot read"),
@@ -88,6 +113,16 @@ fn render_names_the_file_of_a_malformed_plan_and_writes_nothing() {
     }
     let o = run_in(dir.path(), &["render", "p/plan.json"]);
     assert_eq!(o.status.code(), Some(2), "render with nothing to write is an error");
+    // `check` reads the same summary (for its options) and rejects one that is not an object the same way
+    for file in ["plan-string.json", "plan-array.json"] {
+        let o = run_in(dir.path(), &["check", file]);
+        assert_eq!(o.status.code(), Some(2), "{file}: {}", stderr(&o));
+        assert!(
+            stderr(&o).starts_with(&format!("error: {file}: malformed plan: key `plan`: ")),
+            "{file}: {}",
+            stderr(&o)
+        );
+    }
 }
 
 #[test]
@@ -149,6 +184,7 @@ fn sweep_writes_a_plan_per_weight_with_its_layers() {
     // bad weights are refused before planning
     let o = run_in(dir.path(), &["sweep", "example:cube", "--w-values", "0,2", "--out", "bad"]);
     assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--w-values must lie in [0, 1], got 2"), "names the option: {}", stderr(&o));
     assert!(!dir.path().join("bad").exists());
 }
 
@@ -332,6 +368,8 @@ fn the_default_floor_has_room_beside_a_square_part() {
     let dir = tempfile::tempdir().expect("tempdir");
     let o = run_in(dir.path(), &["plan", "example:block", "-q"]);
     assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
+    // -q: only errors, so not even the summary line
+    assert_eq!(stdout(&o), "", "plan -q prints nothing");
     let plan = read_json(&dir.path().join("out/plan.json"));
     assert_eq!(plan["plan"]["placed"], 15, "{}", plan["plan"]["stopped"]);
     assert_eq!(plan["plan"]["options"]["floor"]["polygon"][0], serde_json::json!([-125.0, -125.0]));

@@ -29,7 +29,8 @@ pub struct Cli {
     /// More logging (-v: info, -vv: debug, -vvv: trace).
     #[arg(short, long, action = clap::ArgAction::Count, global = true)]
     pub verbose: u8,
-    /// Only errors.
+    /// Only errors: no logging, and no summary from plan, sweep or check without --json (the exit status still
+    /// tells). What other commands are asked to print is printed.
     #[arg(short, long, global = true)]
     pub quiet: bool,
     /// Worker threads (default: all cores). Results do not depend on it.
@@ -84,6 +85,7 @@ pub fn main() -> ExitCode {
         Err(e) => e.exit(),
     };
     init_logging(cli.verbose, cli.quiet);
+    output::set_quiet(cli.quiet);
     if let Some(n) = cli.threads
         && let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build_global()
     {

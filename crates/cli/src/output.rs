@@ -4,6 +4,15 @@
 use serde::Serialize;
 use std::io::Write;
 use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// `-q`: leave out the summaries of [`print_summary`].
+static QUIET: AtomicBool = AtomicBool::new(false);
+
+/// Sets `-q` for [`print_summary`] (once, from `main`).
+pub fn set_quiet(quiet: bool) {
+    QUIET.store(quiet, Ordering::Relaxed);
+}
 
 /// Writes `bytes` to `path` atomically (a temporary file in the same directory, synced, then renamed): the
 /// writer of `stackplan_geom::io`, so the library and the program share one implementation.
@@ -36,4 +45,14 @@ pub fn print_text(text: &str) -> anyhow::Result<()> {
     out.write_all(text.as_bytes())?;
     out.flush()?;
     Ok(())
+}
+
+/// Prints a summary for people on stdout unless `-q` was given: the result line of `plan`, the lines of `sweep`, the
+/// table of `check` without `--json`, whose outcome the files written and the exit status carry. What a command is
+/// asked to show (JSON, `part info`, `place`, ...) goes through [`print_text`] / [`print_json`] whatever `-q` says.
+pub fn print_summary(text: &str) -> anyhow::Result<()> {
+    if QUIET.load(Ordering::Relaxed) {
+        return Ok(());
+    }
+    print_text(text)
 }

@@ -54,7 +54,11 @@ pub enum PlanFileError {
         message: String,
     },
     /// The summary's part count disagrees with the placements.
-    #[error("{}: the summary says {placed} parts were placed, but there are {placements} placements", file.display())]
+    #[error(
+        "{}: malformed plan: key `plan.placed`: the summary says {placed} parts were placed, but there are \
+         {placements} placements",
+        file.display()
+    )]
     CountMismatch {
         /// The file.
         file: PathBuf,
@@ -111,29 +115,64 @@ pub fn read_plan_file(path: &Path) -> Result<PlanFile, PlanFileError> {
 /// Parses a plan file's bytes; `path` names it in errors.
 pub fn parse_plan_file(bytes: &[u8], path: &Path) -> Result<PlanFile, PlanFileError> {
     let stack = stackplan_geom::io::stack::parse_stack(bytes, path, &ReadOptions::default())?;
-    let malformed = |message: String| PlanFileError::Malformed { file: path.to_path_buf(), message };
-    // parse_stack accepted the JSON, so it is an object with `placements`
-    let mut document: Value = serde_json::from_slice(bytes).map_err(|e| malformed(e.to_string()))?;
-    let Some(Value::Object(mut summary)) = document.get_mut("plan").map(Value::take) else {
+    let Some(mut summary) = plan_summary(stack.plan.as_ref(), path)?.cloned() else {
         return Err(PlanFileError::NotAPlan { file: path.to_path_buf() });
     };
+    let count = stack.placements.len();
+    check_placed(&summary, path, count)?;
     let seconds = summary.get("seconds").and_then(Value::as_f64).unwrap_or(0.0);
-    let placed = summary.get("placed").and_then(Value::as_u64);
     // the summary is typed; the placements' planner fields (cost, theta, stage, ...) are read leniently for the
     // report: JSON has no infinity or NaN, so a non-finite number is written as `null` and shown as "-"
     summary.insert("parts".into(), Value::Array(Vec::new()));
-    let plan: Plan =
-        serde_json::from_value(Value::Object(summary)).map_err(|e| malformed(format!("key `plan`: {e}")))?;
-    let count = stack.placements.len();
-    if let Some(placed) = placed
-        && placed != count as u64
-    {
-        return Err(PlanFileError::CountMismatch { file: path.to_path_buf(), placed, placements: count });
-    }
+    let plan: Plan = serde_json::from_value(Value::Object(summary))
+        .map_err(|e| PlanFileError::Malformed { file: path.to_path_buf(), message: format!("key `plan`: {e}") })?;
     if count == 0 {
         return Err(PlanFileError::Empty { file: path.to_path_buf() });
     }
     Ok(PlanFile { part: stack.part, plan, poses: stack.placements, placements: stack.extras, seconds })
+}
+
+/// The `plan` summary of a stack file (`StackFile::plan`; a JSON `null` reads as absent): `None` for a plain stack
+/// file, the object for a plan file, an error naming the file and the key when it is anything else. Shared by
+/// `stackplan render` and `stackplan check`, so the two agree on what a plan summary is.
+pub fn plan_summary<'a>(plan: Option<&'a Value>, path: &Path) -> Result<Option<&'a Map<String, Value>>, PlanFileError> {
+    match plan {
+        None | Some(Value::Null) => Ok(None),
+        Some(Value::Object(summary)) => Ok(Some(summary)),
+        Some(other) => Err(PlanFileError::Malformed {
+            file: path.to_path_buf(),
+            message: format!("key `plan`: expected the plan summary (an object), got {}", json_kind(other)),
+        }),
+    }
+}
+
+/// Checks the summary's `placed`: present, a non-negative integer, and equal to `placements`.
+pub fn check_placed(summary: &Map<String, Value>, path: &Path, placements: usize) -> Result<(), PlanFileError> {
+    let malformed = |message: String| PlanFileError::Malformed { file: path.to_path_buf(), message };
+    let placed = match summary.get("placed") {
+        None => return Err(malformed("key `plan.placed`: missing (the number of placed parts)".into())),
+        Some(value) => value.as_u64().ok_or_else(|| {
+            malformed(format!(
+                "key `plan.placed`: expected the number of placed parts (a non-negative integer), got {value}"
+            ))
+        })?,
+    };
+    if placed != placements as u64 {
+        return Err(PlanFileError::CountMismatch { file: path.to_path_buf(), placed, placements });
+    }
+    Ok(())
+}
+
+/// What kind of JSON value `v` is, for messages.
+fn json_kind(v: &Value) -> &'static str {
+    match v {
+        Value::Null => "null",
+        Value::Bool(_) => "a boolean",
+        Value::Number(_) => "a number",
+        Value::String(_) => "a string",
+        Value::Array(_) => "an array",
+        Value::Object(_) => "an object",
+    }
 }
 
 /// Every picture of a plan, ready to write.
@@ -405,5 +444,15 @@ mod tests {
         let e = parse_plan_file(with_bad_summary.as_bytes(), Path::new("q.json")).expect_err("malformed");
         assert!(matches!(e, PlanFileError::Malformed { .. }), "{e}");
         assert!(e.to_string().starts_with("q.json: malformed plan"), "{e}");
+        // a summary that is not an object is malformed, not missing; `null` counts as missing
+        let not_an_object = text.replacen("{\"part\"", "{\"plan\": \"x\", \"part\"", 1);
+        let e = parse_plan_file(not_an_object.as_bytes(), Path::new("s.json")).expect_err("malformed");
+        assert_eq!(
+            e.to_string(),
+            "s.json: malformed plan: key `plan`: expected the plan summary (an object), got a string"
+        );
+        let null = text.replacen("{\"part\"", "{\"plan\": null, \"part\"", 1);
+        let e = parse_plan_file(null.as_bytes(), Path::new("n.json")).expect_err("no summary");
+        assert!(matches!(e, PlanFileError::NotAPlan { .. }), "{e}");
     }
 }

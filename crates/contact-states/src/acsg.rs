@@ -578,11 +578,12 @@ impl Acsg {
         s
     }
 
-    /// A \[P\] Table I-style table: state, objective, feasibility, lower and upper bounds (mm, rad).
+    /// A \[P\] Table I-style table: state, objective, feasibility, lower and upper bounds of its extremal
+    /// configurations (`range`: mm and radians, as the header says), one line per state searched.
     pub fn extremal_table(&self) -> String {
         let mut out = format!(
             "{:<32} {:>11} {:<11} {:<60} {:<60}\n",
-            "CS", "objective", "feasibility", "lower bounds [x y z rx ry rz]", "upper bounds"
+            "CS", "objective", "feasibility", "lower bounds [x y z (mm) rx ry rz (rad)]", "upper bounds [same units]"
         );
         for r in &self.states {
             if r.pruned.is_some() {

@@ -5,6 +5,7 @@
 
 use crate::Outcome;
 use crate::output;
+use crate::plan_files::plan_summary;
 use anyhow::Context;
 use serde::Serialize;
 use stackplan::stability::check::{CheckOptions, StackCheck, check_stack};
@@ -74,7 +75,7 @@ fn release_drops(path: &Path, extras: &[serde_json::Map<String, serde_json::Valu
 
 /// `options.KEY` of a plan file's summary (`stackplan plan` writes the planner's options there) when it is a finite
 /// number; `None` for a plain stack file or any other value.
-fn plan_option(plan: Option<&serde_json::Value>, key: &str) -> Option<f64> {
+fn plan_option(plan: Option<&serde_json::Map<String, serde_json::Value>>, key: &str) -> Option<f64> {
     plan?.get("options")?.get(key)?.as_f64().filter(|v| v.is_finite())
 }
 
@@ -87,8 +88,9 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         .iter()
         .map(|pose| PlacedPart { part: &file.part, rotation: pose.rotation, position: pose.position })
         .collect();
-    // a plan file is checked with the planner's own friction, clearance and cup unless the command line says otherwise
-    let plan = file.plan.as_ref();
+    // a plan file is checked with the planner's own friction, clearance and cup unless the command line says otherwise;
+    // a `plan` that is not a summary object is an error, as for `stackplan render` (`plan_summary`)
+    let plan = plan_summary(file.plan.as_ref(), &args.stack)?;
     let mu = args.mu.or_else(|| plan_option(plan, "mu")).unwrap_or(0.5);
     let clearance = args.clearance.or_else(|| plan_option(plan, "clearance")).unwrap_or(0.0);
     let cup_diameter = args.cup_diameter.or_else(|| plan_option(plan, "cup_diameter")).unwrap_or(30.0);
@@ -132,7 +134,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
             report.stack.verdict,
             report.stack.margin.map_or("-".to_string(), |m| format!("{m:.3}"))
         ));
-        output::print_text(&text)?;
+        output::print_summary(&text)?;
     }
     Ok(if ok { Outcome::Success } else { Outcome::ChecksFailed })
 }

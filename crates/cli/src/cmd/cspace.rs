@@ -13,7 +13,7 @@ use anyhow::Context;
 use serde::Serialize;
 use stackplan::cspace::minkowski::{FaceKind, Feature, Obstacle, obstacle};
 use stackplan::cspace::offset::{HalfSpaces, clearance, insertion, insertion_polytope, slice};
-use stackplan::orient_interval::extrapolate_from;
+use stackplan::orient_interval::{ExtrapolateError, extrapolate_from};
 use stackplan_geom::{ConvexPolytope, DMat3, DVec2, Plane};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -157,6 +157,39 @@ pub struct PairObstacle {
     pub interval_deg: Option<[f64; 2]>,
 }
 
+/// `--theta-deg` outside the constant-structure interval of the obstacle built at `--extrapolate-from`, in the
+/// options' unit (the library reports radians).
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "--theta-deg {theta} is outside the constant-structure interval [{start}, {end}] degrees of the obstacle built at \
+     --extrapolate-from {built_at}"
+)]
+pub struct OutsideInterval {
+    /// The requested angle (degrees).
+    pub theta: f64,
+    /// Where the obstacle was built (degrees).
+    pub built_at: f64,
+    /// Interval start (degrees, unwrapped: may be negative).
+    pub start: f64,
+    /// Interval end (degrees).
+    pub end: f64,
+}
+
+/// The library's extrapolation error, with an angle outside the interval given in degrees ([`OutsideInterval`]).
+fn in_degrees(e: ExtrapolateError) -> anyhow::Error {
+    // 7 decimals: event windows are a few 1e-6 degrees wide; the user's own angles print as given
+    let deg = |rad: f64| (rad.to_degrees() * 1e7).round() / 1e7;
+    match e {
+        ExtrapolateError::OutsideInterval { theta, built_at, start, end } => anyhow::Error::new(OutsideInterval {
+            theta: deg(theta),
+            built_at: deg(built_at),
+            start: deg(start),
+            end: deg(end),
+        }),
+        other => anyhow::Error::new(other),
+    }
+}
+
 /// The obstacles of the requested pairs.
 pub fn obstacles(args: &Args) -> anyhow::Result<Vec<PairObstacle>> {
     anyhow::ensure!(args.theta_deg.is_finite(), "--theta-deg must be finite");
@@ -177,8 +210,9 @@ pub fn obstacles(args: &Args) -> anyhow::Result<Vec<PairObstacle>> {
             let (o, interval) = match args.extrapolate_from {
                 None => (obstacle(a, rotation, b).with_context(what)?, None),
                 Some(t0) => {
-                    let (o, iv) =
-                        extrapolate_from(a, b, t0.to_radians(), args.theta_deg.to_radians()).with_context(what)?;
+                    let (o, iv) = extrapolate_from(a, b, t0.to_radians(), args.theta_deg.to_radians())
+                        .map_err(in_degrees)
+                        .with_context(what)?;
                     (o, Some([iv.start.to_degrees(), iv.end.to_degrees()]))
                 }
             };

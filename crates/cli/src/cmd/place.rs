@@ -35,7 +35,8 @@ pub struct Args {
     /// Weight w in [0, 1] of cost (1) (default 0.5). Not with --target.
     #[arg(long, conflicts_with = "target")]
     pub w: Option<f64>,
-    /// Origin (x0, y0, z0) of cost (1) `X,Y,Z` (default: the floor's centre at z = 0).
+    /// Origin (x0, y0, z0) of cost (1) `X,Y,Z` (default: the mean of the floor polygon's corners at z = 0; not the
+    /// area centroid, which can differ for a --floor-polygon).
     #[arg(long, conflicts_with = "target", value_parser = parse_point, allow_hyphen_values = true)]
     pub origin: Option<[f64; 3]>,
     /// Minimise the squared distance of the part's c.g. to `X,Y,Z` instead of cost (1).

@@ -79,7 +79,7 @@ pub fn parse_w_values(s: &str) -> anyhow::Result<Vec<f64>> {
         .map(|x| x.trim().parse::<f64>().with_context(|| format!("--w-values: {x:?} is not a number")))
         .collect::<anyhow::Result<_>>()?;
     for &w in &values {
-        check_w(w)?;
+        check_w("--w-values", w)?;
     }
     Ok(values)
 }
@@ -199,7 +199,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         ));
     }
     text.push_str(&format!("wrote {}\n", args.out.display()));
-    crate::output::print_text(&text)?;
+    crate::output::print_summary(&text)?;
     let complete = sweep.runs.iter().all(|r| r.stopped.is_none());
     Ok(if complete { Outcome::Success } else { Outcome::ChecksFailed })
 }
@@ -228,7 +228,8 @@ mod tests {
     #[test]
     fn w_values_are_checked() {
         assert_eq!(parse_w_values("0, 0.5,1").expect("ok"), vec![0.0, 0.5, 1.0]);
-        assert!(parse_w_values("0,1.5").is_err());
+        let e = parse_w_values("0,1.5").expect_err("1.5 is not a weight");
+        assert_eq!(e.to_string(), "--w-values must lie in [0, 1], got 1.5");
         assert!(parse_w_values("0,x").is_err());
     }
 }
