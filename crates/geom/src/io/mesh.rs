@@ -83,8 +83,6 @@ enum Defect {
     Volume { shell: f64, hull: f64 },
 }
 
-/// Splits triangles into closed shells. See the module documentation. Triangles with a repeated vertex are dropped.
-/// Returns the shells and, per shell, the first open edge found (a polygon index within the shell), if any.
 /// The faces a writer emits for a convex component with vertices `points`: those of the exact convex hull of the
 /// points (each face's vertex indices into `points`, counter-clockwise seen from outside, and its outward unit
 /// normal), which is what the readers rebuild, so that every written polygon lies exactly in a face plane of the
@@ -110,6 +108,8 @@ pub(crate) fn written_faces(component: &ConvexPolytope, points: &[DVec3]) -> Vec
     })
 }
 
+/// Splits triangles into closed shells. See the module documentation. Triangles with a repeated vertex are dropped.
+/// Returns the shells and, per shell, the first open edge found (a polygon index within the shell), if any.
 pub(crate) fn split_shells(points: &[DVec3], triangles: Vec<MeshPolygon>) -> Vec<(Shell, Option<usize>)> {
     let triangles: Vec<MeshPolygon> = triangles
         .into_iter()
