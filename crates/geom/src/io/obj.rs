@@ -9,7 +9,7 @@
 //! welded by exact coordinates. O(file size) parsing.
 //!
 //! **Writing.** One `o piece_<i>` per component with its vertices and the faces of their exact convex hull
-//! (counter-clockwise seen from outside, 1-based absolute indices; [`super::mesh::exact_hull_faces`]), the faces the
+//! (counter-clockwise seen from outside, 1-based absolute indices; `mesh::exact_hull_faces`), the faces the
 //! reader rebuilds. Coordinates use Rust's shortest round-trip `f64` formatting, so a part reads back as its exact
 //! form, component by component (the part's vertices and faces, as sets, when its faces are exactly planar; see the
 //! JSON writer).

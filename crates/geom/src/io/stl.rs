@@ -10,7 +10,7 @@
 //! the file are ignored (the winding order defines the outside). O(file size) parsing.
 //!
 //! **Writing.** Every face of the exact convex hull of each component's vertices (the faces the reader rebuilds;
-//! [`super::mesh::exact_hull_faces`]) is fanned from its first vertex into triangles (hull faces are strictly convex,
+//! `mesh::exact_hull_faces`) is fanned from its first vertex into triangles (hull faces are strictly convex,
 //! so no fan triangle is degenerate), with the face's outward normal. ASCII STL is written with the shortest text
 //! that parses back to the same `f64`, so a part reads back as its exact form (see the JSON writer). Binary STL
 //! stores `f32`: the vertices are rounded first and the hull taken of the rounded points, so the file reads back as
