@@ -999,7 +999,7 @@ mod tests {
     /// tie-break defines the answer when the Hessian is singular, on 1 400 random cells and costs of 2 and 3
     /// variables, four fifths of them with a singular Hessian: the same cost and the same point. (Before the
     /// tie-break the enumeration returned no answer for a singular cost; taking the first cheapest candidate instead
-    /// disagrees with the active-set method on 446 of the 960 singular problems.) A 78 000-case run (seeds 1-39 of
+    /// disagrees with the active-set method on 446 of the 960 singular problems of the first two samples.) A 78 000-case run (seeds 1-39 of
     /// two samples, release) passes; it found the case pinned at the end, which ties decided by cost values missed.
     #[test]
     fn enumeration_matches_the_active_set_method_and_its_tie_break() {
