@@ -1,6 +1,6 @@
 //! `cspace`, `interference`, `place` and `check` end to end, on unit cubes where every answer is known by hand.
 
-mod common;
+use crate::common;
 use common::*;
 use serde_json::Value;
 

@@ -1,6 +1,6 @@
 //! `stackplan part info` and `stackplan part export`, end to end.
 
-mod common;
+use crate::common;
 use common::*;
 
 #[test]

@@ -1,7 +1,7 @@
 //! `render` and `sweep` end to end, the planner's determinism across thread counts, and the HTML report in
 //! headless Chromium.
 
-mod common;
+use crate::common;
 use common::*;
 use serde_json::Value;
 use std::path::{Path, PathBuf};

@@ -27,7 +27,7 @@ use stackplan_contact_states::surface::Element;
 use stackplan_geom::{DMat3, DVec3, Part, PartOrigin};
 use std::collections::HashSet;
 
-mod common;
+use crate::common;
 
 fn geom_parts() -> (Part, Part) {
     let l = stackplan_geom::examples::l_corner_part();

@@ -1,7 +1,7 @@
 //! Interference pairs (BVH broad phase + separating axes) against an independent all-pairs LP classification, on
 //! random box stacks with exact quarter-turn and random rotations and grid positions (touching is frequent).
 
-mod common;
+use crate::common;
 
 use common::*;
 use glam::{DMat3, DVec3};

@@ -3,7 +3,7 @@
 //! boxes, random clouds; rotations about z (exact quarter turns and random angles) and general ones; positions on a
 //! grid, so touching and parallel faces are frequent.
 
-mod common;
+use crate::common;
 
 use common::*;
 use glam::{DMat3, DVec3};

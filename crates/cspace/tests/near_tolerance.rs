@@ -6,7 +6,7 @@ use glam::{DMat3, DVec3};
 use stackplan_cspace::minkowski::{ANGULAR_TOLERANCE, FaceKind, Obstacle, Route, gauss_map_obstacle, obstacle_by_hull};
 use stackplan_geom::ConvexPolytope;
 
-mod common;
+use crate::common;
 
 fn cuboid(hi: DVec3) -> ConvexPolytope {
     common::cuboid(DVec3::ZERO, hi)

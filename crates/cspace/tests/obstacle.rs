@@ -2,7 +2,7 @@
 //! interiors of `R A + p` and `B` intersect; a QP gives Euclidean distances to the hull of the difference points; the
 //! exact-predicate hull of the differences gives the reference volume and vertex set.
 
-mod common;
+use crate::common;
 
 use common::*;
 use glam::{DMat3, DVec2, DVec3};

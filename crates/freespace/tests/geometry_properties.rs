@@ -1,7 +1,7 @@
 //! Property tests of subtraction (set preservation, disjointness) and of Omega (the part at any vertex of Omega
 //! touches the floor volume's boundary and stays inside it).
 
-mod common;
+use crate::common;
 
 use common::{Rng, Shape, bbox, random_cell, random_points};
 use proptest::prelude::*;

@@ -16,7 +16,7 @@
 //! cells), vertices where more than three planes are tight, empty cells; costs include w = 0 and w = 1 of cost (1)
 //! (singular Hessians), linear costs (LPs with the tie-break only) and badly scaled positive Hessians.
 
-mod common;
+use crate::common;
 
 use common::Rng;
 use proptest::prelude::*;

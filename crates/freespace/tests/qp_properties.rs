@@ -1,6 +1,6 @@
 //! Property tests of the exact QP against clarabel, brute-force sampling and independent tie-break oracles.
 
-mod common;
+use crate::common;
 
 use common::{Rng, Shape, bbox, random_cell};
 use proptest::prelude::*;

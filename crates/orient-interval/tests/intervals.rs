@@ -1,6 +1,6 @@
 //! Property tests of critical orientations, intervals and extrapolation (the heart of the issue).
 
-mod common;
+use crate::common;
 
 use common::{cases, mirrored, pair};
 use proptest::prelude::*;

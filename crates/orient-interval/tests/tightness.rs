@@ -2,7 +2,7 @@
 //! the true end found by sampling the from-scratch structure every 0.25 degree and bisecting the first change (test
 //! only). The reported end must never lie after the true end; the distribution is printed (docs/benchmarks.md).
 
-mod common;
+use crate::common;
 
 use common::{cases, example_components, pair};
 use proptest::strategy::{Strategy, ValueTree};

@@ -2,7 +2,7 @@
 //! the stacking planner's caches): the first placement of every search is the exact optimum a fresh search finds,
 //! also on a floor that grew since the carried search (stage 1's footprint).
 
-mod common;
+use crate::common;
 
 use common::growing_stack_request;
 use stackplan_cspace::ObstacleCache;

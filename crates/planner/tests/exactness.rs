@@ -2,7 +2,7 @@
 //! orientation subtracted from Omega, minimised over every cell; a dense sample of positions checked pair by pair;
 //! every returned placement checked by an independent all-pairs test.
 
-mod common;
+use crate::common;
 use common::boxes;
 
 use glam::{DMat3, DVec3};

@@ -2,7 +2,7 @@
 //! obstacle equals the one constructed from scratch at its angle (same structure and provenance, coordinates within
 //! 1e-9 relative), and searches with extrapolation find what searches that construct every obstacle find.
 
-mod common;
+use crate::common;
 use common::{box_or_l, boxes};
 
 use glam::{DMat3, DVec3};

@@ -4,7 +4,7 @@
 //! free sample may beat the search's optimum; when the search finds nothing, no sample may be free; every returned
 //! placement lies at `fixed_z`, inside the floor volume and free of interference.
 
-mod common;
+use crate::common;
 
 use glam::{DMat3, DVec3};
 use proptest::prelude::*;

@@ -20,7 +20,7 @@
 //! Random plans of boxes and L-shapes (any weight, clearance, step and floor), and the Channel and Triangle
 //! fixtures. Cost: O(n^2 m^2) pair tests per plan; the slices O(V^4) per close pair (V <= 8 for boxes).
 
-mod common;
+use crate::common;
 
 use glam::{DMat3, DVec2, DVec3};
 use parry3d_f64::math::Pose;

@@ -3,7 +3,7 @@
 //! region it finds the exact optimum of the whole floor; also when both carry their frontiers into a growing stack
 //! and a growing region, as the planner's searches do.
 
-mod common;
+use crate::common;
 
 use common::growing_stack_request;
 use glam::DVec2;

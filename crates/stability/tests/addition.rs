@@ -7,7 +7,7 @@
 //! planks, with and without clearance. (The whole check runs with `prefix_stability`, so that its `removable` reads
 //! the stability of the stack left behind, which the precondition gives the added part's check.)
 
-mod common;
+use crate::common;
 
 use common::{at, box_layers, box_part, build, for_each_fixture_column, placements, planned_channels, same_margin};
 use glam::DVec3;

@@ -1,6 +1,6 @@
 //! Analytic cases of the issue: box on the floor, overhang, incline vs friction angle, seesaw.
 
-mod common;
+use crate::common;
 
 use common::{at, box_part, wedge_part};
 use glam::{DMat3, DVec3};

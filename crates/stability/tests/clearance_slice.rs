@@ -3,7 +3,7 @@
 //! random points, boxes tilted by up to a few degrees and slivers, placed so that their z-ranges overlap; and the
 //! separating axes' lower bound (`clearance::horizontal_distance_bound_by_axes`) against both.
 
-mod common;
+use crate::common;
 
 use glam::{DMat3, DVec3};
 use proptest::prelude::*;

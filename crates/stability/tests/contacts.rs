@@ -1,6 +1,6 @@
 //! Contact patches and interference depths against analytic values.
 
-mod common;
+use crate::common;
 
 use common::{at, box_part, cuboid};
 use glam::{DMat3, DVec2, DVec3};

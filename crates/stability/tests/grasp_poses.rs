@@ -1,7 +1,7 @@
 //! Grasp faces against closed forms and a brute-force sampled disc test; resting poses against a brute-force
 //! enumeration of supporting planes.
 
-mod common;
+use crate::common;
 
 use common::{box_part, boxes_part};
 use glam::{DMat3, DVec2, DVec3};

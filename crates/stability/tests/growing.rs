@@ -6,7 +6,7 @@
 //! same candidate tested twice and on a stack grown in between (the memos), and tilted copies of a part (the grasp
 //! memo per rotation).
 
-mod common;
+use crate::common;
 
 use common::{at, box_layers, box_part, build, for_each_fixture_column, placements, planned_channels};
 use glam::{DMat3, DVec3};

@@ -1,6 +1,6 @@
 //! Insertion straight down, removal straight up.
 
-mod common;
+use crate::common;
 
 use common::{at, box_part, boxes_part};
 use glam::DVec3;

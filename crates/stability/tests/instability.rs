@@ -14,7 +14,7 @@
 //! Where the plain SOCP ends unsure (`Unknown`, e.g. `AlmostPrimalInfeasible` for a part far off a single edge), a
 //! certificate may decide `Unstable`; a stable verdict never changes.
 
-mod common;
+use crate::common;
 
 use common::{at, box_layers, box_part, boxes_part, build};
 use glam::DVec3;

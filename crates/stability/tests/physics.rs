@@ -34,7 +34,7 @@
 //! further seeds one column with a load margin of 0.00096 toppled. With 16 iterations, three seeds x 4096 cases
 //! (19411, 1, 2): 8 152 stable columns moved at most 0.15 mm, 4 103 unstable ones at least 11.9 mm.
 
-mod common;
+use crate::common;
 
 use common::{at, box_part, wedge_part};
 use glam::{DMat3, DQuat, DVec3};

@@ -1,7 +1,7 @@
 //! The placement clearance of a plan whose parts are released above their supports ([`CheckOptions::release_drops`]):
 //! each part at its release position against the parts placed before it.
 
-mod common;
+use crate::common;
 
 use common::{at, box_part};
 use glam::DVec3;

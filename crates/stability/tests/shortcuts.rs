@@ -20,7 +20,7 @@
 //!   by a certificate of instability where the plain SOCP ends `Unknown`, see `same_verdict`), margins within 1e-6
 //!   relative, the same minimum-norm forces (see `assert_equivalent`).
 
-mod common;
+use crate::common;
 
 use common::{at, box_layers, box_part, build, for_each_fixture_column, placements, planned_channels, same_margin};
 use glam::DVec3;

@@ -1,0 +1,9 @@
+//! The integration tests of this package, one module per file, built as one test binary: one compile and one link
+//! instead of one per file (each test binary links every dependency again). `cargo test -p PACKAGE NAME` still
+//! filters by module, e.g. `tightness::`.
+
+mod common;
+mod interference;
+mod interference_axes;
+mod near_tolerance;
+mod obstacle;
