@@ -236,3 +236,44 @@ fn contacts_table_names_its_units() {
     // a feasible cube-on-cube state tilts up to 2 degrees = 3.491e-2 rad
     assert!(text.contains("3.491e-2") && !text.contains("2.000e0"), "{text}");
 }
+
+/// Inputs found by fuzzing the command line that used to panic (capacity overflow: exit 101), run out of memory, or
+/// fail deep in a solver: each is now an error (exit 2) that names the option, or the file and the place, and writes
+/// nothing.
+#[test]
+fn fuzzed_inputs_are_clear_errors() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let plan = run_in(dir.path(), &["plan", "example:cube", "--count", "2", "--cup-diameter", "0.5", "--out", "p"]);
+    assert!(plan.status.success(), "{}", stderr(&plan));
+    let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
+    write("underflow.json", r#"{"convex_pieces": [[[0,0,0],[1e-160,0,0],[0,1e-160,0],[0,0,1e-160]]]}"#);
+    write("huge_floor.json", "[[-1e300,-1e300],[1e300,-1e300],[1e300,1e300],[-1e300,1e300]]");
+    let mut negative_mu: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("p/plan.json")).expect("plan")).expect("JSON");
+    negative_mu["plan"]["options"]["mu"] = serde_json::json!(-0.5);
+    write("negative_mu.json", &negative_mu.to_string());
+    let max = u64::MAX.to_string();
+    let cube_box = ["--t-min", "-0.1,-0.1,-0.1,-1,-1,-1", "--t-max", "0.1,0.1,0.1,1,1,1"];
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["plan", "example:cube", "--dtheta-deg", "1e-300", "--out", "x"], "--dtheta-deg must lie in [0.01, 360]"),
+        (vec!["place", "example:cube", "--stack", "p/plan.json", "--dtheta-deg", "1e-9"], "--dtheta-deg"),
+        (vec!["check", "p/plan.json", "--margin-directions", &max], "at most 3600 margin directions"),
+        (
+            [&["contacts", "example:cube", "example:cube"][..], &cube_box, &["--population", &max]].concat(),
+            "--population must lie in 4..=100000",
+        ),
+        (vec!["part", "info", "underflow.json"], "underflow.json: piece 0, point 1: coordinate 1e-160"),
+        (vec!["check", "negative_mu.json"], "negative_mu.json: malformed plan: key `plan.options.mu`"),
+        (vec!["place", "example:cube", "--stack", "p/plan.json", "--floor-polygon", "huge_floor.json"], "huge_floor"),
+        (vec!["place", "example:cube", "--stack", "p/plan.json", "--origin", "1e308,0,0"], "--origin: 1e308"),
+        (vec!["plan", "example:cube", "--floor", "-1e300,-1,1,1", "--out", "x"], "--floor: -1e300"),
+        (vec!["render", "p/plan.json", "--png", "s.png", "--svg", "./s.png"], "given for two outputs"),
+    ];
+    for (args, message) in &cases {
+        let o = run_in(dir.path(), args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(message), "{args:?}: {}", stderr(&o));
+        assert!(!stderr(&o).contains("panicked"), "{args:?}: {}", stderr(&o));
+    }
+    assert!(!dir.path().join("x").exists() && !dir.path().join("s.png").exists(), "an error left output behind");
+}

@@ -141,7 +141,7 @@ fn contacts(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
     let seed = scenario.get("seed").and_then(Value::as_u64).unwrap_or(2004);
     let settings = AcsgSettings { ga: GaSettings { seed, ..GaSettings::default() }, ..AcsgSettings::default() };
     let started = std::time::Instant::now();
-    let graph = generate(&ContactPart::from_part(&fixed)?, &ContactPart::from_part(&moving)?, bounds, settings);
+    let graph = generate(&ContactPart::from_part(&fixed)?, &ContactPart::from_part(&moving)?, bounds, settings)?;
     let seconds = started.elapsed().as_secs_f64();
     let per_level = graph.counts_per_level();
     let mut ranges = serde_json::Map::new();

@@ -47,12 +47,47 @@ pub fn decomposition(triangulate: bool) -> Decomposition {
     if triangulate { Decomposition::Triangulation } else { Decomposition::ConvexMerge }
 }
 
+/// `v` in the shorter of Rust's plain and scientific notations (`0.5`, `1e-300`, not three hundred zeros), for
+/// messages.
+pub fn short_number(v: f64) -> String {
+    let (plain, sci) = (v.to_string(), format!("{v:e}"));
+    if plain.len() <= sci.len() { plain } else { sci }
+}
+
+/// Checks lengths or coordinates (mm) given by `what` (an option or a file and key): finite and at most
+/// [`MAX_COORDINATE`] (1e9 mm) in magnitude, the range the part readers accept. Beyond it the planner's solvers would
+/// fail with messages about their own internals instead.
+///
+/// [`MAX_COORDINATE`]: stackplan_geom::io::MAX_COORDINATE
+pub fn check_lengths(what: &str, values: &[f64]) -> anyhow::Result<()> {
+    let max = stackplan_geom::io::MAX_COORDINATE;
+    if let Some(v) = values.iter().find(|v| !(v.is_finite() && v.abs() <= max)) {
+        anyhow::bail!("{what}: {} is not a finite length of at most {max:e} mm in magnitude", short_number(*v));
+    }
+    Ok(())
+}
+
+/// Checks `--dtheta-deg`: at least 0.01 degree (the planner's [`MAX_THETAS`] angles per turn) and at most 360.
+///
+/// [`MAX_THETAS`]: stackplan::planner::request::MAX_THETAS
+pub fn check_dtheta_deg(dtheta_deg: f64) -> anyhow::Result<()> {
+    let min = 360.0 / stackplan::planner::request::MAX_THETAS as f64;
+    anyhow::ensure!(
+        (min..=360.0).contains(&dtheta_deg),
+        "--dtheta-deg must lie in [{min}, 360] degrees, got {}",
+        short_number(dtheta_deg)
+    );
+    Ok(())
+}
+
 /// Reads a pose file: JSON `{"position": [x, y, z], "rotation": [[row 0], [row 1], [row 2]]}` (a proper rotation).
 pub fn read_pose(path: &std::path::Path) -> anyhow::Result<stackplan_geom::Pose> {
     let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let record: stackplan_geom::pose::PoseRecord =
         serde_json::from_str(&text).with_context(|| format!("parsing the pose in {}", path.display()))?;
-    stackplan_geom::Pose::try_from(record).with_context(|| format!("the pose in {}", path.display()))
+    let pose = stackplan_geom::Pose::try_from(record).with_context(|| format!("the pose in {}", path.display()))?;
+    check_lengths(&format!("{}: position", path.display()), &pose.position.to_array())?;
+    Ok(pose)
 }
 
 /// Parses `--pair I,J` (moving component I, fixed component J).

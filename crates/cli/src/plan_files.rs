@@ -146,6 +146,27 @@ pub fn plan_summary<'a>(plan: Option<&'a Value>, path: &Path) -> Result<Option<&
     }
 }
 
+/// `options.KEY` of a plan summary (`stackplan plan` writes the planner's options there): `None` when `options` or
+/// the key is absent, the number when it is finite and non-negative, an error naming the file and the key otherwise
+/// (a plan file's friction, clearance or cup that cannot be used is not silently replaced by a default).
+pub fn plan_option(summary: &Map<String, Value>, key: &str, path: &Path) -> Result<Option<f64>, PlanFileError> {
+    let malformed = |message: String| PlanFileError::Malformed { file: path.to_path_buf(), message };
+    let options = match summary.get("options") {
+        None | Some(Value::Null) => return Ok(None),
+        Some(Value::Object(options)) => options,
+        Some(other) => {
+            return Err(malformed(format!("key `plan.options`: expected an object, got {}", json_kind(other))));
+        }
+    };
+    match options.get(key) {
+        None | Some(Value::Null) => Ok(None),
+        Some(value) => match value.as_f64() {
+            Some(v) if v >= 0.0 && v.is_finite() => Ok(Some(v)),
+            _ => Err(malformed(format!("key `plan.options.{key}`: expected a finite number >= 0, got {value}"))),
+        },
+    }
+}
+
 /// Checks the summary's `placed`: present, a non-negative integer, and equal to `placements`.
 pub fn check_placed(summary: &Map<String, Value>, path: &Path, placements: usize) -> Result<(), PlanFileError> {
     let malformed = |message: String| PlanFileError::Malformed { file: path.to_path_buf(), message };

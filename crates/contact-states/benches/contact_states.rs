@@ -72,7 +72,7 @@ fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("acsg");
     group.sample_size(10);
     group.bench_function("block_l_corner_default_ga", |bench| {
-        bench.iter(|| generate(&fixed, &moving, bx, AcsgSettings::default()))
+        bench.iter(|| generate(&fixed, &moving, bx, AcsgSettings::default()).expect("default settings"))
     });
     group.finish();
 }

@@ -36,7 +36,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &moving,
         bounds,
         AcsgSettings { ga, extremal_budget, analytic_steps, ..AcsgSettings::default() },
-    );
+    )?;
     let seconds = start.elapsed().as_secs_f64();
     let per_level = g.counts_per_level();
     println!("GA {ga:?}");

@@ -24,7 +24,7 @@
 use crate::analytic_seeds::edge_edge_candidates;
 use crate::criteria::{ContactPart, Objective, Weights, face_point_distance_2d};
 use crate::extremal::{Extremal, extremals, range_of};
-use crate::ga::{GaSettings, minimise_with_polish, mix_seed};
+use crate::ga::{GaSettings, SettingsError, check_count, minimise_with_polish, mix_seed};
 use crate::manifold::{Manifolds, Rejection, StrictTolerances, segment_segment_distance};
 use crate::pose::{Config, ConfigBox, VARIABLE_NAMES};
 use crate::principal_contact::{ContactState, PcType, PrincipalContact, all_ppcs};
@@ -73,6 +73,37 @@ impl Default for AcsgSettings {
             max_level: 12,
             analytic_steps: default_analytic_steps(),
         }
+    }
+}
+
+/// The most analytic grid values per angle ([`AcsgSettings::analytic_steps`]): the candidates of an edge pair grow
+/// with its cube.
+pub const MAX_ANALYTIC_STEPS: usize = 64;
+
+/// The most witness attempts per start ([`AcsgSettings::witness_attempts`]) and projections per extremal search
+/// ([`AcsgSettings::extremal_budget`]).
+pub const MAX_ATTEMPTS: usize = 1_000_000;
+
+impl AcsgSettings {
+    /// Checks the settings before any search: the GA's sizes ([`GaSettings::check`]), the counts up to
+    /// [`MAX_ATTEMPTS`] and [`MAX_ANALYTIC_STEPS`], and the threshold, widening and strict tolerances finite and
+    /// non-negative.
+    pub fn check(&self) -> Result<(), SettingsError> {
+        self.ga.check()?;
+        check_count("witness_attempts", self.witness_attempts, 0, MAX_ATTEMPTS)?;
+        check_count("extremal_budget", self.extremal_budget, 0, MAX_ATTEMPTS)?;
+        check_count("analytic_steps", self.analytic_steps, 0, MAX_ANALYTIC_STEPS)?;
+        for (name, value) in [
+            ("threshold_relative", self.threshold_relative),
+            ("widen", self.widen),
+            ("strict.hold", self.strict.hold),
+            ("strict.clear", self.strict.clear),
+        ] {
+            if !(value >= 0.0 && value.is_finite()) {
+                return Err(SettingsError::Negative { name, value });
+            }
+        }
+        Ok(())
     }
 }
 
@@ -439,7 +470,16 @@ impl Context<'_> {
 }
 
 /// Generates the ACSG of the moving part B against the fixed part A within `bounds`.
-pub fn generate(fixed: &ContactPart, moving: &ContactPart, bounds: ConfigBox, settings: AcsgSettings) -> Acsg {
+///
+/// # Errors
+/// Settings that [`AcsgSettings::check`] rejects.
+pub fn generate(
+    fixed: &ContactPart,
+    moving: &ContactPart,
+    bounds: ConfigBox,
+    settings: AcsgSettings,
+) -> Result<Acsg, SettingsError> {
+    settings.check()?;
     let weights = Weights::for_parts(moving);
     let threshold = settings.threshold_relative * weights.length;
     let (sa, sb) = (&fixed.surface, &moving.surface);
@@ -529,7 +569,7 @@ pub fn generate(fixed: &ContactPart, moving: &ContactPart, bounds: ConfigBox, se
             }
         }
     }
-    Acsg {
+    Ok(Acsg {
         fixed: fixed.name.clone(),
         moving: moving.name.clone(),
         bounds,
@@ -540,7 +580,7 @@ pub fn generate(fixed: &ContactPart, moving: &ContactPart, bounds: ConfigBox, se
         states,
         relations,
         stats,
-    }
+    })
 }
 
 impl Acsg {
@@ -616,6 +656,31 @@ impl Acsg {
 mod tests {
     use super::*;
     use crate::criteria::tests::box_part;
+
+    #[test]
+    fn settings_beyond_their_ranges_are_errors_before_any_search() {
+        let slab = box_part("slab", DVec3::new(-50.0, -50.0, -10.0), DVec3::new(50.0, 50.0, 0.0));
+        let cube = box_part("cube", DVec3::splat(-0.5), DVec3::splat(0.5));
+        let bounds = ConfigBox::new([-1.0, -1.0, 0.4, -0.1, -0.1, -0.1], [1.0, 1.0, 0.6, 0.1, 0.1, 0.1]).expect("box");
+        let base = AcsgSettings::default();
+        assert_eq!(base.check(), Ok(()));
+        let with_ga = |ga: GaSettings| AcsgSettings { ga, ..base };
+        // a population of usize::MAX was a capacity-overflow panic in the GA
+        for (settings, name) in [
+            (with_ga(GaSettings { population: usize::MAX, ..base.ga }), "population"),
+            (with_ga(GaSettings { population: 3, ..base.ga }), "population"),
+            (with_ga(GaSettings { generations: usize::MAX, ..base.ga }), "generations"),
+            (with_ga(GaSettings { polish_evaluations: usize::MAX, ..base.ga }), "polish_evaluations"),
+            (AcsgSettings { analytic_steps: 65, ..base }, "analytic_steps"),
+            (AcsgSettings { witness_attempts: usize::MAX, ..base }, "witness_attempts"),
+            (AcsgSettings { extremal_budget: usize::MAX, ..base }, "extremal_budget"),
+            (AcsgSettings { threshold_relative: f64::NAN, ..base }, "threshold_relative"),
+            (AcsgSettings { widen: -0.1, ..base }, "widen"),
+        ] {
+            let err = generate(&slab, &cube, bounds, settings).expect_err(name);
+            assert!(err.to_string().starts_with(name), "{name}: {err}");
+        }
+    }
 
     #[test]
     fn distance_ranges_prune_pcs_that_cannot_hold_together() {

@@ -79,6 +79,54 @@ pub struct GaSettings {
     pub seed: u64,
 }
 
+/// The largest [`GaSettings::population`] and [`GaSettings::generations`] accepted by [`GaSettings::check`].
+pub const MAX_GA_SIZE: usize = 100_000;
+
+/// The largest [`GaSettings::polish_evaluations`] accepted by [`GaSettings::check`].
+pub const MAX_POLISH_EVALUATIONS: usize = 10_000_000;
+
+/// Settings that no search can run with: a count outside its supported range, or a tolerance that is negative or not
+/// finite (the name is the setting's field).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SettingsError {
+    /// A count outside `min..=max`.
+    #[error("{name} must lie in {min}..={max}, got {value}")]
+    OutOfRange {
+        /// The setting.
+        name: &'static str,
+        /// Its value.
+        value: usize,
+        /// The smallest supported value.
+        min: usize,
+        /// The largest supported value.
+        max: usize,
+    },
+    /// A tolerance or fraction that is negative or not finite.
+    #[error("{name} must be finite and >= 0, got {value}")]
+    Negative {
+        /// The setting.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+    },
+}
+
+/// `value` within `min..=max`, else [`SettingsError::OutOfRange`] naming the setting.
+pub(crate) fn check_count(name: &'static str, value: usize, min: usize, max: usize) -> Result<(), SettingsError> {
+    if (min..=max).contains(&value) { Ok(()) } else { Err(SettingsError::OutOfRange { name, value, min, max }) }
+}
+
+impl GaSettings {
+    /// Checks the sizes: a population of 4 to [`MAX_GA_SIZE`], at most [`MAX_GA_SIZE`] generations and
+    /// [`MAX_POLISH_EVALUATIONS`] polish evaluations. [`minimise`] allocates the population it is given, so settings
+    /// from users should pass this first ([`crate::generate`] checks them).
+    pub fn check(&self) -> Result<(), SettingsError> {
+        check_count("population", self.population, 4, MAX_GA_SIZE)?;
+        check_count("generations", self.generations, 0, MAX_GA_SIZE)?;
+        check_count("polish_evaluations", self.polish_evaluations, 0, MAX_POLISH_EVALUATIONS)
+    }
+}
+
 impl Default for GaSettings {
     fn default() -> Self {
         Self { population: 40, generations: 30, polish_evaluations: 1200, seed: 1 }

@@ -33,6 +33,7 @@ pub mod surface;
 pub use acsg::{Acsg, AcsgSettings, StateRecord, generate};
 pub use criteria::{ContactPart, Objective, Weights};
 pub use ga::GaSettings;
+pub use ga::SettingsError;
 pub use growth_distance::{ConvexPiece, growth_distance};
 pub use pose::{Config, ConfigBox, Pose};
 pub use principal_contact::{ContactState, PcType, PrincipalContact};

@@ -70,7 +70,7 @@ fn cube_on_a_plane_with_free_rotation_has_v_plus_e_plus_f_states() {
     let cube = box_part("cube", DVec3::splat(-0.5), DVec3::splat(0.5));
     let bounds =
         ConfigBox::new([-1.0, -1.0, 0.0, -PI, -FRAC_PI_2, -PI], [1.0, 1.0, 1.5, PI, FRAC_PI_2, PI]).expect("box");
-    let g = generate(&slab, &cube, bounds, settings(3));
+    let g = generate(&slab, &cube, bounds, settings(3)).expect("settings");
     let labels: Vec<&str> = g.feasible().map(|s| s.label.as_str()).collect();
     assert_eq!(kinds(&g), (8, 12, 6, 0), "{labels:?} {:?}", report(&g));
     assert_eq!(g.counts_per_level(), vec![0, 8, 12, 6]);
@@ -98,7 +98,7 @@ fn cube_face_down_with_small_rotations_has_nine_states() {
     let slab = box_part("slab", DVec3::new(-50.0, -50.0, -10.0), DVec3::new(50.0, 50.0, 0.0));
     let cube = box_part("cube", DVec3::splat(-0.5), DVec3::splat(0.5));
     let bounds = ConfigBox::new([-1.0, -1.0, 0.4, -0.2, -0.2, -0.2], [1.0, 1.0, 1.0, 0.2, 0.2, 0.2]).expect("box");
-    let g = generate(&slab, &cube, bounds, settings(5));
+    let g = generate(&slab, &cube, bounds, settings(5)).expect("settings");
     let labels: Vec<&str> = g.feasible().map(|s| s.label.as_str()).collect();
     assert_eq!(kinds(&g), (4, 4, 1, 0), "{labels:?} {:?}", report(&g));
     // the f-f state pins z to 0.5 and the tilts to 0 (within the extremal search accuracy)
@@ -145,7 +145,8 @@ fn face_on_face_extremal_translations_are_exact() {
             ga: GaSettings { population: 24, generations: 12, polish_evaluations: 600, seed: 11 },
             ..settings(11)
         },
-    );
+    )
+    .expect("settings");
     let ff = g.feasible().find(|s| s.state.pcs.len() == 1 && s.state.pcs[0].kind() == PcType::FaceFace).expect("f-f");
     let r = ff.range.expect("range");
     let reach = 1.0 + 0.5 * 2f64.sqrt();
@@ -170,12 +171,14 @@ fn same_seed_same_graph_at_any_thread_count() {
         .num_threads(1)
         .build()
         .expect("pool")
-        .install(|| generate(&slab, &cube, bounds, s));
+        .install(|| generate(&slab, &cube, bounds, s))
+        .expect("settings");
     let two = rayon::ThreadPoolBuilder::new()
         .num_threads(2)
         .build()
         .expect("pool")
-        .install(|| generate(&slab, &cube, bounds, s));
+        .install(|| generate(&slab, &cube, bounds, s))
+        .expect("settings");
     assert_eq!(one, two);
     let json = serde_json::to_string(&one).expect("json");
     assert!(json.contains("\"states\""));

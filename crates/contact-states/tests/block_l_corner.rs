@@ -67,7 +67,7 @@ fn block_into_l_corner() {
         extremal_budget: 150,
         ..AcsgSettings::default()
     };
-    let g = generate(&fixed, &moving, bounds, settings);
+    let g = generate(&fixed, &moving, bounds, settings).expect("settings");
     let per_level = g.counts_per_level();
     let total: usize = per_level.iter().sum();
     tracing::info!(?per_level, total, stats = ?g.stats, "block into L-corner");

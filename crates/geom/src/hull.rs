@@ -43,6 +43,17 @@ pub enum HullError {
     /// All points lie in a plane.
     #[error("all points are coplanar: the hull is flat, not a solid")]
     Coplanar,
+    /// A nonzero coordinate smaller than [`MIN_COORDINATE`] or larger than [`MAX_HULL_COORDINATE`] in magnitude.
+    #[error(
+        "point {index} has the coordinate {value:e}, outside the supported range (0, or a magnitude from 1e-50 to \
+         1e50, where the exact predicates neither underflow nor overflow)"
+    )]
+    OutOfRange {
+        /// Index of the offending point.
+        index: usize,
+        /// The coordinate.
+        value: f64,
+    },
     /// Internal consistency failure (a bug): the triangulated surface could not be turned into a polytope.
     #[error("internal hull error: {0}")]
     Internal(#[from] PolytopeError),
@@ -55,6 +66,27 @@ pub struct ConvexHull {
     pub polytope: ConvexPolytope,
     /// `source[i]` is the index in the input of `polytope.vertices()[i]` (the first such index when duplicated).
     pub source: Vec<usize>,
+}
+
+/// The smallest nonzero coordinate magnitude [`convex_hull`] accepts. The exact predicates (Shewchuk's adaptive
+/// `orient3d`) are exact only while no product of coordinate differences underflows: a coordinate that is 0 or at
+/// least 1e-50 in magnitude makes every nonzero difference at least `ulp(1e-50)`, about 2^-218, and a product of
+/// three of them (with their expansion tails) stays far above the smallest normal double, 2^-1022. Below it a
+/// product can round to zero, and a hull of such points could come out inconsistent.
+pub const MIN_COORDINATE: f64 = 1e-50;
+
+/// The largest coordinate magnitude [`convex_hull`] accepts: cubes of differences stay below 1e151, far from
+/// overflow. (Part files are held to a tighter 1e9 mm, [`crate::io::MAX_COORDINATE`].)
+pub const MAX_HULL_COORDINATE: f64 = 1e50;
+
+/// The first coordinate outside `{0} u [MIN_COORDINATE, MAX_HULL_COORDINATE]`, with its point's index.
+fn out_of_range(points: &[DVec3]) -> Option<(usize, f64)> {
+    points.iter().enumerate().find_map(|(i, p)| {
+        p.to_array()
+            .into_iter()
+            .find(|c| *c != 0.0 && !(MIN_COORDINATE..=MAX_HULL_COORDINATE).contains(&c.abs()))
+            .map(|c| (i, c))
+    })
 }
 
 const NONE: u32 = u32::MAX;
@@ -111,6 +143,9 @@ pub fn convex_hull(points: &[DVec3]) -> Result<ConvexHull, HullError> {
     }
     if let Some(index) = points.iter().position(|p| !p.is_finite()) {
         return Err(HullError::NonFinite { index });
+    }
+    if let Some((index, value)) = out_of_range(points) {
+        return Err(HullError::OutOfRange { index, value });
     }
     let simplex = initial_simplex(points)?;
     // a slight overestimate of the largest |q - a| keeps the static filter safe
@@ -515,6 +550,22 @@ mod tests {
         let plane: Vec<DVec3> = (0..9).map(|i| DVec3::new((i % 3) as f64, (i / 3) as f64, 2.0)).collect();
         assert_eq!(convex_hull(&plane), Err(HullError::Coplanar));
         assert_eq!(convex_hull(&[DVec3::ZERO, DVec3::new(f64::NAN, 0.0, 0.0)]), Err(HullError::NonFinite { index: 1 }));
+    }
+
+    #[test]
+    fn coordinates_whose_products_would_underflow_or_overflow_are_rejected() {
+        let tetra = |s: f64| [DVec3::ZERO, DVec3::new(s, 0.0, 0.0), DVec3::new(0.0, s, 0.0), DVec3::new(0.0, 0.0, s)];
+        // a tetrahedron of edge 1e-160: its volume determinant (1e-480) underflows; it was reported "coplanar"
+        assert_eq!(convex_hull(&tetra(1e-160)), Err(HullError::OutOfRange { index: 1, value: 1e-160 }));
+        assert_eq!(convex_hull(&tetra(-1e60)), Err(HullError::OutOfRange { index: 1, value: -1e60 }));
+        // the ends of the range are accepted, and zeros anywhere
+        for s in [MIN_COORDINATE, 1e-40, 1e40, MAX_HULL_COORDINATE] {
+            assert_eq!(convex_hull(&tetra(s)).map(|h| h.polytope.vertices().len()), Ok(4), "edge {s:e}");
+        }
+        // two tetrahedra 1e-300 apart in z (the fuzzer's case: "internal hull error: face 3 is degenerate")
+        let mut two = tetra(1.0).to_vec();
+        two.push(DVec3::new(0.0, 0.0, 1e-300));
+        assert_eq!(convex_hull(&two), Err(HullError::OutOfRange { index: 4, value: 1e-300 }));
     }
 
     #[test]

@@ -27,7 +27,7 @@ pub mod triangulate;
 pub mod vertex_cycle;
 
 pub use glam::{DMat3, DVec2, DVec3};
-pub use hull::{ConvexHull, HullError, convex_hull};
+pub use hull::{ConvexHull, HullError, MAX_HULL_COORDINATE, MIN_COORDINATE, convex_hull};
 pub use io::{IoError, ReadOptions, read_part, write_part};
 pub use mass::MassProperties;
 pub use part::{BoundaryFace, Part, PartError, PartOrigin};

@@ -134,6 +134,13 @@ const CASES: &[(&str, Check, &str)] = &[
         |e| matches!(e, IoError::BadCoordinate { at: Place::PiecePoint { piece: 1, point: 3 }, .. }),
         "piece 1, point 3",
     ),
+    (
+        // a nonzero coordinate below 1e-50 would underflow the exact predicates' products (the hull came out
+        // inconsistent: "internal hull error", found by fuzzing the CLI)
+        "json_coordinate_too_small.json",
+        |e| matches!(e, IoError::BadCoordinate { at: Place::PiecePoint { piece: 1, point: 0 }, value, .. } if *value == 1e-300),
+        "piece 1, point 0",
+    ),
     ("json_truncated.json", |e| matches!(e, IoError::Syntax { at: Place::LineColumn { line: 2, .. }, .. }), "line 2"),
     (
         "json_wrong_point_length.json",

@@ -144,13 +144,28 @@ pub fn uniform_thetas(n: usize) -> Vec<f64> {
     (0..n).map(|k| k as f64 * std::f64::consts::TAU / n as f64).collect()
 }
 
-/// Angles `0, step, 2 step, ...` below a full turn (`step` in radians, positive).
-pub fn thetas_with_step(step: f64) -> Vec<f64> {
+/// The most angles a theta set may hold ([`PlacementRequest::thetas`]): steps of 0.01 degree. Every angle is an
+/// orientation of the search per resting pose, with its own obstacles, so memory and time grow with the count.
+pub const MAX_THETAS: usize = 36_000;
+
+/// Angles `0, step, 2 step, ...` below a full turn (`step` in radians).
+///
+/// # Errors
+/// [`PlacementError::BadOption`] when `step` is not positive and finite, or so small that the turn would take more
+/// than [`MAX_THETAS`] angles (a step below 0.01 degree).
+pub fn thetas_with_step(step: f64) -> Result<Vec<f64>, PlacementError> {
     if !(step > 0.0 && step.is_finite()) {
-        return Vec::new();
+        return Err(PlacementError::BadOption(format!("the theta step must be positive and finite, got {step} rad")));
     }
-    let n = (std::f64::consts::TAU / step - 1e-9).ceil().max(1.0) as usize;
-    (0..n).map(|k| k as f64 * step).collect()
+    let n = (std::f64::consts::TAU / step - 1e-9).ceil().max(1.0);
+    if n > MAX_THETAS as f64 {
+        return Err(PlacementError::BadOption(format!(
+            "a theta step of {} degrees makes {n:.0} angles per turn; at most {MAX_THETAS} are supported (a step of at \
+             least 0.01 degree)",
+            step.to_degrees()
+        )));
+    }
+    Ok((0..n as usize).map(|k| k as f64 * step).collect())
 }
 
 /// Checks that `poly` (named `what` in the message) is a convex polygon, counter-clockwise seen from above, with at
@@ -219,6 +234,12 @@ impl<'a> PlacementRequest<'a> {
         }
         if self.thetas.is_empty() {
             return Err(PlacementError::BadOption("the theta set is empty".into()));
+        }
+        if self.thetas.len() > MAX_THETAS {
+            return Err(PlacementError::BadOption(format!(
+                "the theta set has {} angles; at most {MAX_THETAS} are supported",
+                self.thetas.len()
+            )));
         }
         if let Some(i) = self.thetas.iter().position(|t| !t.is_finite()) {
             return Err(PlacementError::BadOption(format!("theta {i} is not finite")));
@@ -323,4 +344,22 @@ pub enum PlacementError {
         /// Placements found before giving up.
         found: usize,
     },
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn theta_steps_are_checked_before_anything_is_allocated() {
+        let five = thetas_with_step(5f64.to_radians()).expect("5 degrees");
+        assert_eq!(five.len(), 72);
+        assert_eq!(thetas_with_step(0.01f64.to_radians()).expect("the finest step").len(), MAX_THETAS);
+        assert_eq!(thetas_with_step(std::f64::consts::TAU).expect("a whole turn"), vec![0.0]);
+        // a step a little finer than 0.01 degree, and one that used to overflow the vector's capacity (a panic)
+        for step in [0.0099f64.to_radians(), 1e-300, 0.0, -1.0, f64::NAN, f64::INFINITY] {
+            let err = thetas_with_step(step).expect_err("not a supported step");
+            assert!(matches!(err, PlacementError::BadOption(_)), "{step}: {err}");
+        }
+    }
 }

@@ -320,7 +320,7 @@ pub fn plan_stack_with_progress(
             options.partitions
         )));
     }
-    let thetas = thetas_with_step(options.dtheta);
+    let thetas = thetas_with_step(options.dtheta).map_err(|e| PlanError::BadOption(format!("dtheta: {e}")))?;
     let poses =
         stackplan_stability::resting_poses::resting_poses(part).map_err(|e| PlanError::NoRestingPose(e.to_string()))?;
     if poses.is_empty() {

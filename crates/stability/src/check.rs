@@ -163,6 +163,13 @@ pub(crate) fn analyse(stack: &[PlacedPart<'_>], options: &CheckOptions) -> Resul
             options.grasp.cup_diameter
         )));
     }
+    if options.margin_directions > crate::equilibrium::MAX_MARGIN_DIRECTIONS {
+        return Err(StabilityError::BadOption(format!(
+            "at most {} margin directions are supported, got {}",
+            crate::equilibrium::MAX_MARGIN_DIRECTIONS,
+            options.margin_directions
+        )));
+    }
     let parts = world_stack(stack)?;
     let released = if options.release_drops.is_empty() {
         None

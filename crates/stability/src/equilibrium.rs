@@ -204,7 +204,7 @@ impl Verdict {
 pub struct EquilibriumOptions {
     /// Coulomb friction coefficient (>= 0).
     pub mu: f64,
-    /// Number of horizontal load directions for the margin (0 = no margin).
+    /// Number of horizontal load directions for the margin (0 = no margin; at most [`MAX_MARGIN_DIRECTIONS`]).
     pub directions: usize,
     /// Compute every margin by its SOCP, also where the closed form of a part on a flat support applies (for
     /// cross-checking the closed form; the results agree to the solver's tolerance).
@@ -222,6 +222,10 @@ pub struct EquilibriumOptions {
     #[serde(default)]
     pub verdict_only: bool,
 }
+
+/// The most horizontal load directions [`EquilibriumOptions::directions`] may ask for: steps of 0.1 degree. Each
+/// direction is a margin problem per group of contacts, so the work grows linearly with the count.
+pub const MAX_MARGIN_DIRECTIONS: usize = 3600;
 
 impl EquilibriumOptions {
     /// Friction `mu`, `directions` margin directions, closed-form margins where they apply.
@@ -269,6 +273,9 @@ pub enum EquilibriumError {
     /// Friction coefficient negative or not finite.
     #[error("friction coefficient must be finite and >= 0, got {0}")]
     BadFriction(f64),
+    /// More margin directions than [`MAX_MARGIN_DIRECTIONS`].
+    #[error("at most {MAX_MARGIN_DIRECTIONS} margin directions are supported, got {0}")]
+    TooManyDirections(usize),
     /// A patch refers to a part that does not exist.
     #[error("contact patch {patch} refers to part {part}, but there are {len} parts")]
     BadPart {
@@ -356,6 +363,9 @@ pub fn solve_equilibrium_with(
 ) -> Result<Equilibrium, EquilibriumError> {
     if !(options.mu >= 0.0 && options.mu.is_finite()) {
         return Err(EquilibriumError::BadFriction(options.mu));
+    }
+    if options.directions > MAX_MARGIN_DIRECTIONS {
+        return Err(EquilibriumError::TooManyDirections(options.directions));
     }
     let is_movable = |i: usize| movable.get(i).copied().unwrap_or(false);
     let mut points = Vec::new();

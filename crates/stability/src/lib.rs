@@ -35,7 +35,8 @@ pub use addition::check_added_part;
 pub use check::{CheckOptions, PartCheck, StackCheck, check_stack, check_stack_reference};
 pub use contacts::{Body, ContactAnalysis, ContactPatch, analyse_contacts};
 pub use equilibrium::{
-    Equilibrium, EquilibriumOptions, SolveCache, Verdict, solve_equilibrium, solve_equilibrium_with,
+    Equilibrium, EquilibriumOptions, MAX_MARGIN_DIRECTIONS, SolveCache, Verdict, solve_equilibrium,
+    solve_equilibrium_with,
 };
 pub use grasp::{GraspFace, GraspOptions, grasp_faces};
 pub use growing::{Accepted, GrowingStack, Rejection, ToleranceScale};

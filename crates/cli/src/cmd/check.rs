@@ -5,7 +5,7 @@
 
 use crate::Outcome;
 use crate::output;
-use crate::plan_files::plan_summary;
+use crate::plan_files::{plan_option, plan_summary};
 use anyhow::Context;
 use serde::Serialize;
 use stackplan::stability::check::{CheckOptions, StackCheck, check_stack};
@@ -31,7 +31,7 @@ pub struct Args {
     /// Contact tolerance (mm) instead of the policy's 1e-9 x stack size (for stacks with rounded coordinates).
     #[arg(long)]
     pub contact_tolerance: Option<f64>,
-    /// Horizontal directions sampled for the robustness margins.
+    /// Horizontal directions sampled for the robustness margins (0 to 3600).
     #[arg(long, default_value_t = 8)]
     pub margin_directions: usize,
     /// JSON output.
@@ -73,12 +73,6 @@ fn release_drops(path: &Path, extras: &[serde_json::Map<String, serde_json::Valu
         .collect()
 }
 
-/// `options.KEY` of a plan file's summary (`stackplan plan` writes the planner's options there) when it is a finite
-/// number; `None` for a plain stack file or any other value.
-fn plan_option(plan: Option<&serde_json::Map<String, serde_json::Value>>, key: &str) -> Option<f64> {
-    plan?.get("options")?.get(key)?.as_f64().filter(|v| v.is_finite())
-}
-
 /// Runs `check`.
 pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let file = stackplan::geom::io::stack::read_stack(&args.stack)
@@ -91,9 +85,22 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     // a plan file is checked with the planner's own friction, clearance and cup unless the command line says otherwise;
     // a `plan` that is not a summary object is an error, as for `stackplan render` (`plan_summary`)
     let plan = plan_summary(file.plan.as_ref(), &args.stack)?;
-    let mu = args.mu.or_else(|| plan_option(plan, "mu")).unwrap_or(0.5);
-    let clearance = args.clearance.or_else(|| plan_option(plan, "clearance")).unwrap_or(0.0);
-    let cup_diameter = args.cup_diameter.or_else(|| plan_option(plan, "cup_diameter")).unwrap_or(30.0);
+    let option = |key: &str| match plan {
+        Some(summary) => plan_option(summary, key, &args.stack),
+        None => Ok(None),
+    };
+    let mu = match args.mu {
+        Some(mu) => mu,
+        None => option("mu")?.unwrap_or(0.5),
+    };
+    let clearance = match args.clearance {
+        Some(clearance) => clearance,
+        None => option("clearance")?.unwrap_or(0.0),
+    };
+    let cup_diameter = match args.cup_diameter {
+        Some(cup) => cup,
+        None => option("cup_diameter")?.unwrap_or(30.0),
+    };
     let options = CheckOptions {
         mu,
         clearance,

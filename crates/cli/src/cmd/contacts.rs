@@ -9,7 +9,7 @@ use crate::output;
 use anyhow::Context;
 use stackplan::contact_states::acsg::{AcsgSettings, generate};
 use stackplan::contact_states::criteria::ContactPart;
-use stackplan::contact_states::ga::GaSettings;
+use stackplan::contact_states::ga::{GaSettings, MAX_GA_SIZE};
 use stackplan::contact_states::pose::ConfigBox;
 use stackplan_geom::{DMat3, DVec3, Part, PartOrigin};
 use std::path::PathBuf;
@@ -33,10 +33,10 @@ pub struct Args {
     /// GA seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// GA population.
+    /// GA population (4 to 100000).
     #[arg(long, default_value_t = GaSettings::default().population)]
     pub population: usize,
-    /// GA generations.
+    /// GA generations (at most 100000).
     #[arg(long, default_value_t = GaSettings::default().generations)]
     pub generations: usize,
     /// Split concave sheet-metal faces by plain triangulation.
@@ -62,16 +62,27 @@ fn parse_list(s: &str, n: usize, what: &str) -> anyhow::Result<Vec<f64>> {
 
 fn config(s: &str, what: &str) -> anyhow::Result<[f64; 6]> {
     let v = parse_list(s, 6, what)?;
+    crate::input::check_lengths(&format!("{what} (X,Y,Z)"), &v[..3])?;
     Ok([v[0], v[1], v[2], v[3].to_radians(), v[4].to_radians(), v[5].to_radians()])
 }
 
 /// Runs the command.
 pub fn run(args: &Args) -> anyhow::Result<Outcome> {
-    anyhow::ensure!(args.population >= 4, "--population must be at least 4");
+    anyhow::ensure!(
+        (4..=MAX_GA_SIZE).contains(&args.population),
+        "--population must lie in 4..={MAX_GA_SIZE}, got {}",
+        args.population
+    );
+    anyhow::ensure!(
+        args.generations <= MAX_GA_SIZE,
+        "--generations must be at most {MAX_GA_SIZE}, got {}",
+        args.generations
+    );
     let bounds = ConfigBox::new(config(&args.t_min, "--t-min")?, config(&args.t_max, "--t-max")?)?;
     let PartPair { moving, mut fixed, .. } = load_pair(&args.moving, &args.fixed, args.triangulate, None, None)?;
     if let Some(o) = &args.offset {
         let v = parse_list(o, 3, "--offset")?;
+        crate::input::check_lengths("--offset", &v)?;
         let shift = DVec3::new(v[0], v[1], v[2]);
         let components = fixed.components.iter().map(|c| c.transformed(DMat3::IDENTITY, shift)).collect();
         fixed = Part::from_components(fixed.name.clone(), components, fixed.density, PartOrigin::ConvexPieces)?;
@@ -87,7 +98,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         },
         ..AcsgSettings::default()
     };
-    let graph = generate(&fixed, &moving, bounds, settings);
+    let graph = generate(&fixed, &moving, bounds, settings)?;
     if let Some(path) = &args.dot {
         output::write_atomic(path, graph.to_dot().as_bytes())?;
     }

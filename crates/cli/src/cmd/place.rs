@@ -42,7 +42,7 @@ pub struct Args {
     /// Minimise the squared distance of the part's c.g. to `X,Y,Z` instead of cost (1).
     #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
     pub target: Option<[f64; 3]>,
-    /// Step of the rotation about z (degrees).
+    /// Step of the rotation about z (degrees, 0.01 to 360).
     #[arg(long, default_value_t = 1.0)]
     pub dtheta_deg: f64,
     /// Minimum distance to the stack's parts (mm).
@@ -95,9 +95,24 @@ struct Output<'a> {
 pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let part = load_part(&args.part)?;
     let stack_file = read_stack(&args.stack)?;
-    if !(args.dtheta_deg > 0.0 && args.dtheta_deg <= 360.0) {
-        bail!("--dtheta-deg must lie in (0, 360], got {}", args.dtheta_deg);
+    crate::input::check_dtheta_deg(args.dtheta_deg)?;
+    let check_lengths = crate::input::check_lengths;
+    if let Some(floor) = &args.floor {
+        check_lengths("--floor", floor)?;
     }
+    if let Some(height) = args.height {
+        check_lengths("--height", &[height])?;
+    }
+    if let Some(origin) = &args.origin {
+        check_lengths("--origin", origin)?;
+    }
+    if let Some(target) = &args.target {
+        check_lengths("--target", target)?;
+    }
+    if let Some(z) = args.fixed_z {
+        check_lengths("--fixed-z", &[z])?;
+    }
+    check_lengths("--clearance", &[args.clearance])?;
     let diag = {
         let (lo, hi) = part.aabb();
         (hi - lo).length()
@@ -122,6 +137,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         let pts = match file {
             PolygonFile::Bare(p) | PolygonFile::Wrapped { polygon: p } => p,
         };
+        check_lengths(&format!("{}: corners", path.display()), pts.as_flattened())?;
         pts.into_iter().map(|[x, y]| DVec2::new(x, y)).collect()
     } else if let Some([x0, y0, x1, y1]) = args.floor {
         if !(x1 > x0 && y1 > y0) {
@@ -137,7 +153,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let stack: Vec<StackPart<'_>> =
         stack_file.placements.iter().map(|pose| StackPart { part: &stack_file.part, pose: *pose }).collect();
     let mut request = PlacementRequest::new(&part, stack, floor.clone());
-    request.thetas = thetas_with_step(args.dtheta_deg.to_radians());
+    request.thetas = thetas_with_step(args.dtheta_deg.to_radians()).context("--dtheta-deg")?;
     request.clearance = args.clearance;
     request.insertion = args.insertion;
     request.fixed_z = args.fixed_z;

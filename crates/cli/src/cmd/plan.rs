@@ -46,7 +46,7 @@ pub struct PlannerArgs {
     /// Clearance between parts for the robot's positioning error (mm).
     #[arg(long, default_value_t = 5.0)]
     pub clearance: f64,
-    /// Step of the rotation about z (degrees).
+    /// Step of the rotation about z (degrees, 0.01 to 360).
     #[arg(long, default_value_t = 5.0)]
     pub dtheta_deg: f64,
     /// Friction coefficient.
@@ -75,8 +75,9 @@ fn parse_floor(s: &str) -> anyhow::Result<[f64; 4]> {
         .map(|x| x.trim().parse::<f64>().with_context(|| format!("--floor: {x:?} is not a number")))
         .collect::<anyhow::Result<_>>()?;
     let [x0, y0, x1, y1] = v[..] else { bail!("--floor needs four numbers X0,Y0,X1,Y1, got {}", v.len()) };
-    if !(x0 < x1 && y0 < y1) || v.iter().any(|x| !x.is_finite()) {
-        bail!("--floor {s}: needs X0 < X1 and Y0 < Y1, finite");
+    crate::input::check_lengths("--floor", &v)?;
+    if !(x0 < x1 && y0 < y1) {
+        bail!("--floor {s}: needs X0 < X1 and Y0 < Y1");
     }
     Ok([x0, y0, x1, y1])
 }
@@ -85,7 +86,7 @@ fn parse_floor(s: &str) -> anyhow::Result<[f64; 4]> {
 /// names with the value.
 pub fn check_w(option: &str, w: f64) -> anyhow::Result<()> {
     if !(0.0..=1.0).contains(&w) {
-        bail!("{option} must lie in [0, 1], got {w}");
+        bail!("{option} must lie in [0, 1], got {}", crate::input::short_number(w));
     }
     Ok(())
 }
@@ -103,9 +104,12 @@ impl PlannerArgs {
                 self.search_partitions
             );
         }
-        if !(self.dtheta_deg > 0.0 && self.dtheta_deg <= 360.0) {
-            bail!("--dtheta-deg must lie in (0, 360], got {}", self.dtheta_deg);
+        crate::input::check_dtheta_deg(self.dtheta_deg)?;
+        if let Some(height) = self.height {
+            crate::input::check_lengths("--height", &[height])?;
         }
+        crate::input::check_lengths("--clearance", &[self.clearance])?;
+        crate::input::check_lengths("--cup-diameter", &[self.cup_diameter])?;
         load_part_spec(spec, crate::input::decomposition(self.triangulate), false)
     }
 

@@ -13,7 +13,7 @@ use crate::cmd::plan::{PlannerArgs, check_w, run_planner};
 use crate::output::{json_text, write_all_atomic};
 use crate::plan_files::{PNG_SCALE, PlanFile, parse_plan_file, plan_document_text, stack_scene};
 use crate::render::{Figure, FigurePanel, ISOMETRIC, Scene, figure_png, figure_svg};
-use anyhow::Context;
+use anyhow::{Context, bail};
 use serde::Serialize;
 use stackplan_geom::{Part, Pose};
 use std::path::PathBuf;
@@ -78,8 +78,12 @@ pub fn parse_w_values(s: &str) -> anyhow::Result<Vec<f64>> {
         .split(',')
         .map(|x| x.trim().parse::<f64>().with_context(|| format!("--w-values: {x:?} is not a number")))
         .collect::<anyhow::Result<_>>()?;
-    for &w in &values {
+    for (k, &w) in values.iter().enumerate() {
         check_w("--w-values", w)?;
+        // each weight names its own plan file, and two runs of one weight would be the same plan
+        if values[..k].contains(&w) {
+            bail!("--w-values: {w} is given twice");
+        }
     }
     Ok(values)
 }
@@ -114,6 +118,14 @@ pub fn layer_counts(part: &Part, poses: &[Pose]) -> Vec<usize> {
     counts
 }
 
+/// The file name of the plan at weight `w`: `plan-w<W>.json` with `W` as Rust prints the number (`plan-w0.5.json`),
+/// or in scientific notation when that is long (`plan-w1e-300.json`, not three hundred zeros). Both are the shortest
+/// digits that read back as `w`, so distinct weights get distinct names.
+fn plan_file_name(w: f64) -> String {
+    let plain = w.to_string();
+    if plain.len() <= 24 { format!("plan-w{plain}.json") } else { format!("plan-w{w:e}.json") }
+}
+
 /// Runs `sweep`.
 pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let ws = parse_w_values(&args.w_values)?;
@@ -139,7 +151,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
                 return Err(e.context(format!("sweeping {} at w = {}", args.part, options.w)));
             }
         };
-        let name = format!("plan-w{}.json", options.w);
+        let name = plan_file_name(options.w);
         let text = plan_document_text(&part, &plan, seconds)?;
         let file = parse_plan_file(text.as_bytes(), &args.out.join(&name))?;
         plans.push((name, text, file));
@@ -231,5 +243,10 @@ mod tests {
         let e = parse_w_values("0,1.5").expect_err("1.5 is not a weight");
         assert_eq!(e.to_string(), "--w-values must lie in [0, 1], got 1.5");
         assert!(parse_w_values("0,x").is_err());
+        let e = parse_w_values("0.5,1,0.5").expect_err("a repeated weight");
+        assert!(e.to_string().contains("0.5 is given twice"), "{e}");
+        assert_eq!(plan_file_name(0.5), "plan-w0.5.json");
+        assert_eq!(plan_file_name(1.0), "plan-w1.json");
+        assert_eq!(plan_file_name(1e-300), "plan-w1e-300.json");
     }
 }

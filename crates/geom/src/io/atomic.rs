@@ -38,11 +38,18 @@ pub fn write_atomic_with(
 /// written. The error names the file. O(total size).
 pub fn write_all_atomic<'a>(files: impl IntoIterator<Item = (&'a Path, &'a [u8])>) -> Result<(), IoError> {
     let mut staged_files = Vec::new();
+    let mut targets = Vec::new();
     for (path, bytes) in files {
         // a target that is a directory would fail only at its rename, after the others were renamed
         if path.is_dir() {
             return Err(IoError::os(path, std::io::Error::other("is a directory")));
         }
+        // two outputs to one file: the last would silently replace the first (an SVG in `stack.png`)
+        let target = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+        if targets.contains(&target) {
+            return Err(IoError::os(path, std::io::Error::other("is given for two outputs")));
+        }
+        targets.push(target);
         staged_files.push((staged(path, |w| w.write_all(bytes))?, path));
     }
     for (tmp, path) in staged_files {

@@ -127,8 +127,14 @@ pub enum IoError {
         /// What is wrong.
         message: String,
     },
-    /// A NaN or infinite coordinate, or one beyond [`MAX_COORDINATE`].
-    #[error("{}: {at}: coordinate {} is not finite or exceeds {MAX_COORDINATE:e} mm in magnitude", file.display(), short_number(*value))]
+    /// A NaN or infinite coordinate, one beyond [`MAX_COORDINATE`], or a nonzero one below
+    /// [`crate::MIN_COORDINATE`] in magnitude.
+    #[error(
+        "{}: {at}: coordinate {} is not finite or outside the supported range (0, or a magnitude from 1e-50 to \
+         {MAX_COORDINATE:e} mm)",
+        file.display(),
+        short_number(*value)
+    )]
     BadCoordinate {
         /// The file.
         file: PathBuf,
@@ -373,9 +379,9 @@ fn short_number(value: f64) -> String {
     if exponent.len() < plain.len() { exponent } else { plain }
 }
 
-/// Checks one coordinate: finite and within [`MAX_COORDINATE`].
+/// Checks one coordinate: finite, and 0 or of a magnitude from [`crate::MIN_COORDINATE`] to [`MAX_COORDINATE`].
 pub(crate) fn check_coordinate(value: f64, file: &Path, at: impl FnOnce() -> Place) -> Result<f64, IoError> {
-    if value.is_finite() && value.abs() <= MAX_COORDINATE {
+    if value == 0.0 || (crate::MIN_COORDINATE..=MAX_COORDINATE).contains(&value.abs()) {
         Ok(value)
     } else {
         Err(IoError::BadCoordinate { file: file.to_path_buf(), at: at(), value })
