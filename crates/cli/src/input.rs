@@ -54,15 +54,19 @@ pub fn short_number(v: f64) -> String {
     if plain.len() <= sci.len() { plain } else { sci }
 }
 
-/// Checks lengths or coordinates (mm) given by `what` (an option or a file and key): finite and at most
-/// [`MAX_COORDINATE`] (1e9 mm) in magnitude, the range the part readers accept. Beyond it the planner's solvers would
-/// fail with messages about their own internals instead.
+/// Checks lengths or coordinates (mm) given by `what` (an option or a file and key): 0, or a magnitude from
+/// [`MIN_COORDINATE`] (1e-50 mm) to [`MAX_COORDINATE`] (1e9 mm), the range the part readers accept. Outside it the
+/// planner's solvers and hulls would fail with messages about their own internals instead.
 ///
+/// [`MIN_COORDINATE`]: stackplan_geom::MIN_COORDINATE
 /// [`MAX_COORDINATE`]: stackplan_geom::io::MAX_COORDINATE
 pub fn check_lengths(what: &str, values: &[f64]) -> anyhow::Result<()> {
-    let max = stackplan_geom::io::MAX_COORDINATE;
-    if let Some(v) = values.iter().find(|v| !(v.is_finite() && v.abs() <= max)) {
-        anyhow::bail!("{what}: {} is not a finite length of at most {max:e} mm in magnitude", short_number(*v));
+    let (min, max) = (stackplan_geom::MIN_COORDINATE, stackplan_geom::io::MAX_COORDINATE);
+    if let Some(v) = values.iter().find(|v| !(**v == 0.0 || (min..=max).contains(&v.abs()))) {
+        anyhow::bail!(
+            "{what}: {} is not a finite length of 0 or a magnitude from {min:e} to {max:e} mm",
+            short_number(*v)
+        );
     }
     Ok(())
 }
