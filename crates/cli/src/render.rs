@@ -6,6 +6,11 @@
 //! different parts overlap in depth it can be wrong in a small region — pictures are for people, the JSON is the
 //! result. O(F log F) for F faces.
 //!
+//! A face's edges are outlined except the *seams* of the convex decomposition: an edge shared by two coplanar faces
+//! (same outward normal) of one part is drawn in the face's own colour, so a sheet-metal face split into convex pieces
+//! reads as the one face it is, and its bends, holes and outline stay drawn (`outlines_skip_the_seams_of_a_decomposition`).
+//! Seams are found by matching edges whose end points agree after rounding to 1e-7 of the scene's size.
+//!
 //! One drawing routine ([`draw_figure`]) serves both formats through the [`Canvas`] trait: [`SvgCanvas`] writes SVG
 //! elements, [`PngCanvas`] paints with tiny-skia. tiny-skia has no text, so the PNG writes text with a built-in 5 x 7
 //! bitmap font ([`GLYPHS`]: digits and the few signs of part numbers, frame and sweep captions such as `n = 12`,
@@ -246,6 +251,8 @@ pub struct TextStyle {
 pub trait Canvas {
     /// A closed polygon, filled and/or outlined (`stroke`: colour, width, dashed).
     fn polygon(&mut self, points: &[DVec2], fill: Option<[u8; 3]>, stroke: Option<([u8; 3], f64, bool)>);
+    /// Line segments (`stroke`: colour and width), round-capped.
+    fn lines(&mut self, segments: &[(DVec2, DVec2)], color: [u8; 3], width: f64);
     /// A filled disc.
     fn disc(&mut self, centre: DVec2, radius: f64, fill: [u8; 3]);
     /// Text at `at` (its baseline).
@@ -260,7 +267,60 @@ struct ProjectedFace {
     points: Vec<DVec2>,
     depth: f64,
     fill: [u8; 3],
+    /// `seam[k]`: the edge from point `k` to point `k + 1` is shared with a coplanar face of the same part.
+    seam: Vec<bool>,
 }
+
+/// A world point rounded to a grid of `cell`, for matching the end points of edges of different components.
+fn grid_key(p: DVec3, cell: f64) -> [i64; 3] {
+    (p / cell).round().to_array().map(|c| c as i64)
+}
+
+/// The edges of face `f` of `s`, as world end points in the face's order.
+fn face_edges<'a>(s: &'a Solid, f: &'a stackplan_geom::Face) -> impl Iterator<Item = (DVec3, DVec3)> + 'a {
+    let v = s.polytope.vertices();
+    let n = f.vertices.len();
+    (0..n).map(move |k| (v[f.vertices[k]], v[f.vertices[(k + 1) % n]]))
+}
+
+/// For every face of `scene` (solids in order, faces in order), whether each edge is a seam: the same edge (end points
+/// equal on a grid of 1e-7 of the scene's size) of another face of the same part with the same outward normal.
+fn seams(scene: &Scene) -> Vec<Vec<Vec<bool>>> {
+    use std::collections::HashMap;
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for v in scene.solids.iter().flat_map(|s| s.polytope.vertices()) {
+        (lo, hi) = (lo.min(*v), hi.max(*v));
+    }
+    let cell = 1e-7 * (hi - lo).max_element().max(f64::MIN_POSITIVE);
+    type EdgeKey = (usize, [i64; 3], [i64; 3], [i64; 3]);
+    let edge_key = |part: usize, normal: DVec3, a: DVec3, b: DVec3| -> EdgeKey {
+        let (a, b) = (grid_key(a, cell), grid_key(b, cell));
+        let normal = (normal * 1e9).round().to_array().map(|c| c as i64);
+        if a <= b { (part, normal, a, b) } else { (part, normal, b, a) }
+    };
+    let mut count: HashMap<EdgeKey, u32> = HashMap::new();
+    for s in &scene.solids {
+        for f in s.polytope.faces() {
+            for (a, b) in face_edges(s, f) {
+                *count.entry(edge_key(s.part, f.plane.normal, a, b)).or_default() += 1;
+            }
+        }
+    }
+    scene
+        .solids
+        .iter()
+        .map(|s| {
+            s.polytope
+                .faces()
+                .iter()
+                .map(|f| face_edges(s, f).map(|(a, b)| count[&edge_key(s.part, f.plane.normal, a, b)] > 1).collect())
+                .collect()
+        })
+        .collect()
+}
+
+/// The colour of the faces' outlines.
+const OUTLINE: [u8; 3] = [34, 34, 34];
 
 fn shade(c: [u8; 3], normal: DVec3) -> [u8; 3] {
     let light = DVec3::new(0.4, -0.6, 1.0).normalize();
@@ -269,11 +329,11 @@ fn shade(c: [u8; 3], normal: DVec3) -> [u8; 3] {
 }
 
 /// The visible faces of a scene, back to front, in screen coordinates.
-fn visible_faces(scene: &Scene, at: &Placement) -> Vec<ProjectedFace> {
+fn visible_faces(scene: &Scene, seams: &[Vec<Vec<bool>>], at: &Placement) -> Vec<ProjectedFace> {
     let mut faces = Vec::new();
-    for s in &scene.solids {
+    for (s, solid_seams) in scene.solids.iter().zip(seams) {
         let v = s.polytope.vertices();
-        for f in s.polytope.faces() {
+        for (f, seam) in s.polytope.faces().iter().zip(solid_seams) {
             if f.plane.normal.dot(at.frame.toward) <= 1e-9 {
                 continue;
             }
@@ -282,6 +342,7 @@ fn visible_faces(scene: &Scene, at: &Placement) -> Vec<ProjectedFace> {
                 points: f.vertices.iter().map(|&i| at.to_screen(v[i])).collect(),
                 depth: at.frame.toward.dot(centroid),
                 fill: shade(s.color, f.plane.normal),
+                seam: seam.clone(),
             });
         }
     }
@@ -298,12 +359,25 @@ pub fn draw_figure(figure: &Figure<'_>, canvas: &mut dyn Canvas) {
     for (k, (panel, at)) in figure.panels.iter().zip(figure.placements()).enumerate() {
         canvas.begin_group(&format!("view-{k}"));
         let scene = panel.scene;
+        let scene_seams = seams(scene);
         if scene.floor.len() >= 3 {
             let pts: Vec<DVec2> = scene.floor.iter().map(|p| at.to_screen(*p)).collect();
             canvas.polygon(&pts, Some([242, 242, 242]), Some(([136, 136, 136], 0.8, true)));
         }
-        for f in visible_faces(scene, &at) {
-            canvas.polygon(&f.points, Some(f.fill), Some(([34, 34, 34], 0.5, false)));
+        for f in visible_faces(scene, &scene_seams, &at) {
+            if !f.seam.contains(&true) {
+                canvas.polygon(&f.points, Some(f.fill), Some((OUTLINE, 0.5, false)));
+                continue;
+            }
+            // a seam is stroked in the face's own colour (covering the anti-aliased gap between the pieces), the
+            // other edges in the outline colour
+            canvas.polygon(&f.points, Some(f.fill), Some((f.fill, 0.5, false)));
+            let n = f.points.len();
+            let outline: Vec<(DVec2, DVec2)> =
+                (0..n).filter(|&k| !f.seam[k]).map(|k| (f.points[k], f.points[(k + 1) % n])).collect();
+            if !outline.is_empty() {
+                canvas.lines(&outline, OUTLINE, 0.5);
+            }
         }
         for m in &scene.markers {
             canvas.disc(at.to_screen(m.position), 3.0, m.color);
@@ -352,6 +426,16 @@ impl Canvas for SvgCanvas {
             None => String::new(),
         };
         let _ = writeln!(self.out, r#"<polygon points="{}" fill="{fill}"{stroke}/>"#, pts.join(" "));
+    }
+    fn lines(&mut self, segments: &[(DVec2, DVec2)], color: [u8; 3], width: f64) {
+        let d: Vec<String> =
+            segments.iter().map(|(a, b)| format!("M{:.2},{:.2}L{:.2},{:.2}", a.x, a.y, b.x, b.y)).collect();
+        let _ = writeln!(
+            self.out,
+            r#"<path d="{}" fill="none" stroke="{}" stroke-width="{width}" stroke-linecap="round"/>"#,
+            d.join(""),
+            hex(color)
+        );
     }
     fn disc(&mut self, c: DVec2, r: f64, fill: [u8; 3]) {
         let _ = writeln!(self.out, r#"<circle cx="{:.2}" cy="{:.2}" r="{r}" fill="{}"/>"#, c.x, c.y, hex(fill));
@@ -472,6 +556,17 @@ impl Canvas for PngCanvas {
             self.pixmap.stroke_path(&path, &paint(c, true), &stroke, t, None);
         }
     }
+    fn lines(&mut self, segments: &[(DVec2, DVec2)], color: [u8; 3], width: f64) {
+        let mut pb = tiny_skia::PathBuilder::new();
+        for (a, b) in segments {
+            pb.move_to(a.x as f32, a.y as f32);
+            pb.line_to(b.x as f32, b.y as f32);
+        }
+        let Some(path) = pb.finish() else { return };
+        let stroke =
+            tiny_skia::Stroke { width: width as f32, line_cap: tiny_skia::LineCap::Round, ..Default::default() };
+        self.pixmap.stroke_path(&path, &paint(color, true), &stroke, self.transform(), None);
+    }
     fn disc(&mut self, c: DVec2, r: f64, fill: [u8; 3]) {
         if let Some(path) = tiny_skia::PathBuilder::from_circle(c.x as f32, c.y as f32, r as f32) {
             let t = self.transform();
@@ -574,6 +669,45 @@ mod tests {
         assert_eq!(s.matches(">2</text>").count(), 3, "part 2 numbered in each view");
         let p = png(&scene, 1.0).expect("png");
         assert_eq!(&p[1..4], b"PNG");
+    }
+
+    /// Two boxes side by side as one part (a face split into two convex pieces): their shared edge on top is a seam,
+    /// drawn in the face's colour; as two parts it is an outline. Seen from the top, at the middle of that edge.
+    #[test]
+    fn outlines_skip_the_seams_of_a_decomposition() {
+        let boxes = |second_part: usize| Scene {
+            solids: vec![
+                Solid { polytope: cube_at(DVec3::ZERO), color: part_color(0), part: 0 },
+                Solid { polytope: cube_at(DVec3::X), color: part_color(0), part: second_part },
+            ],
+            ..Scene::default()
+        };
+        let seams_of = |scene: &Scene| seams(scene).iter().flatten().flatten().filter(|s| **s).count();
+        // the shared edges of the top, bottom, front and back faces (the glued side faces have opposite normals)
+        assert_eq!(seams_of(&boxes(0)), 2 * 4);
+        assert_eq!(seams_of(&boxes(1)), 0);
+        let top = View { name: "top", toward_viewer: DVec3::Z, up: DVec3::Y };
+        let pixel_on_the_shared_edge = |scene: &Scene| {
+            let figure = Figure {
+                title: String::new(),
+                panels: vec![FigurePanel { scene, view: top, caption: String::new() }],
+                columns: 1,
+                cell: (200.0, 120.0),
+                common_scale: false,
+            };
+            let at = figure.placements();
+            let p = at[0].to_screen(DVec3::new(1.0, 0.5, 1.0));
+            let image = decode(&figure_png(&figure, 1.0).expect("png"));
+            let c = image.pixel(p.x.round() as u32, p.y.round() as u32).expect("inside");
+            [c.red(), c.green(), c.blue()]
+        };
+        let fill = shade(part_color(0), DVec3::Z);
+        assert_eq!(pixel_on_the_shared_edge(&boxes(0)), fill, "a seam is drawn in the face's colour");
+        let outlined = pixel_on_the_shared_edge(&boxes(1));
+        assert!(outlined.iter().zip(fill).all(|(o, f)| *o < f), "{outlined:?} is the outline, darker than {fill:?}");
+        // the SVG: one face with a seam gets its outline as a path of the other three edges
+        let s = svg(&boxes(0));
+        assert!(s.contains(r##"fill="none" stroke="#222222""##), "{s}");
     }
 
     /// The PNG's part numbers: the pixels of the glyphs of "12" appear, black on a white box, at the label.
