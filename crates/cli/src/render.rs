@@ -286,37 +286,34 @@ fn face_edges<'a>(s: &'a Solid, f: &'a stackplan_geom::Face) -> impl Iterator<It
 /// For every face of `scene` (solids in order, faces in order), whether each edge is a seam: the same edge (end points
 /// equal on a grid of 1e-7 of the scene's size) of another face of the same part with the same outward normal.
 fn seams(scene: &Scene) -> Vec<Vec<Vec<bool>>> {
-    use std::collections::HashMap;
     let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
     for v in scene.solids.iter().flat_map(|s| s.polytope.vertices()) {
         (lo, hi) = (lo.min(*v), hi.max(*v));
     }
     let cell = 1e-7 * (hi - lo).max_element().max(f64::MIN_POSITIVE);
-    type EdgeKey = (usize, [i64; 3], [i64; 3], [i64; 3]);
-    let edge_key = |part: usize, normal: DVec3, a: DVec3, b: DVec3| -> EdgeKey {
+    // an edge as one 64-bit hash of (part, rounded normal, rounded end points in order): two different edges agree
+    // with probability 2^-64, and would only lose an outline
+    let edge_key = |part: usize, normal: DVec3, a: DVec3, b: DVec3| -> u64 {
         let (a, b) = (grid_key(a, cell), grid_key(b, cell));
+        let (a, b) = if a <= b { (a, b) } else { (b, a) };
         let normal = (normal * 1e9).round().to_array().map(|c| c as i64);
-        if a <= b { (part, normal, a, b) } else { (part, normal, b, a) }
+        [part as i64].iter().chain(&normal).chain(&a).chain(&b).fold(0x9e37_79b9_7f4a_7c15_u64, |h, &x| {
+            let h = (h ^ x as u64).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            h ^ (h >> 31)
+        })
     };
-    let mut count: HashMap<EdgeKey, u32> = HashMap::new();
-    for s in &scene.solids {
-        for f in s.polytope.faces() {
-            for (a, b) in face_edges(s, f) {
-                *count.entry(edge_key(s.part, f.plane.normal, a, b)).or_default() += 1;
-            }
-        }
-    }
-    scene
+    let keys: Vec<Vec<Vec<u64>>> = scene
         .solids
         .iter()
         .map(|s| {
-            s.polytope
-                .faces()
-                .iter()
-                .map(|f| face_edges(s, f).map(|(a, b)| count[&edge_key(s.part, f.plane.normal, a, b)] > 1).collect())
-                .collect()
+            let faces = s.polytope.faces().iter();
+            faces.map(|f| face_edges(s, f).map(|(a, b)| edge_key(s.part, f.plane.normal, a, b)).collect()).collect()
         })
-        .collect()
+        .collect();
+    let mut sorted: Vec<u64> = keys.iter().flatten().flatten().copied().collect();
+    sorted.sort_unstable();
+    let shared = |key: &u64| sorted.partition_point(|k| k <= key) - sorted.partition_point(|k| k < key) > 1;
+    keys.iter().map(|solid| solid.iter().map(|face| face.iter().map(shared).collect()).collect()).collect()
 }
 
 /// The colour of the faces' outlines.
