@@ -248,6 +248,8 @@ fn fuzzed_inputs_are_clear_errors() {
     let write = |name: &str, text: &str| std::fs::write(dir.path().join(name), text).expect("write");
     write("underflow.json", r#"{"convex_pieces": [[[0,0,0],[1e-160,0,0],[0,1e-160,0],[0,0,1e-160]]]}"#);
     write("huge_floor.json", "[[-1e300,-1e300],[1e300,-1e300],[1e300,1e300],[-1e300,1e300]]");
+    write("clockwise.json", "[[0,0],[0,10],[10,10],[10,0]]");
+    write("tiny_offsets.json", r#"{"convex_pieces": [[[0,1.5e-38,2e-39],[1,0,0],[0,1,0],[0,0,1]]]}"#);
     let mut negative_mu: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("p/plan.json")).expect("plan")).expect("JSON");
     negative_mu["plan"]["options"]["mu"] = serde_json::json!(-0.5);
@@ -268,6 +270,20 @@ fn fuzzed_inputs_are_clear_errors() {
         (vec!["place", "example:cube", "--stack", "p/plan.json", "--origin", "1e308,0,0"], "--origin: 1e308"),
         (vec!["plan", "example:cube", "--floor", "-1e300,-1,1,1", "--out", "x"], "--floor: -1e300"),
         (vec!["render", "p/plan.json", "--png", "s.png", "--svg", "./s.png"], "given for two outputs"),
+        // the second round
+        (
+            vec!["plan", "example:cube", "--clearance", "1e9", "--cup-diameter", "0.5", "--out", "x"],
+            "the default floor (1.5 part sizes plus --clearance): 1000000001.5",
+        ),
+        (
+            [&["contacts", "example:cube", "example:cube"][..], &["--t-min=0.1,0,0,0,0,0", "--t-max=-0.1,0,0,0,0,0"]]
+                .concat(),
+            "--t-min / --t-max: bounds of variable x",
+        ),
+        (
+            vec!["place", "example:cube", "--stack", "p/plan.json", "--floor-polygon", "clockwise.json"],
+            "placing example:cube on the floor polygon of clockwise.json",
+        ),
     ];
     for (args, message) in &cases {
         let o = run_in(dir.path(), args);
@@ -276,4 +292,13 @@ fn fuzzed_inputs_are_clear_errors() {
         assert!(!stderr(&o).contains("panicked"), "{args:?}: {}", stderr(&o));
     }
     assert!(!dir.path().join("x").exists() && !dir.path().join("s.png").exists(), "an error left output behind");
+    // valid requests that failed: a floor 2e7 mm wide for a 1 mm cube ("the cell is unbounded": the Chebyshev LP's
+    // cap was relative to the part), and a part turned by 1e-20 degree whose rounded coordinates (1e-60) underflowed
+    // the hull's exact predicates
+    let wide = ["plan", "example:cube", "--count", "2", "--floor", "-1e7,-1e7,1e7,1e7", "--height", "1e7"];
+    let o =
+        run_in(dir.path(), &[&wide[..], &["--dtheta-deg", "90", "--cup-diameter", "0.5", "--out", "wide"]].concat());
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let o = run_in(dir.path(), &["cspace", "tiny_offsets.json", "example:cube", "--theta-deg", "1e-20", "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
 }

@@ -687,7 +687,12 @@ impl<const D: usize> Cell<D> {
     /// [`Cell::chebyshev`] with its rows in `scratch`.
     fn chebyshev_in(&self, scratch: &mut Scratch) -> Result<CellShape<D>, CellError> {
         let tol = self.tolerance.linear;
-        let cap = 1e6 * self.length_scale();
+        // The cap on the radius tells an unbounded cell (the LP reaches it) from a bounded one. A bounded cell's
+        // radius is at most max |b_i| (unit normals: a positive combination of the rows vanishes, and the same
+        // combination of `a_i . c + r <= b_i` gives `r <= max |b_i|`), so twice that keeps a large bounded cell (a
+        // floor 1e7 mm wide for a 1 mm part: found by fuzzing the CLI) from being reported unbounded.
+        let largest_offset = self.offsets().iter().fold(0.0f64, |m, b| m.max(b.abs()));
+        let cap = (1e6 * self.length_scale()).max(2.0 * largest_offset);
         let Scratch { rows, offsets, .. } = scratch;
         let mut r0 = cap;
         for (row, &b) in self.rows().iter().zip(self.offsets()) {

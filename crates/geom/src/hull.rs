@@ -16,6 +16,10 @@
 //!   exactly the set of extreme points, and every face is strictly convex to its neighbours.
 //!
 //! Flat, collinear and coincident input has no 3-D hull and returns a [`HullError`].
+//!
+//! The exact predicates are exact only while products of coordinate differences neither underflow nor overflow: a
+//! coordinate below [`MIN_COORDINATE`] (1e-50) in magnitude is taken as 0 (the hull's vertices carry the zero), and
+//! one above [`MAX_HULL_COORDINATE`] (1e50) is [`HullError::OutOfRange`].
 
 use crate::polytope::{ConvexPolytope, PolytopeError};
 use crate::predicates::{self, side};
@@ -43,10 +47,10 @@ pub enum HullError {
     /// All points lie in a plane.
     #[error("all points are coplanar: the hull is flat, not a solid")]
     Coplanar,
-    /// A nonzero coordinate smaller than [`MIN_COORDINATE`] or larger than [`MAX_HULL_COORDINATE`] in magnitude.
+    /// A coordinate larger than [`MAX_HULL_COORDINATE`] in magnitude.
     #[error(
-        "point {index} has the coordinate {value:e}, outside the supported range (0, or a magnitude from 1e-50 to \
-         1e50, where the exact predicates neither underflow nor overflow)"
+        "point {index} has the coordinate {value:e}, beyond the supported 1e50 in magnitude (where the exact \
+         predicates' products would overflow)"
     )]
     OutOfRange {
         /// Index of the offending point.
@@ -68,25 +72,36 @@ pub struct ConvexHull {
     pub source: Vec<usize>,
 }
 
-/// The smallest nonzero coordinate magnitude [`convex_hull`] accepts. The exact predicates (Shewchuk's adaptive
-/// `orient3d`) are exact only while no product of coordinate differences underflows: a coordinate that is 0 or at
-/// least 1e-50 in magnitude makes every nonzero difference at least `ulp(1e-50)`, about 2^-218, and a product of
-/// three of them (with their expansion tails) stays far above the smallest normal double, 2^-1022. Below it a
-/// product can round to zero, and a hull of such points could come out inconsistent.
+/// The smallest nonzero coordinate magnitude [`convex_hull`] keeps; smaller ones are taken as 0. The exact predicates
+/// (Shewchuk's adaptive `orient3d`) are exact only while no product of coordinate differences underflows: a
+/// coordinate that is 0 or at least 1e-50 in magnitude makes every nonzero difference at least `ulp(1e-50)`, about
+/// 2^-218, and a product of three of them (with their expansion tails) stays far above the smallest normal double,
+/// 2^-1022. Below it a product can round to zero, and a hull could come out inconsistent (a tetrahedron of edge
+/// 1e-160 was "coplanar", two 1e-300 apart an "internal hull error"). Such coordinates arise from rounding (a part
+/// turned by 1e-50 degree), never from a length that matters: moving a point by less than 1e-50 mm is no change.
+/// The part readers reject them in files ([`crate::io`]), where they can only be mistakes.
 pub const MIN_COORDINATE: f64 = 1e-50;
 
 /// The largest coordinate magnitude [`convex_hull`] accepts: cubes of differences stay below 1e151, far from
 /// overflow. (Part files are held to a tighter 1e9 mm, [`crate::io::MAX_COORDINATE`].)
 pub const MAX_HULL_COORDINATE: f64 = 1e50;
 
-/// The first coordinate outside `{0} u [MIN_COORDINATE, MAX_HULL_COORDINATE]`, with its point's index.
+/// The first coordinate beyond [`MAX_HULL_COORDINATE`], with its point's index.
 fn out_of_range(points: &[DVec3]) -> Option<(usize, f64)> {
-    points.iter().enumerate().find_map(|(i, p)| {
-        p.to_array()
-            .into_iter()
-            .find(|c| *c != 0.0 && !(MIN_COORDINATE..=MAX_HULL_COORDINATE).contains(&c.abs()))
-            .map(|c| (i, c))
-    })
+    points
+        .iter()
+        .enumerate()
+        .find_map(|(i, p)| p.to_array().into_iter().find(|c| c.abs() > MAX_HULL_COORDINATE).map(|c| (i, c)))
+}
+
+/// `points` with every coordinate below [`MIN_COORDINATE`] in magnitude set to 0 (borrowed when there is none).
+fn snap_tiny(points: &[DVec3]) -> std::borrow::Cow<'_, [DVec3]> {
+    let tiny = |c: f64| c != 0.0 && c.abs() < MIN_COORDINATE;
+    if !points.iter().any(|p| p.to_array().into_iter().any(tiny)) {
+        return std::borrow::Cow::Borrowed(points);
+    }
+    let snap = |c: f64| if tiny(c) { 0.0 } else { c };
+    std::borrow::Cow::Owned(points.iter().map(|p| DVec3::new(snap(p.x), snap(p.y), snap(p.z))).collect())
 }
 
 const NONE: u32 = u32::MAX;
@@ -147,6 +162,8 @@ pub fn convex_hull(points: &[DVec3]) -> Result<ConvexHull, HullError> {
     if let Some((index, value)) = out_of_range(points) {
         return Err(HullError::OutOfRange { index, value });
     }
+    let snapped = snap_tiny(points);
+    let points: &[DVec3] = &snapped;
     let simplex = initial_simplex(points)?;
     // a slight overestimate of the largest |q - a| keeps the static filter safe
     let diameter = crate::tolerance::bounding_diagonal(points) * (1.0 + 1e-9);
@@ -553,19 +570,27 @@ mod tests {
     }
 
     #[test]
-    fn coordinates_whose_products_would_underflow_or_overflow_are_rejected() {
+    fn coordinates_whose_products_would_underflow_are_zero_and_overflow_is_an_error() {
         let tetra = |s: f64| [DVec3::ZERO, DVec3::new(s, 0.0, 0.0), DVec3::new(0.0, s, 0.0), DVec3::new(0.0, 0.0, s)];
-        // a tetrahedron of edge 1e-160: its volume determinant (1e-480) underflows; it was reported "coplanar"
-        assert_eq!(convex_hull(&tetra(1e-160)), Err(HullError::OutOfRange { index: 1, value: 1e-160 }));
+        // a tetrahedron of edge 1e-160: its volume determinant (1e-480) underflows; it was reported "coplanar", and
+        // is now all zeros, coincident
+        assert_eq!(convex_hull(&tetra(1e-160)), Err(HullError::Coincident));
         assert_eq!(convex_hull(&tetra(-1e60)), Err(HullError::OutOfRange { index: 1, value: -1e60 }));
-        // the ends of the range are accepted, and zeros anywhere
+        // the ends of the range are kept, and zeros anywhere
         for s in [MIN_COORDINATE, 1e-40, 1e40, MAX_HULL_COORDINATE] {
             assert_eq!(convex_hull(&tetra(s)).map(|h| h.polytope.vertices().len()), Ok(4), "edge {s:e}");
         }
-        // two tetrahedra 1e-300 apart in z (the fuzzer's case: "internal hull error: face 3 is degenerate")
+        // two tetrahedra 1e-300 apart in z (the fuzzer's case: "internal hull error: face 3 is degenerate"): the
+        // point 1e-300 above the origin is the origin, a duplicate
         let mut two = tetra(1.0).to_vec();
         two.push(DVec3::new(0.0, 0.0, 1e-300));
-        assert_eq!(convex_hull(&two), Err(HullError::OutOfRange { index: 4, value: 1e-300 }));
+        let hull = convex_hull(&two).expect("a tetrahedron");
+        assert_eq!(hull.polytope.vertices().len(), 4);
+        assert!(hull.polytope.vertices().iter().all(|v| v.to_array().iter().all(|c| *c == 0.0 || *c == 1.0)));
+        // a tiny coordinate beside normal ones: the vertex carries the zero
+        let tilted = [DVec3::new(0.0, 1.5e-60, 0.0), DVec3::X, DVec3::Y, DVec3::Z];
+        let hull = convex_hull(&tilted).expect("a tetrahedron");
+        assert!(hull.polytope.vertices().contains(&DVec3::ZERO));
     }
 
     #[test]

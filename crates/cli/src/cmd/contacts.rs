@@ -78,7 +78,8 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         "--generations must be at most {MAX_GA_SIZE}, got {}",
         args.generations
     );
-    let bounds = ConfigBox::new(config(&args.t_min, "--t-min")?, config(&args.t_max, "--t-max")?)?;
+    let bounds = ConfigBox::new(config(&args.t_min, "--t-min")?, config(&args.t_max, "--t-max")?)
+        .context("--t-min / --t-max")?;
     let PartPair { moving, mut fixed, .. } = load_pair(&args.moving, &args.fixed, args.triangulate, None, None)?;
     if let Some(o) = &args.offset {
         let v = parse_list(o, 3, "--offset")?;

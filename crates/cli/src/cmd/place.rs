@@ -165,7 +165,12 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
             origin: args.origin.map(DVec3::from_array).unwrap_or_else(|| floor.centre()),
         },
     };
-    let result = place(&request)?;
+    let floor_source = match (&args.floor_polygon, &args.floor) {
+        (Some(path), _) => format!("the floor polygon of {}", path.display()),
+        (None, Some(_)) => "--floor".to_string(),
+        (None, None) => "the default floor".to_string(),
+    };
+    let result = place(&request).with_context(|| format!("placing {} on {floor_source}", args.part.part))?;
     if args.json {
         output::print_json(&Output {
             placements: &result.placements,

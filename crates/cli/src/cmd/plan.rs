@@ -124,7 +124,11 @@ impl PlannerArgs {
         let half = 1.5 * footprint + clearance;
         let [x0, y0, x1, y1] = match &self.floor {
             Some(s) => parse_floor(s)?,
-            None => [-half, -half, half, half],
+            None => {
+                // the default grows with --clearance, which alone could carry it past the readers' range
+                crate::input::check_lengths("the default floor (1.5 part sizes plus --clearance)", &[half])?;
+                [-half, -half, half, half]
+            }
         };
         let height = self.height.unwrap_or(6.0 * size.z.max(size.x.min(size.y)));
         let mut options = PlanOptions::new(self.count, FloorVolume::rectangle(x0, y0, x1, y1, height));
