@@ -47,12 +47,7 @@ pub fn decomposition(triangulate: bool) -> Decomposition {
     if triangulate { Decomposition::Triangulation } else { Decomposition::ConvexMerge }
 }
 
-/// `v` in the shorter of Rust's plain and scientific notations (`0.5`, `1e-300`, not three hundred zeros), for
-/// messages.
-pub fn short_number(v: f64) -> String {
-    let (plain, sci) = (v.to_string(), format!("{v:e}"));
-    if plain.len() <= sci.len() { plain } else { sci }
-}
+pub use stackplan_geom::io::short_number;
 
 /// Checks lengths or coordinates (mm) given by `what` (an option or a file and key): 0, or a magnitude from
 /// [`MIN_COORDINATE`] (1e-50 mm) to [`MAX_COORDINATE`] (1e9 mm), the range the part readers accept. Outside it the

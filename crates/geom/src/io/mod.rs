@@ -372,8 +372,9 @@ pub(crate) fn stem_name(path: &Path) -> String {
     path.file_stem().and_then(|s| s.to_str()).unwrap_or("part").to_string()
 }
 
-/// `value` as Rust prints it, in exponent form when that is shorter (`1e300` rather than 301 digits).
-fn short_number(value: f64) -> String {
+/// `value` as Rust prints it, in exponent form when that is shorter (`1e300` rather than 301 digits): numbers in
+/// messages.
+pub fn short_number(value: f64) -> String {
     let plain = value.to_string();
     let exponent = format!("{value:e}");
     if exponent.len() < plain.len() { exponent } else { plain }
