@@ -57,7 +57,7 @@ pub use stackplan_geom::io::short_number;
 /// [`MAX_COORDINATE`]: stackplan_geom::io::MAX_COORDINATE
 pub fn check_lengths(what: &str, values: &[f64]) -> anyhow::Result<()> {
     let (min, max) = (stackplan_geom::MIN_COORDINATE, stackplan_geom::io::MAX_COORDINATE);
-    if let Some(v) = values.iter().find(|v| !(**v == 0.0 || (min..=max).contains(&v.abs()))) {
+    if let Some(v) = values.iter().find(|v| !stackplan_geom::io::coordinate_in_range(**v)) {
         anyhow::bail!(
             "{what}: {} is not a finite length of 0 or a magnitude from {min:e} to {max:e} mm",
             short_number(*v)

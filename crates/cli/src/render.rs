@@ -8,8 +8,9 @@
 //!
 //! A face's edges are outlined except the *seams* of the convex decomposition: an edge shared by two coplanar faces
 //! (same outward normal) of one part is drawn in the face's own colour, so a sheet-metal face split into convex pieces
-//! reads as the one face it is, and its bends, holes and outline stay drawn (`outlines_skip_the_seams_of_a_decomposition`).
-//! Seams are found by matching edges whose end points agree after rounding to 1e-7 of the scene's size.
+//! reads as the one face it is, and its bends, holes and outline stay drawn
+//! (`outlines_skip_the_seams_of_a_decomposition`). Seams are found by matching edges whose end points agree after
+//! rounding to 1e-7 of the scene's size, once per scene (the three views of a stack share them).
 //!
 //! One drawing routine ([`draw_figure`]) serves both formats through the [`Canvas`] trait: [`SvgCanvas`] writes SVG
 //! elements, [`PngCanvas`] paints with tiny-skia. tiny-skia has no text, so the PNG writes text with a built-in 5 x 7
@@ -353,15 +354,22 @@ pub fn draw_figure(figure: &Figure<'_>, canvas: &mut dyn Canvas) {
     canvas.text(DVec2::new(MARGIN, 20.0), &figure.title, title);
     let label = TextStyle { size: 11.0, anchor: Anchor::Middle, color: [0, 0, 0], halo: true };
     let caption = TextStyle { size: 12.0, anchor: Anchor::Start, color: [85, 85, 85], halo: false };
+    let mut last_seams: Option<(&Scene, Vec<Vec<Vec<bool>>>)> = None;
     for (k, (panel, at)) in figure.panels.iter().zip(figure.placements()).enumerate() {
         canvas.begin_group(&format!("view-{k}"));
         let scene = panel.scene;
-        let scene_seams = seams(scene);
+        // consecutive views of one scene (a stack's three views) share its seams
+        let scene_seams = match last_seams.take() {
+            Some((seen, found)) if std::ptr::eq(seen, scene) => found,
+            _ => seams(scene),
+        };
         if scene.floor.len() >= 3 {
             let pts: Vec<DVec2> = scene.floor.iter().map(|p| at.to_screen(*p)).collect();
             canvas.polygon(&pts, Some([242, 242, 242]), Some(([136, 136, 136], 0.8, true)));
         }
-        for f in visible_faces(scene, &scene_seams, &at) {
+        let faces = visible_faces(scene, &scene_seams, &at);
+        last_seams = Some((scene, scene_seams));
+        for f in faces {
             if !f.seam.contains(&true) {
                 canvas.polygon(&f.points, Some(f.fill), Some((OUTLINE, 0.5, false)));
                 continue;

@@ -380,9 +380,15 @@ pub fn short_number(value: f64) -> String {
     if exponent.len() < plain.len() { exponent } else { plain }
 }
 
-/// Checks one coordinate: finite, and 0 or of a magnitude from [`crate::MIN_COORDINATE`] to [`MAX_COORDINATE`].
+/// Whether a coordinate or length (mm) is in the range the readers accept: 0, or a magnitude from
+/// [`crate::MIN_COORDINATE`] to [`MAX_COORDINATE`] (so never NaN or infinite). The CLI holds its options to it too.
+pub fn coordinate_in_range(value: f64) -> bool {
+    value == 0.0 || (crate::MIN_COORDINATE..=MAX_COORDINATE).contains(&value.abs())
+}
+
+/// Checks one coordinate: [`coordinate_in_range`].
 pub(crate) fn check_coordinate(value: f64, file: &Path, at: impl FnOnce() -> Place) -> Result<f64, IoError> {
-    if value == 0.0 || (crate::MIN_COORDINATE..=MAX_COORDINATE).contains(&value.abs()) {
+    if coordinate_in_range(value) {
         Ok(value)
     } else {
         Err(IoError::BadCoordinate { file: file.to_path_buf(), at: at(), value })
