@@ -48,6 +48,12 @@ fn negative_numbers_are_values() {
     }
     let o = run(&["interference", "example:cube", "example:cube", "--position", "-0.5,0,0", "--theta-deg", "-5"]);
     assert!(o.status.success(), "{}", stderr(&o));
+    // a signed exponent, which clap's own test for a negative number does not take
+    let tiny = at("-1e-5");
+    assert_eq!(tiny["theta_deg"], -1e-5);
+    let o = run(&["cspace", "example:block", "example:l-corner", "--theta-deg", "-v", "--json"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("invalid value '-v' for '--theta-deg"), "{}", stderr(&o));
     let dir = tempfile::tempdir().expect("tempdir");
     let o = run_in(dir.path(), &["plan", "example:block", "--height", "-5"]);
     assert_eq!(o.status.code(), Some(2));
@@ -254,6 +260,10 @@ fn fuzzed_inputs_are_clear_errors() {
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("p/plan.json")).expect("plan")).expect("JSON");
     negative_mu["plan"]["options"]["mu"] = serde_json::json!(-0.5);
     write("negative_mu.json", &negative_mu.to_string());
+    let mut string_height = negative_mu.clone();
+    string_height["plan"]["options"]["mu"] = serde_json::json!(0.5);
+    string_height["plan"]["options"]["floor"]["height"] = serde_json::json!("high");
+    write("string_height.json", &string_height.to_string());
     let max = u64::MAX.to_string();
     let cube_box = ["--t-min", "-0.1,-0.1,-0.1,-1,-1,-1", "--t-max", "0.1,0.1,0.1,1,1,1"];
     let cases: Vec<(Vec<&str>, &str)> = vec![
@@ -270,6 +280,10 @@ fn fuzzed_inputs_are_clear_errors() {
         (vec!["place", "example:cube", "--stack", "p/plan.json", "--origin", "1e308,0,0"], "--origin: 1e308"),
         (vec!["plan", "example:cube", "--floor", "-1e300,-1,1,1", "--out", "x"], "--floor: -1e300"),
         (vec!["render", "p/plan.json", "--png", "s.png", "--svg", "./s.png"], "given for two outputs"),
+        (
+            vec!["render", "string_height.json", "--png", "h.png"],
+            "string_height.json: malformed plan: key `plan.options.floor.height`: invalid type: string \"high\"",
+        ),
         // the second round
         (
             vec!["plan", "example:cube", "--clearance", "1e9", "--cup-diameter", "0.5", "--out", "x"],
@@ -291,7 +305,10 @@ fn fuzzed_inputs_are_clear_errors() {
         assert!(stderr(&o).contains(message), "{args:?}: {}", stderr(&o));
         assert!(!stderr(&o).contains("panicked"), "{args:?}: {}", stderr(&o));
     }
-    assert!(!dir.path().join("x").exists() && !dir.path().join("s.png").exists(), "an error left output behind");
+    assert!(
+        !dir.path().join("x").exists() && !dir.path().join("s.png").exists() && !dir.path().join("h.png").exists(),
+        "an error left output behind"
+    );
     // valid requests that failed: a floor 2e7 mm wide for a 1 mm cube ("the cell is unbounded": the Chebyshev LP's
     // cap was relative to the part), and a part turned by 1e-20 degree whose rounded coordinates (1e-60) underflowed
     // the hull's exact predicates

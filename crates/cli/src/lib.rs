@@ -72,9 +72,21 @@ pub enum Command {
 /// Runs the command line with the process arguments; returns the exit status.
 /// The command line as clap sees it, with negative numbers taken as values in every subcommand (`--theta-deg -30`,
 /// `--fixed-z -1`, `--height -5` reaches its own check), not as unknown flags.
+///
+/// clap's own test for a negative number does not take a signed exponent (`-1e-5`), so every option whose value is a
+/// single `f64` also takes values that start with a hyphen: `--theta-deg -1e-5` is a turn, and `--w -v` is an invalid
+/// number for `--w` rather than a missing value.
 pub fn command() -> clap::Command {
     fn with_negatives(c: clap::Command) -> clap::Command {
-        c.allow_negative_numbers(true).mut_subcommands(with_negatives)
+        c.allow_negative_numbers(true)
+            .mut_args(|a| {
+                if a.get_value_parser().type_id() == std::any::TypeId::of::<f64>() {
+                    a.allow_hyphen_values(true)
+                } else {
+                    a
+                }
+            })
+            .mut_subcommands(with_negatives)
     }
     with_negatives(<Cli as clap::CommandFactory>::command())
 }

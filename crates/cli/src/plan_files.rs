@@ -124,8 +124,14 @@ pub fn parse_plan_file(bytes: &[u8], path: &Path) -> Result<PlanFile, PlanFileEr
     // the summary is typed; the placements' planner fields (cost, theta, stage, ...) are read leniently for the
     // report: JSON has no infinity or NaN, so a non-finite number is written as `null` and shown as "-"
     summary.insert("parts".into(), Value::Array(Vec::new()));
-    let plan: Plan = serde_json::from_value(Value::Object(summary))
-        .map_err(|e| PlanFileError::Malformed { file: path.to_path_buf(), message: format!("key `plan`: {e}") })?;
+    // the error names the nested key (`plan.options.floor.height`), not only the summary
+    let plan: Plan = serde_path_to_error::deserialize(Value::Object(summary)).map_err(|e| {
+        let key = match e.path().to_string().as_str() {
+            "." => "plan".to_string(),
+            nested => format!("plan.{nested}"),
+        };
+        PlanFileError::Malformed { file: path.to_path_buf(), message: format!("key `{key}`: {}", e.inner()) }
+    })?;
     if count == 0 {
         return Err(PlanFileError::Empty { file: path.to_path_buf() });
     }
