@@ -63,6 +63,10 @@ pub struct DerivedObstacle {
     pub planes: Vec<Plane>,
     /// Provenance of each plane.
     pub origins: Vec<PlaneOrigin>,
+    /// With insertion: the planes of the pair's c-space obstacle `C` that face down, which the insertion obstacle
+    /// drops (grown like the others). A position on the insertion obstacle's boundary that violates one of them
+    /// lies below `C`, on its downward sweep: the part does not touch the stack component there. Empty otherwise.
+    pub below: Vec<Plane>,
 }
 
 impl DerivedObstacle {
@@ -97,8 +101,15 @@ impl DerivedObstacle {
         horizontal_clearance: bool,
         with_insertion: bool,
     ) -> Self {
+        let mut below: Vec<Plane> = Vec::new();
         let (mut planes, origins): (Vec<Plane>, Vec<PlaneOrigin>) = if with_insertion {
             let poly = raw.polytope();
+            below = poly
+                .faces()
+                .iter()
+                .filter(|f| f.plane.normal.z < -stackplan_cspace::minkowski::ANGULAR_TOLERANCE)
+                .map(|f| f.plane)
+                .collect();
             let ins = insertion(poly);
             let kept: Vec<PlaneOrigin> = poly
                 .faces()
@@ -114,7 +125,7 @@ impl DerivedObstacle {
             (raw.planes().copied().collect(), raw.face_kinds().iter().map(|k| PlaneOrigin::Face { face: *k }).collect())
         };
         if clearance > 0.0 {
-            for p in &mut planes {
+            for p in planes.iter_mut().chain(&mut below) {
                 // support function of the growth set: the ball (clearance) or the horizontal disc (clearance |n_xy|)
                 p.offset += if horizontal_clearance {
                     clearance * (1.0 - p.normal.z * p.normal.z).max(0.0).sqrt()
@@ -123,7 +134,7 @@ impl DerivedObstacle {
                 };
             }
         }
-        Self { orientation, moving, fixed, planes, origins }
+        Self { orientation, moving, fixed, planes, origins, below }
     }
 
     /// The region of positions at which the part, at `orientation`, lies inside the convex polygon `polygon`
@@ -138,7 +149,14 @@ impl DerivedObstacle {
             .map(|(n, offset)| Plane { normal: glam::DVec3::new(n.x, n.y, 0.0), offset })
             .collect();
         let origins = vec![PlaneOrigin::SearchedElsewhere; planes.len()];
-        Self { orientation: orientation.index, moving: usize::MAX, fixed: usize::MAX, planes, origins }
+        Self {
+            orientation: orientation.index,
+            moving: usize::MAX,
+            fixed: usize::MAX,
+            planes,
+            origins,
+            below: Vec::new(),
+        }
     }
 
     /// Whether this is the region of [`DerivedObstacle::searched_elsewhere`] (no pair's obstacle).
@@ -158,6 +176,21 @@ impl DerivedObstacle {
             depth = depth.min(slack);
         }
         Some(depth + tol)
+    }
+
+    /// Whether `p` lies in the closed set grown by `tol` (`n_k . p <= d_k + tol` for every plane): on a face of the
+    /// obstacle rather than on the face plane's extension beyond it. A cell's constraint from face `k` can be active
+    /// at a point far outside the obstacle (the cells are cut by the face planes, which reach past the face), so an
+    /// active face names a contact only when this holds. O(F).
+    pub fn closure_contains(&self, p: glam::DVec3, tol: f64) -> bool {
+        self.planes.iter().all(|pl| pl.normal.dot(p) <= pl.offset + tol)
+    }
+
+    /// Whether `p` lies below the pair's c-space obstacle, outside one of its down-facing planes by more than `tol`
+    /// (only with insertion, see [`DerivedObstacle::below`]): on the insertion obstacle's boundary, such a position is
+    /// held by the straight-down path past the stack component, not by touching it. O(F).
+    pub fn under_sweep(&self, p: glam::DVec3, tol: f64) -> bool {
+        self.below.iter().any(|pl| pl.normal.dot(p) > pl.offset + tol)
     }
 
     /// Whether `p` lies in the interior by more than `tol` (interference).

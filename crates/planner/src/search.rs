@@ -97,7 +97,7 @@
 use crate::dary_heap::DaryHeap;
 use crate::detect::{CandidateQueue, DetectCounts, DetectScratch, StackScene, SweepAxes};
 use crate::interval_obstacles::{EventStore, IntervalObstacles, ObstacleRoute};
-use crate::obstacles::DerivedObstacle;
+use crate::obstacles::{DerivedObstacle, PlaneOrigin};
 use crate::orientation::{Orientation, SeparableQuadratic, rotated_components};
 use crate::qp::{QpOptimum, Quadratic, minimise};
 use crate::request::{FloorVolume, PlacementError, PlacementRequest, polygon_side_planes};
@@ -2143,15 +2143,23 @@ impl Search<'_, '_> {
             let contact = match cell.halfspaces()[j].tag {
                 Tag::ObstacleFace { obstacle, face } => {
                     let ob = &self.obstacles[obstacle as usize];
-                    if ob.is_searched_elsewhere() {
+                    // a face plane reaches past its face: p touches the obstacle only when it lies on it (the
+                    // cells' tolerance; the clearance's growth is part of the planes)
+                    if ob.is_searched_elsewhere() || !ob.closure_contains(p, self.tol.linear) {
                         continue;
                     }
                     let sc = &self.scene.components[ob.fixed];
+                    // a face of C on the insertion obstacle's boundary below C is a side of the sweep
+                    let face_kind = if ob.under_sweep(p, self.tol.linear) {
+                        PlaneOrigin::InsertionSide.name()
+                    } else {
+                        ob.origins[face as usize].name()
+                    };
                     Contact::Stack {
                         our_component: ob.moving,
                         stack_part: sc.part,
                         stack_component: sc.piece,
-                        face_kind: ob.origins[face as usize].name().to_string(),
+                        face_kind: face_kind.to_string(),
                     }
                 }
                 Tag::Floor => Contact::Floor,

@@ -442,7 +442,11 @@ pub fn plan_stack_with_progress(
                 };
                 let started = std::time::Instant::now();
                 stats.candidates_checked += 1;
-                let candidate = settled(part, &rests, candidate, search.scene(), &cache, tol, &request.cost)?;
+                let mut candidate = settled(part, &rests, candidate, search.scene(), &cache, tol, &request.cost)?;
+                // stage 1's floor is the clipped footprint: its sides are walls only where they lie on the plan's
+                if polygon.is_some() {
+                    candidate.0.contacts = sides_of_floor(&candidate.0.contacts, &request.floor, &options.floor, tol);
+                }
                 let mut verdict = accept(&mut growing, part, &candidate.0, &mut stats)?;
                 // the clearance at the release position as the plan's check measures it
                 if verdict.is_ok() && options.clearance > 0.0 {
@@ -581,6 +585,32 @@ fn cheaper(a: f64, b: f64) -> bool {
     b - a > 1e-9 * (1.0 + a.abs().max(b.abs()))
 }
 
+/// `contacts` found on the floor `searched` (stage 1's clipped region) with their `floor_side` contacts renumbered
+/// as sides of `floor`, the plan's: a side of `searched` on the line of a side of `floor` (parallel outward normals,
+/// offsets within `tol`) is that side; any other side of `searched` is no wall, and its contact is dropped. O(contacts
+/// x sides).
+fn sides_of_floor(contacts: &[Contact], searched: &FloorVolume, floor: &FloorVolume, tol: f64) -> Vec<Contact> {
+    let (searched_sides, floor_sides) = (searched.side_planes(), floor.side_planes());
+    let mut out: Vec<Contact> = Vec::with_capacity(contacts.len());
+    for contact in contacts {
+        let contact = match *contact {
+            Contact::FloorSide { side } => {
+                let Some(&(n, d)) = searched_sides.get(side as usize) else { continue };
+                let on_line = floor_sides.iter().position(|&(m, e)| (n - m).length() <= 1e-9 && (d - e).abs() <= tol);
+                match on_line {
+                    Some(k) => Contact::FloorSide { side: k as u32 },
+                    None => continue,
+                }
+            }
+            ref other => other.clone(),
+        };
+        if !out.contains(&contact) {
+            out.push(contact);
+        }
+    }
+    out
+}
+
 /// The xy bounding rectangle of the placed parts.
 fn footprint(part: &Part, placed: &[Pose]) -> (DVec2, DVec2) {
     let mut lo = DVec2::splat(f64::INFINITY);
@@ -671,6 +701,24 @@ mod tests {
             .collect();
         let hull = convex_hull(&pts).expect("box").polytope;
         Part::from_components("block", vec![hull], 1.0, PartOrigin::ConvexPieces).expect("part")
+    }
+
+    #[test]
+    fn stage_one_floor_sides_are_renumbered_or_dropped() {
+        let floor = FloorVolume::rectangle(0.0, 0.0, 100.0, 50.0, 10.0);
+        // the footprint clipped at x <= 40: its sides 0 (y = 0), 2 (y = 50) and 3 (x = 0) lie on the floor's sides 0,
+        // 2 and 3; its side 1 (x = 40) is no wall
+        let searched = FloorVolume {
+            polygon: clip_to_rectangle(&floor.polygon, DVec2::new(-5.0, -5.0), DVec2::new(40.0, 60.0)),
+            height: 10.0,
+        };
+        assert_eq!(searched.polygon.len(), 4);
+        let side = |side: u32| Contact::FloorSide { side };
+        let stack = Contact::Stack { our_component: 0, stack_part: 0, stack_component: 1, face_kind: "x".into() };
+        let found = [Contact::Floor, side(1), stack.clone(), side(0), side(3)];
+        assert_eq!(searched.polygon, [(0.0, 0.0), (40.0, 0.0), (40.0, 50.0), (0.0, 50.0)].map(DVec2::from));
+        let expected = [Contact::Floor, stack, side(0), side(3)];
+        assert_eq!(sides_of_floor(&found, &searched, &floor, 1e-9), expected);
     }
 
     fn options(count: usize, w: f64, floor: FloorVolume) -> PlanOptions {
