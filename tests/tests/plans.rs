@@ -89,7 +89,7 @@ fn render_names_the_file_of_a_malformed_plan_and_writes_nothing() {
         .expect("write");
     let cases = [
         ("no-summary.json", "not a plan file"),
-        ("bad-summary.json", "malformed plan: key `plan`"),
+        ("bad-summary.json", "malformed plan: key `plan.options`: invalid type: string \"fast\""),
         (
             "wrong-count.json",
             "malformed plan: key `plan.placed`: the summary says 9 parts were placed, but there are 4",

@@ -10,7 +10,7 @@ use proptest::prelude::*;
 use stackplan_cspace::minkowski::{FaceKind, Feature, Obstacle, Route, facet_bound, obstacle, obstacle_by_hull};
 use stackplan_cspace::offset::{clearance, insertion, slice};
 use stackplan_geom::polytope::Containment;
-use stackplan_geom::{ConvexPolytope, Tolerance};
+use stackplan_geom::{ConvexPolytope, Tolerance, convex_hull};
 
 fn any_pair() -> impl Strategy<Value = (ConvexPolytope, ConvexPolytope)> {
     prop_oneof![(dyadic_cloud(4..14), dyadic_cloud(4..14)), (any_box(), any_box()), prism_pair(), prism_pair(),]
@@ -242,6 +242,67 @@ proptest! {
                 continue;
             }
             prop_assert_eq!(m3 < 0.0, d2 > 0.0, "slice disagrees at {:?}", x);
+        }
+    }
+}
+
+/// A convex piece and a copy of it turned by the same general rotation `Q` and moved: the stack of sheet-metal parts
+/// in one orientation (a Triangle nest, or `place` of a part onto a copy of itself), where faces and edges of the two
+/// are parallel only up to rounding in directions that are not axes. Returns (A, R, B) with A moving by `R`: either
+/// `A = Q P` and `R = I`, or `A = P` and `R = Q` (the planner's split into a resting rotation and a turn).
+fn copies_in_one_orientation() -> impl Strategy<Value = (ConvexPolytope, DMat3, ConvexPolytope)> {
+    let sheet =
+        ((5.0f64..60.0, 5.0f64..60.0, 0.5f64..4.0)).prop_map(|(x, y, z)| cuboid(DVec3::ZERO, DVec3::new(x, y, z)));
+    (
+        prop_oneof![sheet, any_box(), dyadic_cloud(5..10)],
+        (-3.2f64..3.2, -1.6f64..1.6, -3.2f64..3.2),
+        (-80.0f64..80.0, -80.0f64..80.0, -80.0f64..80.0),
+        any::<bool>(),
+    )
+        .prop_filter_map("a copy without a hull", |(piece, (z, y, x), (tx, ty, tz), turn_by_r)| {
+            let q = DMat3::from_euler(glam::EulerRot::ZYX, z, y, x);
+            // each copy as a part file gives it: the exact hull of its turned, rounded vertices (whose face planes are
+            // fitted to those points, so the two copies' normals differ by more than the rotation's rounding)
+            let hull = |t: DVec3| {
+                let points: Vec<DVec3> = piece.vertices().iter().map(|v| q * *v + t).collect();
+                convex_hull(&points).map(|h| h.polytope)
+            };
+            let (Ok(turned), Ok(fixed)) = (hull(DVec3::ZERO), hull(DVec3::new(tx, ty, tz))) else {
+                return None;
+            };
+            Some(if turn_by_r { (piece, q, fixed) } else { (turned, DMat3::IDENTITY, fixed) })
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(cases(64)))]
+
+    /// Whatever route builds it (the overlay, or the exact hull of the differences when the overlay of these nearly
+    /// parallel features is inconsistent), the obstacle's planes support every difference point and its interior is
+    /// the LP oracle's. Before the hull computed its face planes accurately, the fallback's sliver faces got planes
+    /// that cut the obstacle by tens of millimetres (`place` then put a part into its copy), or the hull failed.
+    #[test]
+    fn copies_in_one_orientation_match_the_lp_oracle(
+        (a, r, b) in copies_in_one_orientation(),
+        samples in prop::collection::vec((0.0f64..1.0, 0.0f64..1.0, 0.0f64..1.0), 10),
+    ) {
+        let o = obstacle(&a, r, &b).map_err(|e| TestCaseError::fail(e.to_string()))?;
+        let c = o.polytope();
+        let pts = differences(&a, r, &b);
+        let scale = stackplan_geom::tolerance::bounding_diagonal(&pts);
+        for (k, f) in c.faces().iter().enumerate() {
+            let above = pts.iter().map(|p| f.plane.signed_distance(*p)).fold(f64::NEG_INFINITY, f64::max);
+            prop_assert!(above <= 1e-9 * scale, "face {} ({:?}): a difference point {} above it", k, o.route(), above);
+        }
+        let (lo, hi) = c.aabb();
+        for (u, v, w) in samples {
+            let p = lo + (hi - lo) * DVec3::new(u, v, w);
+            let margin = c.planes().map(|pl| pl.signed_distance(p)).fold(f64::NEG_INFINITY, f64::max);
+            if margin.abs() < 1e-4 {
+                continue;
+            }
+            let Some(t) = overlap_slack(&a, r, p, &b) else { continue };
+            prop_assert_eq!(margin < 0.0, t > 0.0, "p {:?}: margin {} LP slack {} ({:?})", p, margin, t, o.route());
         }
     }
 }

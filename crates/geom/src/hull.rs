@@ -21,7 +21,8 @@
 //! coordinate below [`MIN_COORDINATE`] (1e-50) in magnitude is taken as 0 (the hull's vertices carry the zero), and
 //! one above [`MAX_HULL_COORDINATE`] (1e50) is [`HullError::OutOfRange`].
 
-use crate::polytope::{ConvexPolytope, PolytopeError};
+use crate::accurate_normal::accurate_cross;
+use crate::polytope::{ConvexPolytope, Face, Plane, PolytopeError};
 use crate::predicates::{self, side};
 use glam::DVec3;
 use std::cmp::Ordering;
@@ -498,13 +499,24 @@ fn merge(p: &[DVec3], tris: &[Tri]) -> Result<ConvexHull, HullError> {
             }
         }
     }
+    // per group, the triangle whose float normal is longest: the best-conditioned of its exactly coplanar triangles,
+    // whose accurate normal is the face's
+    let mut representative: Vec<u32> = vec![NONE; group_count as usize];
+    for (i, t) in tris.iter().enumerate() {
+        if t.alive {
+            let r = &mut representative[group_of[i] as usize];
+            if *r == NONE || t.normal.length_squared() > tris[*r as usize].normal.length_squared() {
+                *r = i as u32;
+            }
+        }
+    }
     let boundary = (0..group_count as usize).map(|g| &flat[bucket_start[g] as usize..bucket_start[g + 1] as usize]);
     let mut next: Vec<u32> = vec![NONE; p.len()];
     let mut new_index: Vec<u32> = vec![NONE; p.len()];
     let mut vertices = Vec::new();
     let mut source = Vec::new();
     let mut faces = Vec::with_capacity(group_count as usize);
-    for b in boundary {
+    for (b, &r) in boundary.zip(&representative) {
         let Some(&(start, _)) = b.iter().min_by_key(|e| e.0) else { continue };
         for &(a, c) in b {
             next[a as usize] = c;
@@ -522,9 +534,21 @@ fn merge(p: &[DVec3], tris: &[Tri]) -> Result<ConvexHull, HullError> {
             }
             v = next[v as usize];
         }
-        faces.push(cycle);
+        // the face's plane through its representative triangle, computed accurately (a sliver's plain cross product
+        // can point anywhere); the offset is the largest `n . v` over the face's vertices, as `ConvexPolytope::new`
+        let [a, b, c] = tris[r as usize].v.map(|v| p[v as usize]);
+        let n = accurate_cross(a, b, c);
+        let len = n.length();
+        if !(len > 0.0 && len.is_finite()) {
+            return Err(HullError::Internal(PolytopeError::DegenerateFace { face: faces.len() }));
+        }
+        let normal = n / len;
+        let offset = cycle.iter().map(|&i| normal.dot(vertices[i])).fold(f64::NEG_INFINITY, f64::max);
+        faces.push(Face { vertices: cycle.into(), plane: Plane { normal, offset } });
     }
-    let polytope = ConvexPolytope::new(vertices, faces)?;
+    // every face has a positive area: it is a union of triangles that are not exactly degenerate (see the module
+    // documentation), and its plane was computed above
+    let polytope = ConvexPolytope::from_faces_with_area(vertices, faces)?;
     Ok(ConvexHull { polytope, source })
 }
 

@@ -6,11 +6,13 @@
 //! * [`tolerance`]: the one tolerance policy for computed quantities (touching vs penetrating);
 //! * [`polytope`]: convex polytopes with faces, edges and planes, and their validation;
 //! * [`hull`]: a robust 3-D convex hull (Quickhull with exact predicates and exact coplanar merging);
+//! * [`accurate_normal`]: the normal of the plane through three points, accurate for slivers (the hull's face planes);
 //! * [`mass`]: volume, centre of gravity and inertia tensor;
 //! * [`part`]: rigid parts as unions of convex components, with boundary faces;
 //! * [`pose`]: rigid poses (rotation and position) of placed parts;
 //! * [`io`]: file formats (part JSON, STL, OBJ, glTF export, stack files) with located errors.
 
+pub mod accurate_normal;
 pub mod convex_merge;
 pub mod examples;
 pub mod hull;

@@ -113,6 +113,7 @@ fn in_triangle(a: DVec3, b: DVec3, c: DVec3, q: DVec3) -> bool {
 
 fn check_invariants(points: &[DVec3], hull: &ConvexPolytope) {
     hull.validate_exact().expect("validate_exact");
+    check_planes(points, hull);
     // every input point on or inside every face plane, exactly
     for f in 0..hull.faces().len() {
         let (a, b, c) = hull.face_frame(f).expect("face frame");
@@ -120,6 +121,51 @@ fn check_invariants(points: &[DVec3], hull: &ConvexPolytope) {
             assert_ne!(side(a, b, c, *p), Ordering::Greater, "point {p} outside face {f}");
         }
     }
+}
+
+/// The faces' floating-point planes (what every consumer of a polytope reads) support the input: each face's own
+/// vertices lie on its plane and no input point lies above it, within `1e-9` of the points' extent (the kernel's
+/// tolerance policy). The exact invariants above test the faces' vertex sets, not these planes.
+fn check_planes(points: &[DVec3], hull: &ConvexPolytope) {
+    let scale = stackplan_geom::tolerance::bounding_diagonal(points).max(1.0);
+    for (f, face) in hull.faces().iter().enumerate() {
+        let (n, d) = (face.plane.normal, face.plane.offset);
+        assert!((n.length() - 1.0).abs() < 1e-12, "face {f}: normal {n} not unit");
+        for &v in &face.vertices {
+            let off = n.dot(hull.vertices()[v]) - d;
+            assert!(off.abs() <= 1e-9 * scale, "face {f}: its vertex {v} is {off} off its plane");
+        }
+        let above = points.iter().map(|p| n.dot(*p) - d).fold(f64::NEG_INFINITY, f64::max);
+        assert!(above <= 1e-9 * scale, "face {f}: an input point is {above} above its plane");
+    }
+}
+
+/// A rotation from three angles (about z, y, x).
+fn rotation(angles: (f64, f64, f64)) -> glam::DMat3 {
+    glam::DMat3::from_euler(glam::EulerRot::ZYX, angles.0, angles.1, angles.2)
+}
+
+/// The difference points `Q b + t - Q a` of a box against a translate of itself, both turned by the same rotation
+/// `Q`: what the c-space obstacle's hull fallback gets for two copies of a sheet-metal piece in one orientation.
+/// Rounding moves the points of each face of the sum (an exact box) off a common plane, so the exact hull is full of
+/// slivers a few ulps wide.
+fn rotated_copy_differences() -> impl Strategy<Value = Vec<DVec3>> {
+    (
+        (1.0f64..60.0, 1.0f64..60.0, 0.5f64..4.0),
+        (-3.2f64..3.2, -1.6f64..1.6, -3.2f64..3.2),
+        (-50.0f64..50.0, -50.0f64..50.0, -50.0f64..50.0),
+    )
+        .prop_map(|(size, angles, t)| {
+            let q = rotation(angles);
+            let corners: Vec<DVec3> = (0..8)
+                .map(|i| {
+                    let c = |bit: usize, e: f64| if i & bit == 0 { 0.0 } else { e };
+                    q * DVec3::new(c(1, size.0), c(2, size.1), c(4, size.2))
+                })
+                .collect();
+            let t = DVec3::new(t.0, t.1, t.2);
+            corners.iter().flat_map(|a| corners.iter().map(move |b| (*b + t) - *a)).collect()
+        })
 }
 
 fn canonical_faces(p: &ConvexPolytope) -> Vec<Vec<[u64; 3]>> {
@@ -199,6 +245,19 @@ proptest! {
             (Err(a), Err(b)) => prop_assert_eq!(a, b),
             (a, b) => prop_assert!(false, "order changed the outcome: {a:?} vs {b:?}"),
         }
+    }
+
+    /// The hull of rounded, nearly coplanar points (differences of turned copies) is a hull of them with faces whose
+    /// planes are right: before the face planes were computed accurately, sliver faces got planes cutting through the
+    /// hull by tens of millimetres, and some hulls failed with "face is degenerate (zero area)".
+    #[test]
+    fn slivers_of_turned_copies_get_supporting_planes(points in rotated_copy_differences()) {
+        let h = convex_hull(&points).expect("a full-dimensional set");
+        check_invariants(&points, &h.polytope);
+        // the volume is the box's `(2 size)^3`-scaled product up to rounding: nothing is cut off or added
+        let (lo, hi) = (points.iter().fold(DVec3::splat(f64::INFINITY), |a, b| a.min(*b)),
+                        points.iter().fold(DVec3::splat(f64::NEG_INFINITY), |a, b| a.max(*b)));
+        prop_assert!(h.polytope.volume() > 0.0 && h.polytope.volume() <= (hi - lo).element_product() * (1.0 + 1e-9));
     }
 
     #[test]
