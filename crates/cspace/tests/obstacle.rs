@@ -252,7 +252,7 @@ proptest! {
 /// `A = Q P` and `R = I`, or `A = P` and `R = Q` (the planner's split into a resting rotation and a turn).
 fn copies_in_one_orientation() -> impl Strategy<Value = (ConvexPolytope, DMat3, ConvexPolytope)> {
     let sheet =
-        ((5.0f64..60.0, 5.0f64..60.0, 0.5f64..4.0)).prop_map(|(x, y, z)| cuboid(DVec3::ZERO, DVec3::new(x, y, z)));
+        (5.0f64..60.0, 5.0f64..60.0, 0.5f64..4.0).prop_map(|(x, y, z)| cuboid(DVec3::ZERO, DVec3::new(x, y, z)));
     (
         prop_oneof![sheet, any_box(), dyadic_cloud(5..10)],
         (-3.2f64..3.2, -1.6f64..1.6, -3.2f64..3.2),
