@@ -10,7 +10,7 @@ use proptest::prelude::*;
 use stackplan_cspace::minkowski::{FaceKind, Feature, Obstacle, Route, facet_bound, obstacle, obstacle_by_hull};
 use stackplan_cspace::offset::{clearance, insertion, slice};
 use stackplan_geom::polytope::Containment;
-use stackplan_geom::{ConvexPolytope, Tolerance, convex_hull};
+use stackplan_geom::{ConvexPolytope, Tolerance, convex_hull, convex_hull_merged};
 
 fn any_pair() -> impl Strategy<Value = (ConvexPolytope, ConvexPolytope)> {
     prop_oneof![(dyadic_cloud(4..14), dyadic_cloud(4..14)), (any_box(), any_box()), prism_pair(), prism_pair(),]
@@ -250,7 +250,7 @@ proptest! {
 /// in one orientation (a Triangle nest, or `place` of a part onto a copy of itself), where faces and edges of the two
 /// are parallel only up to rounding in directions that are not axes. Returns (A, R, B) with A moving by `R`: either
 /// `A = Q P` and `R = I`, or `A = P` and `R = Q` (the planner's split into a resting rotation and a turn).
-fn copies_in_one_orientation() -> impl Strategy<Value = (ConvexPolytope, DMat3, ConvexPolytope)> {
+fn copies_in_one_orientation() -> impl Strategy<Value = (ConvexPolytope, DMat3, ConvexPolytope, bool)> {
     let sheet =
         (5.0f64..60.0, 5.0f64..60.0, 0.5f64..4.0).prop_map(|(x, y, z)| cuboid(DVec3::ZERO, DVec3::new(x, y, z)));
     (
@@ -258,19 +258,21 @@ fn copies_in_one_orientation() -> impl Strategy<Value = (ConvexPolytope, DMat3, 
         (-3.2f64..3.2, -1.6f64..1.6, -3.2f64..3.2),
         (-80.0f64..80.0, -80.0f64..80.0, -80.0f64..80.0),
         any::<bool>(),
+        any::<bool>(),
     )
-        .prop_filter_map("a copy without a hull", |(piece, (z, y, x), (tx, ty, tz), turn_by_r)| {
+        .prop_filter_map("a copy without a hull", |(piece, (z, y, x), (tx, ty, tz), turn_by_r, exact)| {
             let q = DMat3::from_euler(glam::EulerRot::ZYX, z, y, x);
-            // each copy as a part file gives it: the exact hull of its turned, rounded vertices (whose face planes are
-            // fitted to those points, so the two copies' normals differ by more than the rotation's rounding)
+            // each copy as a part file gives it: the hull of its turned, rounded vertices with the rounding creases
+            // merged (whose face planes are fitted to those points, so the two copies' normals differ by more than
+            // the rotation's rounding); `exact` copies are the exact hulls, whose faces are split into facets
             let hull = |t: DVec3| {
                 let points: Vec<DVec3> = piece.vertices().iter().map(|v| q * *v + t).collect();
-                convex_hull(&points).map(|h| h.polytope)
+                if exact { convex_hull(&points) } else { convex_hull_merged(&points) }.map(|h| h.polytope)
             };
             let (Ok(turned), Ok(fixed)) = (hull(DVec3::ZERO), hull(DVec3::new(tx, ty, tz))) else {
                 return None;
             };
-            Some(if turn_by_r { (piece, q, fixed) } else { (turned, DMat3::IDENTITY, fixed) })
+            Some(if turn_by_r { (piece, q, fixed, exact) } else { (turned, DMat3::IDENTITY, fixed, exact) })
         })
 }
 
@@ -283,11 +285,15 @@ proptest! {
     /// that cut the obstacle by tens of millimetres (`place` then put a part into its copy), or the hull failed.
     #[test]
     fn copies_in_one_orientation_match_the_lp_oracle(
-        (a, r, b) in copies_in_one_orientation(),
+        (a, r, b, exact) in copies_in_one_orientation(),
         samples in prop::collection::vec((0.0f64..1.0, 0.0f64..1.0, 0.0f64..1.0), 10),
     ) {
         let o = obstacle(&a, r, &b).map_err(|e| TestCaseError::fail(e.to_string()))?;
         let c = o.polytope();
+        // copies as the readers build them have no creases, and the overlay pairs their parallel faces
+        if !exact {
+            prop_assert_eq!(o.route(), Route::GaussMap, "{:?}", stackplan_cspace::minkowski::gauss_map_obstacle(&a, r, &b).err());
+        }
         let pts = differences(&a, r, &b);
         let scale = stackplan_geom::tolerance::bounding_diagonal(&pts);
         for (k, f) in c.faces().iter().enumerate() {
@@ -305,6 +311,36 @@ proptest! {
             prop_assert_eq!(margin < 0.0, t > 0.0, "p {:?}: margin {} LP slack {} ({:?})", p, margin, t, o.route());
         }
     }
+}
+
+/// The audit's case: the Triangle part's inclined pieces against themselves, turned by 1e-9 to 1e-5 rad about `z`
+/// from the critical orientations 0 and 90 degrees, where their faces and edges are nearly parallel: every obstacle's
+/// planes support its difference points within the tolerance. Until the hull computed its face planes accurately,
+/// the pieces' own planes were off by up to 1e-7 rad (fitted to points planar only to rounding), and the obstacle of
+/// pair (2, 2) at 1e-7 degree had a difference point 8.4e-4 mm (over 2000 tolerances) above an edge-edge face: `place`
+/// could report a position penetrating by that much as touching.
+#[test]
+fn triangle_pieces_just_off_critical_orientations() {
+    let part = stackplan_geom::examples::part_by_name("triangle", stackplan_geom::Decomposition::default())
+        .expect("the Triangle example");
+    let mut worst: f64 = 0.0;
+    for base in [0.0, std::f64::consts::FRAC_PI_2] {
+        for turn in [1e-9, 1e-8, 1e-7f64.to_radians(), 1e-7, 1e-6, 1e-5, -1e-7, -1e-6] {
+            let r = DMat3::from_rotation_z(base + turn);
+            for a in &part.components {
+                for b in &part.components {
+                    let o = obstacle(a, r, b).expect("obstacle");
+                    let pts = differences(a, r, b);
+                    let tol = Tolerance::for_scale(stackplan_geom::tolerance::bounding_diagonal(&pts)).linear;
+                    for f in o.polytope().faces() {
+                        let above = pts.iter().map(|p| f.plane.signed_distance(*p)).fold(f64::NEG_INFINITY, f64::max);
+                        worst = worst.max(above / tol);
+                    }
+                }
+            }
+        }
+    }
+    assert!(worst <= 1.0, "a difference point {worst} tolerances above a face plane");
 }
 
 #[test]

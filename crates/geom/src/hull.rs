@@ -17,6 +17,19 @@
 //!
 //! Flat, collinear and coincident input has no 3-D hull and returns a [`HullError`].
 //!
+//! **Face planes.** A face's plane is computed from its best-conditioned triangle with an accurate cross product
+//! ([`crate::accurate_normal`]): where rounding moved points off a common plane, the exact hull has sliver facets a
+//! few ulps wide, whose plain `f64` normals can point anywhere (planes that cut the hull by tens of millimetres).
+//!
+//! **Creases.** The points of a rotated sheet-metal face are coplanar only to rounding, so the exact hull splits the
+//! face into facets that meet at creases of about 1e-16 rad; no real part has such a fold, and downstream the creases
+//! make near-parallel faces within one polytope (the c-space overlay cannot pair them with the other summand's faces;
+//! its exact-hull fallback is correct but fragmented into slivers). [`convex_hull_merged`], the hull the part readers
+//! build, merges adjacent facets whose normals meet at less than [`ROUNDING_CREASE`] (1e-9 rad): every decision of the
+//! hull itself stays exact, only facets are grouped, and a merged face's plane is the area-weighted normal of its
+//! facets (its vertices lie within about `1e-9 x` their distance of it, the kernel's tolerance). A group whose facets
+//! do not all lie within the angle of that normal (small creases adding up to a fold) is not merged.
+//!
 //! The exact predicates are exact only while products of coordinate differences neither underflow nor overflow: a
 //! coordinate below [`MIN_COORDINATE`] (1e-50) in magnitude is taken as 0 (the hull's vertices carry the zero), and
 //! one above [`MAX_HULL_COORDINATE`] (1e50) is [`HullError::OutOfRange`].
@@ -154,6 +167,21 @@ impl Outside {
 
 /// Convex hull of `points`. See the module documentation.
 pub fn convex_hull(points: &[DVec3]) -> Result<ConvexHull, HullError> {
+    hull_with(points, None)
+}
+
+/// [`convex_hull`] whose adjacent facets that meet at an angle below [`ROUNDING_CREASE`] are one face: the hull of a
+/// part's piece as the readers build it (see the module documentation, "Creases").
+pub fn convex_hull_merged(points: &[DVec3]) -> Result<ConvexHull, HullError> {
+    hull_with(points, Some(ROUNDING_CREASE))
+}
+
+/// The largest angle (rad) between the normals of two adjacent facets that [`convex_hull_merged`] takes for one face:
+/// the kernel's relative tolerance ([`crate::tolerance::RELATIVE`]), six orders above the creases rounding leaves
+/// (about 1e-16 rad) and far below any fold of a real part.
+pub const ROUNDING_CREASE: f64 = crate::tolerance::RELATIVE;
+
+fn hull_with(points: &[DVec3], merge_angle: Option<f64>) -> Result<ConvexHull, HullError> {
     if points.is_empty() {
         return Err(HullError::Empty);
     }
@@ -173,7 +201,7 @@ pub fn convex_hull(points: &[DVec3]) -> Result<ConvexHull, HullError> {
     build_simplex(points, simplex, &mut tris, diameter);
     assign_initial_outside(points, simplex, &mut tris, &mut outside);
     expand(points, &mut tris, &mut outside, diameter);
-    merge(points, &tris)
+    merge(points, &tris, merge_angle)
 }
 
 fn initial_simplex(p: &[DVec3]) -> Result<[u32; 4], HullError> {
@@ -414,7 +442,71 @@ fn find(parent: &mut [u32], mut x: u32) -> u32 {
     x
 }
 
-fn merge(p: &[DVec3], tris: &[Tri]) -> Result<ConvexHull, HullError> {
+/// Joins, in the union-find `parent` over the triangles (exactly coplanar ones joined already), adjacent facets whose
+/// normals meet at an angle of at most `angle` (module documentation, "Creases"). The facets of one joined group must
+/// all lie within `angle` of the group's area-weighted normal; a group that does not (a chain of small creases adding
+/// up to a fold) is split back into its exact facets. The groups are connected components, so they do not depend on
+/// the order of the triangles. O(triangles).
+fn merge_creases(p: &[DVec3], tris: &[Tri], parent: &mut [u32], angle: f64) {
+    let n = tris.len();
+    // each exact facet's accurate unit normal and area-weighted normal, at its root
+    let mut facet_normal = vec![DVec3::ZERO; n];
+    for (i, t) in tris.iter().enumerate() {
+        if t.alive {
+            let [a, b, c] = t.v.map(|v| p[v as usize]);
+            facet_normal[find(parent, i as u32) as usize] += accurate_cross(a, b, c);
+        }
+    }
+    let unit = |v: DVec3| v.try_normalize().unwrap_or(DVec3::ZERO);
+    let close = |u: DVec3, v: DVec3| u.dot(v) > 0.0 && u.cross(v).length() <= angle;
+    let facet_of: Vec<u32> =
+        (0..n as u32).map(|i| if tris[i as usize].alive { find(parent, i) } else { NONE }).collect();
+    let mut joined: Vec<u32> = (0..n as u32).collect();
+    let mut any = false;
+    for (i, t) in tris.iter().enumerate() {
+        if !t.alive {
+            continue;
+        }
+        for &j in &t.nbr {
+            let (fi, fj) = (facet_of[i], facet_of[j as usize]);
+            if fj == NONE || fi == fj || !close(unit(facet_normal[fi as usize]), unit(facet_normal[fj as usize])) {
+                continue;
+            }
+            let (a, b) = (find(&mut joined, fi), find(&mut joined, fj));
+            if a != b {
+                joined[a.max(b) as usize] = a.min(b);
+                any = true;
+            }
+        }
+    }
+    if !any {
+        return;
+    }
+    // each joined group's area-weighted normal; a group with a facet farther than `angle` from it stays apart
+    let mut group_normal = vec![DVec3::ZERO; n];
+    for f in 0..n {
+        if facet_of[f] == f as u32 {
+            group_normal[find(&mut joined, f as u32) as usize] += facet_normal[f];
+        }
+    }
+    let mut spread = vec![false; n];
+    for f in 0..n {
+        if facet_of[f] == f as u32 {
+            let g = find(&mut joined, f as u32) as usize;
+            spread[g] |= !close(unit(facet_normal[f]), unit(group_normal[g]));
+        }
+    }
+    for f in 0..n {
+        if facet_of[f] == f as u32 {
+            let g = find(&mut joined, f as u32);
+            if g != f as u32 && !spread[g as usize] {
+                parent[f] = g;
+            }
+        }
+    }
+}
+
+fn merge(p: &[DVec3], tris: &[Tri], merge_angle: Option<f64>) -> Result<ConvexHull, HullError> {
     let n = tris.len();
     let mut parent: Vec<u32> = (0..n as u32).collect();
     for (i, t) in tris.iter().enumerate() {
@@ -440,6 +532,9 @@ fn merge(p: &[DVec3], tris: &[Tri]) -> Result<ConvexHull, HullError> {
                 }
             }
         }
+    }
+    if let Some(angle) = merge_angle {
+        merge_creases(p, tris, &mut parent, angle);
     }
     // group ids
     let mut group_of = vec![u32::MAX; n];
@@ -500,13 +595,27 @@ fn merge(p: &[DVec3], tris: &[Tri]) -> Result<ConvexHull, HullError> {
         }
     }
     // per group, the triangle whose float normal is longest: the best-conditioned of its exactly coplanar triangles,
-    // whose accurate normal is the face's
+    // whose accurate normal is the face's; for a group of facets merged across creases, the sum of its triangles'
+    // accurate normals (twice their areas) instead
     let mut representative: Vec<u32> = vec![NONE; group_count as usize];
+    let mut creased: Vec<bool> = vec![false; group_count as usize];
+    let mut area_normal: Vec<DVec3> = vec![DVec3::ZERO; group_count as usize];
     for (i, t) in tris.iter().enumerate() {
         if t.alive {
-            let r = &mut representative[group_of[i] as usize];
+            let g = group_of[i] as usize;
+            let r = &mut representative[g];
+            if *r != NONE && merge_angle.is_some() {
+                let [a, b, c] = tris[*r as usize].v.map(|v| p[v as usize]);
+                creased[g] |= side(a, b, c, p[t.v[0] as usize]) != Ordering::Equal
+                    || side(a, b, c, p[t.v[1] as usize]) != Ordering::Equal
+                    || side(a, b, c, p[t.v[2] as usize]) != Ordering::Equal;
+            }
             if *r == NONE || t.normal.length_squared() > tris[*r as usize].normal.length_squared() {
                 *r = i as u32;
+            }
+            if merge_angle.is_some() {
+                let [a, b, c] = t.v.map(|v| p[v as usize]);
+                area_normal[g] += accurate_cross(a, b, c);
             }
         }
     }
@@ -516,7 +625,7 @@ fn merge(p: &[DVec3], tris: &[Tri]) -> Result<ConvexHull, HullError> {
     let mut vertices = Vec::new();
     let mut source = Vec::new();
     let mut faces = Vec::with_capacity(group_count as usize);
-    for (b, &r) in boundary.zip(&representative) {
+    for (g, (b, &r)) in boundary.zip(&representative).enumerate() {
         let Some(&(start, _)) = b.iter().min_by_key(|e| e.0) else { continue };
         for &(a, c) in b {
             next[a as usize] = c;
@@ -536,8 +645,12 @@ fn merge(p: &[DVec3], tris: &[Tri]) -> Result<ConvexHull, HullError> {
         }
         // the face's plane through its representative triangle, computed accurately (a sliver's plain cross product
         // can point anywhere); the offset is the largest `n . v` over the face's vertices, as `ConvexPolytope::new`
-        let [a, b, c] = tris[r as usize].v.map(|v| p[v as usize]);
-        let n = accurate_cross(a, b, c);
+        let n = if creased[g] {
+            area_normal[g]
+        } else {
+            let [a, b, c] = tris[r as usize].v.map(|v| p[v as usize]);
+            accurate_cross(a, b, c)
+        };
         let len = n.length();
         if !(len > 0.0 && len.is_finite()) {
             return Err(HullError::Internal(PolytopeError::DegenerateFace { face: faces.len() }));
@@ -555,6 +668,72 @@ fn merge(p: &[DVec3], tris: &[Tri]) -> Result<ConvexHull, HullError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A box turned by a general rotation: its faces are planar only to rounding. The exact hull splits some of them
+    /// into facets; the merged hull has the box's 6 faces and 8 vertices, planes supporting every point.
+    #[test]
+    fn merged_hull_of_a_turned_box_has_its_six_faces() {
+        let r = glam::DMat3::from_euler(glam::EulerRot::ZYX, 0.3, 0.2, 0.1);
+        let mut split = 0;
+        for (k, size) in [DVec3::new(40.0, 20.0, 2.0), DVec3::new(1.0, 1.0, 1.0), DVec3::new(300.0, 0.5, 7.0)]
+            .into_iter()
+            .enumerate()
+        {
+            let t = DVec3::new(k as f64 * 13.7, -5.3, 60.0);
+            let pts: Vec<DVec3> = (0..8)
+                .map(|i| {
+                    let c = |bit: usize, e: f64| if i & bit == 0 { 0.0 } else { e };
+                    r * DVec3::new(c(1, size.x), c(2, size.y), c(4, size.z)) + t
+                })
+                .collect();
+            split += convex_hull(&pts).expect("hull").polytope.faces().len() - 6;
+            let h = convex_hull_merged(&pts).expect("hull");
+            assert_eq!((h.polytope.vertices().len(), h.polytope.faces().len()), (8, 6), "box {k}");
+            h.polytope.validate().expect("valid within the tolerance");
+            for f in h.polytope.faces() {
+                let above = pts.iter().map(|p| f.plane.normal.dot(*p) - f.plane.offset).fold(f64::MIN, f64::max);
+                assert!(above <= 1e-12 * 300.0, "box {k}: a point {above} above a face");
+            }
+        }
+        // the test has teeth: the exact hull splits some of these faces
+        assert!(split > 0);
+    }
+
+    /// A real fold, however shallow (1e-6 rad), stays two faces; so does a fold made of several creases each below
+    /// the angle but adding up to more than it.
+    #[test]
+    fn merged_hull_keeps_real_folds() {
+        // a wedge roof: two top faces meeting at a ridge with a 1e-6 rad fold
+        let h = 1e-6 * 10.0;
+        let pts = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(20.0, 0.0, 0.0),
+            DVec3::new(0.0, 5.0, 0.0),
+            DVec3::new(20.0, 5.0, 0.0),
+            DVec3::new(0.0, 0.0, 1.0),
+            DVec3::new(20.0, 0.0, 1.0),
+            DVec3::new(0.0, 5.0, 1.0),
+            DVec3::new(20.0, 5.0, 1.0),
+            DVec3::new(10.0, 0.0, 1.0 + h),
+            DVec3::new(10.0, 5.0, 1.0 + h),
+        ];
+        let merged = convex_hull_merged(&pts).expect("hull");
+        assert_eq!(merged.polytope.faces().len(), convex_hull(&pts).expect("hull").polytope.faces().len());
+        assert_eq!(merged.polytope.faces().len(), 7);
+        // a gentle arc (radius 1 m, coordinates near the origin so that its sagitta is representable) of 11 points
+        // whose neighbouring facets meet at 4e-10 rad: 4e-9 rad in all
+        let arc: Vec<DVec3> = (0..=10)
+            .flat_map(|k| {
+                let t = (k as f64 - 5.0) * 4e-10;
+                let (x, z) = (1e3 * t.sin(), -2e3 * (0.5 * t).sin().powi(2));
+                [DVec3::new(x, 0.0, z), DVec3::new(x, 1.0, z)]
+            })
+            .chain([DVec3::new(-2e-6, 0.0, -1.0), DVec3::new(2e-6, 0.0, -1.0), DVec3::new(0.0, 1.0, -1.0)])
+            .collect();
+        let top = |h: &ConvexHull| h.polytope.faces().iter().filter(|f| f.plane.normal.z > 0.9).count();
+        assert_eq!(top(&convex_hull(&arc).expect("hull")), 10, "the arc's exact hull has ten top facets");
+        assert_eq!(top(&convex_hull_merged(&arc).expect("hull")), 10, "a 4e-9 rad fold of small creases stays");
+    }
 
     fn grid_box(nx: usize, ny: usize, nz: usize) -> Vec<DVec3> {
         let mut v = Vec::new();

@@ -193,8 +193,9 @@ fn decomposition_accepts_a_non_convex_shell_and_marks_it_approximate() {
         let part = read_part(broken(name), &options).expect("VHACD decomposes the dented cube");
         assert_eq!(part.origin, stackplan_geom::PartOrigin::ApproximateDecomposition, "{name}");
         assert!(part.components.len() >= 2, "{name}: {} components", part.components.len());
+        // valid within the tolerance: a piece's rounding creases are merged, so its faces are planar to rounding
         for c in &part.components {
-            c.validate_exact().expect("decomposed components are exactly valid polytopes");
+            c.validate().expect("decomposed components are valid polytopes");
         }
         // the dented cube has volume 8 - 4/3 (plus the tetrahedron in the OBJ); VHACD approximates it
         let expected = if name.ends_with(".obj") { 8.0 - 4.0 / 3.0 + 1.0 / 6.0 } else { 8.0 - 4.0 / 3.0 };

@@ -4,7 +4,7 @@ use proptest::prelude::*;
 use stackplan_geom::io::glb::{GlbItem, glb_bytes};
 use stackplan_geom::io::stack::{StackPart, read_stack, write_stack, write_stack_with_extras};
 use stackplan_geom::io::{self, IoError, ReadOptions, atomic};
-use stackplan_geom::{ConvexPolytope, DMat3, DVec3, Part, PartOrigin, Pose, convex_hull};
+use stackplan_geom::{ConvexPolytope, DMat3, DVec3, Part, PartOrigin, Pose, convex_hull, convex_hull_merged};
 use std::path::Path;
 
 const BRACKET: &str = r#"{
@@ -87,17 +87,26 @@ fn obj_round_trip_is_exact() {
     same_components(&part, &back);
 }
 
-/// A component as the readers rebuild it: the exact hull of its vertices (its faces exactly planar).
-fn exact_form(part: &Part) -> Part {
-    let components = part.components.iter().map(|c| convex_hull(c.vertices()).expect("hull").polytope).collect();
+/// A component as the readers rebuild it: the hull of its vertices with its rounding creases merged
+/// ([`convex_hull_merged`]).
+fn read_form(part: &Part) -> Part {
+    let components = part.components.iter().map(|c| convex_hull_merged(c.vertices()).expect("hull").polytope).collect();
     Part::from_components(part.name.clone(), components, part.density, PartOrigin::ConvexPieces).expect("part")
 }
 
+/// The number of faces of `part`'s components, and of the exact hulls of their vertices.
+fn face_counts(part: &Part) -> (usize, usize) {
+    let own = part.components.iter().map(|c| c.faces().len()).sum();
+    let exact = part.components.iter().map(|c| convex_hull(c.vertices()).expect("hull").polytope.faces().len()).sum();
+    (own, exact)
+}
+
 /// Every built-in example, in both decompositions, written in every format reads back: the same vertices per
-/// component (binary STL: rounded to `f32`) and the faces of their exact hull. The sheet-metal examples are rotated
-/// into place, so some of their faces are coplanar only to rounding (Triangle's quadrilaterals are 5e-11 out of
-/// plane): before session 30 their OBJ and STL files failed the reader's exact convexity check ("the polygon at line
-/// 11 does not lie in a face plane of the shell's convex hull").
+/// component (binary STL: rounded to `f32`) and the faces of their hull, rounding creases merged. The sheet-metal
+/// examples are rotated into place, so some of their faces are coplanar only to rounding (Triangle's quadrilaterals
+/// are 5e-11 out of plane): before session 30 their OBJ and STL files failed the reader's exact convexity check ("the
+/// polygon at line 11 does not lie in a face plane of the shell's convex hull"), and until session 32 they read back
+/// split into their exact facets; now each reads back as the one face it was built as.
 #[test]
 fn every_example_reads_back_from_every_format() {
     let opts = ReadOptions::default();
@@ -107,7 +116,7 @@ fn every_example_reads_back_from_every_format() {
             .iter()
             .map(|c| {
                 let rounded: Vec<DVec3> = c.vertices().iter().map(|v| v.as_vec3().as_dvec3()).collect();
-                convex_hull(&rounded).expect("hull").polytope
+                convex_hull_merged(&rounded).expect("hull").polytope
             })
             .collect();
         Part::from_components(part.name.clone(), components, part.density, PartOrigin::ConvexPieces).expect("part")
@@ -116,9 +125,11 @@ fn every_example_reads_back_from_every_format() {
     for name in stackplan_geom::examples::NAMES {
         for decomposition in [stackplan_geom::Decomposition::default(), stackplan_geom::Decomposition::Triangulation] {
             let part = stackplan_geom::examples::part_by_name(name, decomposition).expect("example");
-            let exact = exact_form(&part);
-            split_faces += exact.components.iter().map(|c| c.faces().len()).sum::<usize>()
-                - part.components.iter().map(|c| c.faces().len()).sum::<usize>();
+            let exact = read_form(&part);
+            let (own, exact_facets) = face_counts(&part);
+            split_faces += exact_facets - own;
+            // merging the creases gives back the faces the part was built with
+            assert_eq!(exact.components.iter().map(|c| c.faces().len()).sum::<usize>(), own, "{name}");
             let json = io::parse_part_json(io::part_json_string(&part).as_bytes(), Path::new("e.json"), &opts);
             same_components(&exact, &json.unwrap_or_else(|e| panic!("{name}: json: {e}")));
             let obj = io::parse_obj(io::obj_string(&part).as_bytes(), Path::new("e.obj"), &opts);
@@ -138,7 +149,7 @@ fn every_example_reads_back_from_every_format() {
             assert_eq!(back.components.len(), 2 * part.components.len());
         }
     }
-    // the test has teeth: some example faces are coplanar only to rounding and come back split
+    // the test has teeth: some example faces are coplanar only to rounding, and their exact hulls split them
     assert!(split_faces > 0);
 }
 
@@ -442,14 +453,17 @@ proptest! {
     }
 
     /// The same parts turned by a random rotation, so that their faces are planar only to rounding (as a sheet-metal
-    /// part rotated into place): every format reads back to the exact form (binary STL: of the `f32`-rounded
-    /// vertices).
+    /// part rotated into place): every format reads back to the readers' form (binary STL: of the `f32`-rounded
+    /// vertices), which has the faces of the part before it was turned.
     #[test]
     fn rotated_parts_read_back_from_every_format(part in random_part(), angles in prop::array::uniform3(-3.2f64..3.2)) {
         let rotation = DMat3::from_rotation_z(angles[0]) * DMat3::from_rotation_y(angles[1]) * DMat3::from_rotation_x(angles[2]);
         let components = part.components.iter().map(|c| c.transformed(rotation, DVec3::new(3.0, -1.0, 2.0))).collect();
         let turned = Part::from_components("turned", components, 1.0, PartOrigin::ConvexPieces).expect("part");
-        let exact = exact_form(&turned);
+        let exact = read_form(&turned);
+        for (c, t) in exact.components.iter().zip(&turned.components) {
+            prop_assert_eq!(c.faces().len(), t.faces().len(), "the turn's creases are merged");
+        }
         let opts = ReadOptions::default();
         let back = io::parse_part_json(io::part_json_string(&turned).as_bytes(), Path::new("r.json"), &opts).expect("json");
         same_components(&exact, &back);

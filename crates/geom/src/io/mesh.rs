@@ -30,7 +30,7 @@
 //! and may overlap slightly.
 
 use super::{IoError, Place, ReadOptions, resolve_density};
-use crate::hull::{HullError, convex_hull};
+use crate::hull::{HullError, convex_hull, convex_hull_merged};
 use crate::part::{Part, PartOrigin};
 use crate::polytope::{ConvexPolytope, newell_normal};
 use crate::predicates::side;
@@ -284,7 +284,9 @@ fn convex_shell(points: &[DVec3], shell: &Shell) -> Result<ConvexPolytope, Defec
     if !within {
         return Err(Defect::Volume { shell: shell_volume, hull: hull_volume });
     }
-    Ok(hull)
+    // the shell bounds the exact hull; the piece is that hull with its rounding creases merged (as the JSON reader's
+    // pieces): a face planar only to rounding is one face, not its exact facets
+    convex_hull_merged(&local).map(|h| h.polytope).map_err(Defect::Hull)
 }
 
 /// Checks every shell (or decomposes it) and builds the part.
@@ -380,7 +382,7 @@ fn decompose(points: &[DVec3], shell: &Shell) -> Result<Vec<ConvexPolytope>, Str
     })
     .map_err(|_| "VHACD panicked on this mesh".to_string())?;
     let pieces: Vec<ConvexPolytope> =
-        hulls.iter().filter_map(|(pts, _)| convex_hull(pts).ok().map(|h| h.polytope)).collect();
+        hulls.iter().filter_map(|(pts, _)| convex_hull_merged(pts).ok().map(|h| h.polytope)).collect();
     if pieces.is_empty() {
         return Err(format!("VHACD returned {} hulls, none of them solid", hulls.len()));
     }
