@@ -183,9 +183,41 @@ fn plan_writes_every_output_and_check_accepts_the_plan() {
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("p/plan.json")).expect("plan")).expect("JSON");
     assert_eq!(plan["placements"].as_array().map(Vec::len), Some(4));
     assert_eq!(plan["plan"]["placed"], 4);
-    // the plan file is a stack file: check reads it and every part passes
+    // the plan file is a stack file: check reads it and every part passes, inside the plan's floor volume
     let o = run_in(dir.path(), &["check", "p/plan.json", "--cup-diameter", "10", "--json"]);
     assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
+    let report = json(&o);
+    assert_eq!(
+        (report["floor"]["ok"].clone(), report["floor"]["height"].clone()),
+        (Value::from(true), plan["plan"]["options"]["floor"]["height"].clone())
+    );
+    // a part moved off the floor polygon (1000 mm along x), or lifted above the maximum height, fails the check
+    let height = plan["plan"]["options"]["floor"]["height"].as_f64().expect("height");
+    for (axis, by, field) in [(0, 1000.0, "beyond_sides"), (2, height, "above_height")] {
+        let mut moved = plan.clone();
+        let p = moved["placements"][3]["position"][axis].as_f64().expect("coordinate");
+        moved["placements"][3]["position"][axis] = Value::from(p + by);
+        std::fs::write(dir.path().join("moved.json"), moved.to_string()).expect("write");
+        let o = run_in(dir.path(), &["check", "moved.json", "--json"]);
+        assert_eq!(o.status.code(), Some(1), "{field}: {}", stdout(&o));
+        let report = json(&o);
+        let outside = &report["floor"]["outside"];
+        assert_eq!(outside.as_array().map(Vec::len), Some(1), "{field}: {report}");
+        assert_eq!(outside[0]["index"], 3);
+        // moved 1000 mm along x from inside a floor narrower than that, or lifted by the whole height
+        let least = if field == "beyond_sides" { 100.0 } else { 1.0 };
+        assert!(outside[0][field].as_f64().is_some_and(|d| d > least), "{field}: {report}");
+        assert_eq!((report["ok"].clone(), report["parts"][3]["ok"].clone()), (Value::from(false), Value::from(false)));
+        let o = run_in(dir.path(), &["check", "moved.json"]);
+        assert!(stdout(&o).contains("floor volume: part 3 lies"), "{}", stdout(&o));
+    }
+    // a floor volume that is not one is an error naming the nested key
+    let mut bad_floor = plan.clone();
+    bad_floor["plan"]["options"]["floor"]["height"] = Value::from("tall");
+    std::fs::write(dir.path().join("bad-floor.json"), bad_floor.to_string()).expect("write");
+    let o = run_in(dir.path(), &["check", "bad-floor.json"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("bad-floor.json: malformed plan: key `plan.options.floor.height`"), "{}", stderr(&o));
     let html = std::fs::read_to_string(dir.path().join("p/report.html")).expect("html");
     assert!(html.contains("<table id=\"parts\">") && html.contains("stack.png"));
     // a release drop that is not a finite non-negative number is an error that names the file and the placement

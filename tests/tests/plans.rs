@@ -173,6 +173,16 @@ fn sweep_writes_a_plan_per_weight_with_its_layers() {
     assert_eq!(runs[1]["layers"], 4, "w = 1: one column: {}", runs[1]);
     assert_eq!(runs[1]["layer_counts"], serde_json::json!([1, 1, 1, 1]));
     assert!((runs[1]["height"].as_f64().expect("height") - 4.0).abs() < 1e-6);
+    // a weight whose plain form is long is printed in scientific notation in the summary (not 300 digits)
+    let o = run_in(
+        dir.path(),
+        &["sweep", "example:cube", "--count", "1", "--w-values", "1e-300", "--clearance", "0", "--floor", "-1,-1,1,1"]
+            .into_iter()
+            .chain(["--height", "5", "--dtheta-deg", "90", "--cup-diameter", "0.5", "--out", "tiny"])
+            .collect::<Vec<_>>(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("w = 1e-300: 1 placed") && stdout(&o).len() < 400, "{}", stdout(&o));
     // the picture: one panel per weight, captioned
     let svg = std::fs::read_to_string(out.join("sweep.svg")).expect("svg");
     assert!(svg.contains(">w = 0</text>") && svg.contains(">w = 1</text>"));

@@ -173,6 +173,30 @@ pub fn plan_option(summary: &Map<String, Value>, key: &str, path: &Path) -> Resu
     }
 }
 
+/// `options.floor` of a plan summary (the floor volume the planner placed the parts in): `None` when `options` or
+/// the floor is absent, an error naming the file and the nested key when it is not a floor volume (a polygon of at
+/// least three finite corners and a finite height above 0).
+pub fn plan_floor(summary: &Map<String, Value>, path: &Path) -> Result<Option<FloorVolume>, PlanFileError> {
+    let malformed = |message: String| PlanFileError::Malformed { file: path.to_path_buf(), message };
+    let Some(floor) = summary.get("options").and_then(|o| o.get("floor")).filter(|f| !f.is_null()) else {
+        return Ok(None);
+    };
+    let floor: FloorVolume = serde_path_to_error::deserialize(floor.clone()).map_err(|e| {
+        let key = match e.path().to_string().as_str() {
+            "." => "plan.options.floor".to_string(),
+            nested => format!("plan.options.floor.{nested}"),
+        };
+        malformed(format!("key `{key}`: {}", e.inner()))
+    })?;
+    let finite = floor.polygon.iter().all(|p| p.is_finite());
+    if floor.polygon.len() < 3 || !finite || !(floor.height.is_finite() && floor.height > 0.0) {
+        return Err(malformed(
+            "key `plan.options.floor`: expected a polygon of at least 3 finite corners and a finite height > 0".into(),
+        ));
+    }
+    Ok(Some(floor))
+}
+
 /// Checks the summary's `placed`: present, a non-negative integer, and equal to `placements`.
 pub fn check_placed(summary: &Map<String, Value>, path: &Path, placements: usize) -> Result<(), PlanFileError> {
     let malformed = |message: String| PlanFileError::Malformed { file: path.to_path_buf(), message };

@@ -7,7 +7,8 @@
 //! (the walls a Triangle part nests on) is lifted by `delta |n_xy| / n_z`, and the search's optimum floats that
 //! far above its support. That is where the robot lets go; the part then drops straight down until it touches.
 //! The plan records the resting position (what the stack is, what the checks and every later part see) and the
-//! drop (the release height above it).
+//! drop (the release height above it), lowered to the least that keeps the clearance ([`lowest_release`]: the
+//! search's optimum of a cell can also float above what holds it).
 //!
 //! **The drop.** For the moving component `A_i` and a stack component `B_j` with zero-clearance c-space obstacle
 //! `C_ij = {n_k . p <= d_k}` (\[A\] App. B, from the shared [`ObstacleCache`]), the downward ray `q(s) = p - s z`
@@ -35,6 +36,7 @@
 //! any of their obstacles the search did not build.
 
 use crate::detect::StackScene;
+use crate::obstacles::DerivedObstacle;
 use crate::request::PlacementError;
 use crate::search::Contact;
 use glam::{DMat3, DVec3};
@@ -171,6 +173,109 @@ pub fn settle(
     Ok(Settled { position: release - DVec3::Z * drop, drop, contacts: Some(contacts) })
 }
 
+/// The lowest point `rest + h z`, `0 <= h <= drop`, from which the robot can release the part settled at `rest` (the
+/// search released it at `rest + drop z`): the part there keeps the horizontal clearance `clearance` from every stack
+/// component, and with `insertion` also the path straight down to it from above (the search's clearance-grown,
+/// insertion obstacles, [`DerivedObstacle::from_obstacle`]). Returns `h`, the release drop; `drop` itself when nothing
+/// lower is free.
+///
+/// **Why.** The search's optimum of a cell can float above what holds it: beside the obstacle whose face plane
+/// bounds the cell from below (the plane reaches past the face), or anywhere when the cost does not depend on the
+/// height (`w = 1`). Released there, a part dropped up to 0.8 m in a 6-part Complex plan at `w = 1`; the robot can let
+/// it go just above where it rests. The vertical line through the part meets each pair's obstacle (interior by more
+/// than the tolerance, the search's test) in an open interval of heights, and `h` is the least height at or above the
+/// rest not inside any of them, found by raising it past each interval that holds it (at most one pass per
+/// interval); the segment from there up to the search's release is free of the zero-clearance obstacles (`settle`
+/// dropped the part along it), so the part reaches the release point from above as before.
+///
+/// Cost: the pairs whose boxes come within the clearance of the part's vertical sweep, each one obstacle from the
+/// cache (usually built by the search or the settling already) and O(F) per interval.
+#[allow(clippy::too_many_arguments)]
+pub fn lowest_release(
+    part: &Part,
+    rotation: DMat3,
+    rest: DVec3,
+    drop: f64,
+    scene: &StackScene,
+    cache: &ObstacleCache,
+    clearance: f64,
+    insertion: bool,
+    tol: f64,
+) -> Result<f64, PlacementError> {
+    if drop <= tol {
+        return Ok(drop);
+    }
+    // the part's box swept from the rest up to the release, grown by the clearance horizontally
+    let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+    for v in part.all_vertices() {
+        let w = rotation * v + rest;
+        lo = lo.min(w);
+        hi = hi.max(w);
+    }
+    let reach = DVec3::new(clearance + tol, clearance + tol, 0.0);
+    let (lo, hi) = (lo - reach, hi + reach + DVec3::Z * drop);
+    let mut intervals: Vec<(f64, f64)> = Vec::new();
+    for (fi, sc) in scene.components.iter().enumerate() {
+        let (slo, shi) = sc.placed.aabb;
+        // a stack component the sweep cannot come near, or (with insertion: nothing above the release matters more
+        // than what the search saw) wholly below the part at rest
+        if slo.x > hi.x || shi.x < lo.x || slo.y > hi.y || shi.y < lo.y || shi.z < lo.z - tol {
+            continue;
+        }
+        if !insertion && slo.z > hi.z {
+            continue;
+        }
+        for (mi, component) in part.components.iter().enumerate() {
+            let raw = cache.get_or_build(mi, sc.part, sc.piece, component, rotation, &sc.world).map_err(|e| {
+                PlacementError::Obstacle {
+                    moving_piece: mi,
+                    fixed_part: sc.part,
+                    fixed_piece: sc.piece,
+                    reason: e.to_string(),
+                }
+            })?;
+            let derived = DerivedObstacle::from_obstacle(&raw, 0, mi, fi, clearance, true, insertion);
+            if let Some(interval) = line_interval(&derived.planes, rest, tol) {
+                intervals.push(interval);
+            }
+        }
+    }
+    // the least height >= 0 above the rest in no open interval: raise it past every interval that holds it
+    intervals.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut h = 0.0f64;
+    let mut raised = true;
+    while raised {
+        raised = false;
+        for &(below, above) in &intervals {
+            if below < h && h < above {
+                h = above;
+                raised = true;
+            }
+        }
+    }
+    // never above the search's own release (free by construction; rounding could put `h` a hair over it)
+    Ok(if h < drop - tol { h } else { drop })
+}
+
+/// The open interval of heights `h` at which `rest + h z` lies in the interior of `{n_k . q <= d_k}` by more than
+/// `tol` (`n_k . q < d_k - tol` for every plane), or `None` when the vertical line misses it.
+fn line_interval(planes: &[stackplan_geom::polytope::Plane], rest: DVec3, tol: f64) -> Option<(f64, f64)> {
+    const VERTICAL: f64 = 1e-12;
+    let (mut below, mut above) = (f64::NEG_INFINITY, f64::INFINITY);
+    for pl in planes {
+        // n . (rest + h z) < d - tol  <=>  n_z h < d - tol - n . rest
+        let slack = pl.offset - tol - pl.normal.dot(rest);
+        if pl.normal.z > VERTICAL {
+            above = above.min(slack / pl.normal.z);
+        } else if pl.normal.z < -VERTICAL {
+            below = below.max(slack / pl.normal.z);
+        } else if slack <= 0.0 {
+            return None;
+        }
+    }
+    (below < above).then_some((below, above))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -229,6 +334,33 @@ mod tests {
         let p = DVec3::new(1.0 / 3.0, 0.1, 10.0);
         let s = settle(&part, DMat3::IDENTITY, p, &scene, &cache, tol).expect("settles");
         assert_eq!((s.position, s.drop, s.contacts), (p, 0.0, None));
+    }
+
+    /// A cube released 50 mm above the floor beside another, 2 mm from it: with a clearance of 5 mm it must be let go
+    /// above the other cube's top (10 mm), with 1 mm at the floor; with insertion or without, and never above the
+    /// search's own release.
+    #[test]
+    fn the_lowest_release_keeps_the_clearance_and_no_more() {
+        let part = cube_part(10.0);
+        let stack = [(&part, Pose { rotation: DMat3::IDENTITY, position: DVec3::ZERO })];
+        let scene = StackScene::new(&stack);
+        let cache = ObstacleCache::new();
+        let tol = 1e-9 * 20.0;
+        let rest = DVec3::new(12.0, 0.0, 0.0);
+        for insertion in [true, false] {
+            let h = lowest_release(&part, DMat3::IDENTITY, rest, 50.0, &scene, &cache, 5.0, insertion, tol).expect("h");
+            // (touching within the tolerance is free, as in the search)
+            assert!((h - 10.0).abs() <= 2.0 * tol, "insertion {insertion}: release {h} above the rest, not 10");
+            let h = lowest_release(&part, DMat3::IDENTITY, rest, 50.0, &scene, &cache, 1.0, insertion, tol).expect("h");
+            assert_eq!(h, 0.0, "insertion {insertion}: 2 mm apart keeps a 1 mm clearance at rest");
+            // the search released it lower than the clearance allows: its own release stands
+            let h = lowest_release(&part, DMat3::IDENTITY, rest, 6.0, &scene, &cache, 5.0, insertion, tol).expect("h");
+            assert_eq!(h, 6.0);
+        }
+        // a cube resting on top of the other, released 30 mm above: it can be let go where it rests
+        let on_top = DVec3::new(1.0, 2.0, 10.0);
+        let h = lowest_release(&part, DMat3::IDENTITY, on_top, 30.0, &scene, &cache, 5.0, true, tol).expect("h");
+        assert_eq!(h, 0.0);
     }
 
     #[test]

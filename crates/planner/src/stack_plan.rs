@@ -41,7 +41,7 @@ use crate::detect::StackScene;
 use crate::orientation::Orientation;
 use crate::request::{Cost, FloorVolume, PlacementError, PlacementRequest, StackPart, thetas_with_step};
 use crate::search::{Contact, NoPlacement, Placement, PlacementSearch, SearchCaches};
-use crate::settle::settle;
+use crate::settle::{lowest_release, settle};
 use glam::{DMat3, DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 use stackplan_cspace::cache::ObstacleCache;
@@ -447,17 +447,41 @@ pub fn plan_stack_with_progress(
                 if polygon.is_some() {
                     candidate.0.contacts = sides_of_floor(&candidate.0.contacts, &request.floor, &options.floor, tol);
                 }
+                // the lowest release above the rest that keeps the clearance (the search's may float far above it)
+                let search_drop = candidate.1;
+                let pose = candidate.0.pose();
+                candidate.1 = lowest_release(
+                    part,
+                    pose.rotation,
+                    pose.position,
+                    search_drop,
+                    search.scene(),
+                    &cache,
+                    options.clearance,
+                    options.insertion,
+                    tol,
+                )?;
                 let mut verdict = accept(&mut growing, part, &candidate.0, &mut stats)?;
-                // the clearance at the release position as the plan's check measures it
+                // the clearance at the release position as the plan's check measures it: at the lowered release, else
+                // (should the check's measure and the search's obstacles disagree within their tolerances) at the
+                // search's own
                 if verdict.is_ok() && options.clearance > 0.0 {
-                    let pose = candidate.0.pose();
-                    let keeps = growing
-                        .keeps_clearance(
-                            PlacedPart { part, rotation: pose.rotation, position: pose.position },
-                            candidate.1,
-                            options.clearance,
-                        )
+                    let placed = PlacedPart { part, rotation: pose.rotation, position: pose.position };
+                    let mut keeps = growing
+                        .keeps_clearance(placed, candidate.1, options.clearance)
                         .map_err(|e| PlanError::Check(e.to_string()))?;
+                    if !keeps && candidate.1 < search_drop {
+                        tracing::debug!(
+                            index,
+                            lowered = candidate.1,
+                            search_drop,
+                            "lowered release rejected by the check"
+                        );
+                        candidate.1 = search_drop;
+                        keeps = growing
+                            .keeps_clearance(placed, candidate.1, options.clearance)
+                            .map_err(|e| PlanError::Check(e.to_string()))?;
+                    }
                     if !keeps {
                         stats.rejected_clearance += 1;
                         verdict = Err("the best interference-free positions were rejected (last: closer to a placed \

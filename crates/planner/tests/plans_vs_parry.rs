@@ -395,6 +395,23 @@ fn plans_name_only_real_contacts() {
     check_plan(&block, &plan, &options);
 }
 
+/// At `w = 1` the cost does not depend on the height, and a search optimum can float far above what holds it: the
+/// sixth Complex part was released 302 mm above where it came to rest without a clearance (the plan's release drops
+/// are now the lowest that keep the clearance, `settle::lowest_release`). Every part is released where it rests,
+/// and the plan passes the independent tests.
+#[test]
+fn parts_are_released_no_higher_than_the_clearance_needs() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/parts");
+    let part = read_part(root.join("complex.json"), &ReadOptions::default()).expect("fixture part");
+    let floor = FloorVolume::rectangle(-496.5, -496.5, 496.5, 496.5, 1212.0);
+    let options = PlanOptions { w: 1.0, clearance: 0.0, ..PlanOptions::new(6, floor) };
+    let plan = plan_stack(&part, &options).expect("plan");
+    assert_eq!(plan.parts.len(), 6, "{:?}", plan.stopped);
+    let drops: Vec<f64> = plan.parts.iter().map(|p| p.release_drop).collect();
+    assert!(drops.iter().all(|d| *d == 0.0), "release drops {drops:?}");
+    check_plan(&part, &plan, &options);
+}
+
 /// The brute-force horizontal distance itself, on boxes with known answers.
 #[test]
 fn horizontal_distance_of_boxes() {

@@ -1,13 +1,15 @@
 //! `stackplan check STACK.json [--mu MU] [--clearance MM] [--cup-diameter MM] [--json]`: interference, clearance,
 //! stability, grasp, insertion and removal of every part of a stack (crate `stackplan-stability`; JSON documented in
 //! `docs/formats.md`). A plan file is checked with the planner's friction, clearance and cup (its `plan.options`)
-//! unless the command line gives them. Exit status 1 when a check fails.
+//! unless the command line gives them, and against its floor volume (every part inside the floor polygon and below
+//! the maximum height). Exit status 1 when a check fails.
 
 use crate::Outcome;
 use crate::output;
-use crate::plan_files::{plan_option, plan_summary};
+use crate::plan_files::{plan_floor, plan_option, plan_summary};
 use anyhow::Context;
 use serde::Serialize;
+use stackplan::planner::FloorVolume;
 use stackplan::stability::check::{CheckOptions, StackCheck, check_stack};
 use stackplan::stability::grasp::GraspOptions;
 use stackplan::stability::world::PlacedPart;
@@ -46,9 +48,67 @@ pub struct CheckJson {
     pub stack_file: String,
     /// Options used.
     pub options: CheckOptions,
+    /// A plan file's floor volume, and the parts that leave it (`null` for a stack file without one).
+    pub floor: Option<FloorCheck>,
     /// The report.
     #[serde(flatten)]
     pub report: StackCheck,
+}
+
+/// A plan file's floor volume (`plan.options.floor`) checked: every part inside the floor polygon and below the
+/// maximum height, within the check's length tolerance.
+#[derive(Debug, Serialize)]
+pub struct FloorCheck {
+    /// The floor polygon's corners (mm).
+    pub polygon: Vec<[f64; 2]>,
+    /// The maximum height (mm).
+    pub height: f64,
+    /// The parts that leave the floor volume by more than the tolerance.
+    pub outside: Vec<FloorViolation>,
+    /// No part leaves it.
+    pub ok: bool,
+}
+
+/// A part that leaves the floor volume.
+#[derive(Debug, Serialize)]
+pub struct FloorViolation {
+    /// The part's index in the stack.
+    pub index: usize,
+    /// How far its farthest vertex lies outside the floor polygon, horizontally (mm; 0 when inside).
+    pub beyond_sides: f64,
+    /// How far its highest vertex lies above the maximum height (mm; 0 when below).
+    pub above_height: f64,
+}
+
+/// The floor check of `stack` against `floor` (see [`FloorCheck`]). O(parts x vertices x sides).
+fn floor_check(stack: &[PlacedPart<'_>], floor: &FloorVolume, tolerance: f64) -> FloorCheck {
+    let sides = floor.side_planes();
+    let outside: Vec<FloorViolation> = stack
+        .iter()
+        .enumerate()
+        .filter_map(|(index, p)| {
+            let (mut beyond, mut top) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
+            for v in p.part.all_vertices() {
+                let w = p.rotation * v + p.position;
+                top = top.max(w.z);
+                for &(n, d) in &sides {
+                    beyond = beyond.max(n.x * w.x + n.y * w.y - d);
+                }
+            }
+            let (beyond_sides, above_height) = (beyond.max(0.0), (top - floor.height).max(0.0));
+            (beyond_sides > tolerance || above_height > tolerance).then_some(FloorViolation {
+                index,
+                beyond_sides,
+                above_height,
+            })
+        })
+        .collect();
+    FloorCheck {
+        polygon: floor.polygon.iter().map(|c| c.to_array()).collect(),
+        height: floor.height,
+        ok: outside.is_empty(),
+        outside,
+    }
 }
 
 /// The placements' `release_drop` (a plan file's parts released above their supports), or none when no placement
@@ -110,10 +170,23 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         prefix_stability: true,
         release_drops: release_drops(&args.stack, &file.extras)?,
     };
-    let report = check_stack(&stack, &options)?;
+    let mut report = check_stack(&stack, &options)?;
+    // a plan file's floor volume: a part outside it fails (`check_stack` knows the floor plane only)
+    let floor = match plan {
+        Some(summary) => plan_floor(summary, &args.stack)?.map(|f| floor_check(&stack, &f, report.tolerance)),
+        None => None,
+    };
+    if let Some(f) = &floor {
+        for v in &f.outside {
+            if let Some(part) = report.parts.get_mut(v.index) {
+                part.ok = false;
+            }
+        }
+        report.ok &= f.ok;
+    }
     let ok = report.ok;
     if args.json {
-        output::print_json(&CheckJson { stack_file: args.stack.display().to_string(), options, report })?;
+        output::print_json(&CheckJson { stack_file: args.stack.display().to_string(), options, floor, report })?;
     } else {
         let mut text = format!(
             "stack {}: {} parts, {}\n  part  interference  clearance  stable  margin  stack_stable  grasp_radius  insertable  removable  ok\n",
@@ -141,6 +214,17 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
             report.stack.verdict,
             report.stack.margin.map_or("-".to_string(), |m| format!("{m:.3}"))
         ));
+        if let Some(f) = &floor {
+            if f.ok {
+                text.push_str("  floor volume: every part inside\n");
+            }
+            for v in &f.outside {
+                text.push_str(&format!(
+                    "  floor volume: part {} lies {:.6} mm beyond the floor polygon and {:.6} mm above the maximum height\n",
+                    v.index, v.beyond_sides, v.above_height
+                ));
+            }
+        }
         output::print_summary(&text)?;
     }
     Ok(if ok { Outcome::Success } else { Outcome::ChecksFailed })

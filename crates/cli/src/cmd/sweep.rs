@@ -10,6 +10,7 @@
 
 use crate::Outcome;
 use crate::cmd::plan::{PlannerArgs, check_w, run_planner};
+use crate::input::short_number;
 use crate::output::{json_text, write_all_atomic};
 use crate::plan_files::{PNG_SCALE, PlanFile, parse_plan_file, plan_document_text, stack_scene};
 use crate::render::{Figure, FigurePanel, ISOMETRIC, Scene, figure_png, figure_svg};
@@ -140,15 +141,16 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     );
     let mut plans: Vec<(String, String, PlanFile)> = Vec::new();
     for (k, options) in options.iter().enumerate() {
-        bar.set_message(format!("w = {}", options.w));
+        bar.set_message(format!("w = {}", short_number(options.w)));
         let count = options.count;
-        let planned =
-            run_planner(&part, options, &mut |done| bar.set_message(format!("w = {}: {done}/{count}", options.w)));
+        let planned = run_planner(&part, options, &mut |done| {
+            bar.set_message(format!("w = {}: {done}/{count}", short_number(options.w)))
+        });
         let (plan, seconds) = match planned {
             Ok(p) => p,
             Err(e) => {
                 bar.finish_and_clear();
-                return Err(e.context(format!("sweeping {} at w = {}", args.part, options.w)));
+                return Err(e.context(format!("sweeping {} at w = {}", args.part, short_number(options.w))));
             }
         };
         let name = plan_file_name(options.w);
@@ -186,7 +188,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         panels: scenes
             .iter()
             .zip(&sweep.runs)
-            .map(|(scene, run)| FigurePanel { scene, view: ISOMETRIC, caption: format!("w = {}", run.w) })
+            .map(|(scene, run)| FigurePanel { scene, view: ISOMETRIC, caption: format!("w = {}", short_number(run.w)) })
             .collect(),
         columns: 4,
         cell: (300.0, 300.0),
@@ -207,7 +209,14 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     for r in &sweep.runs {
         text.push_str(&format!(
             "w = {}: {} placed, {} layers, height {:.1} mm, footprint {:.1} x {:.1} mm, total cost {:.1}, {:.1} s\n",
-            r.w, r.placed, r.layers, r.height, r.footprint_size[0], r.footprint_size[1], r.total_cost, r.seconds
+            short_number(r.w),
+            r.placed,
+            r.layers,
+            r.height,
+            r.footprint_size[0],
+            r.footprint_size[1],
+            r.total_cost,
+            r.seconds
         ));
     }
     text.push_str(&format!("wrote {}\n", args.out.display()));
