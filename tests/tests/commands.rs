@@ -112,6 +112,37 @@ fn interference_reports_penetrating_touching_and_free() {
     assert_eq!(v["touching"], 0);
 }
 
+/// The audit's reproducers: pairs a few tolerances apart (tolerance 3.0e-7 mm) are `separated` at their distance
+/// (parry's GJK, used before, answered 0 for the first two and left the third out, above the clearance).
+#[test]
+fn interference_gives_the_distance_of_pairs_a_few_tolerances_apart() {
+    let cases: [(&[&str], (u64, u64), f64); 4] = [
+        (&["example:triangle", "example:triangle", "--theta-deg", "0"], (0, 3), 5.0e-7),
+        (&["example:channel", "example:complex", "--theta-deg", "0"], (2, 4), 2.0e-6),
+        (&["example:triangle", "example:triangle", "--theta-deg", "17.3"], (2, 0), 1.0e-5),
+        (&["example:triangle", "example:triangle", "--theta-deg", "0"], (1, 3), 5.0e-7),
+    ];
+    let positions = [
+        "-7.269787197624776,4.19721359549996,-1.44721409549996",
+        "32.49999943182334,-81.00000191759622,-25.0",
+        "-104.57118181894764,-76.95584907443663,-20.000006905572395",
+        "-7.269787197624776,4.19721359549996,-1.44721409549996",
+    ];
+    for ((parts, (i, j), distance), position) in cases.iter().zip(positions) {
+        let position = format!("--position={position}");
+        let o = run(&[&["interference"][..], parts, &[&position, "--clearance", "1", "--json"]].concat());
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        let v = json(&o);
+        let pairs = v["pairs"].as_array().expect("pairs");
+        let pair = pairs.iter().find(|p| p["moving_piece"] == *i && p["fixed_piece"] == *j);
+        let pair = pair.unwrap_or_else(|| panic!("{parts:?} {position}: pair ({i}, {j}) not listed: {pairs:?}"));
+        assert_eq!(pair["contact"], "separated", "{pair}");
+        let gap = pair["gap"].as_f64().expect("gap");
+        // the positions are given to 17 digits of coordinates about 100: 1e-12 mm of rounding
+        assert!((gap - distance).abs() < 1e-11, "{parts:?} {position}: gap {gap}, distance {distance}");
+    }
+}
+
 fn write_stack(dir: &std::path::Path, positions: &[[f64; 3]]) -> std::path::PathBuf {
     let placements: Vec<Value> = positions
         .iter()
