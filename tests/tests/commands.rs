@@ -143,6 +143,39 @@ fn interference_gives_the_distance_of_pairs_a_few_tolerances_apart() {
     }
 }
 
+/// NaN and infinities are errors (exit 2) that name the option, in every option that takes one number of the
+/// geometry commands (`cspace --slice-z NaN` printed `slice_z: null` and empty slices; `intervals --from-deg NaN`
+/// blamed the order of the window).
+#[test]
+fn non_finite_numbers_are_errors_naming_the_option() {
+    let pair = ["example:block", "example:l-corner"];
+    for value in ["NaN", "inf", "-inf"] {
+        let cases: [(&[&str], &str); 9] = [
+            (&["cspace", "--slice-z", value, "--json"], "--slice-z: "),
+            (&["cspace", "--slice-z", value, "--svg", "never.svg"], "is not a finite length"),
+            (&["cspace", "--theta-deg", value, "--json"], "--theta-deg"),
+            (&["cspace", "--extrapolate-from", value, "--json"], "--extrapolate-from"),
+            (&["cspace", "--clearance", value, "--json"], "--clearance"),
+            (&["intervals", "--from-deg", value, "--json"], "--from-deg must be a finite angle"),
+            (&["intervals", "--to-deg", value, "--json"], "--to-deg must be a finite angle"),
+            (&["interference", "--position", "0,0,50", "--theta-deg", value], "--theta-deg"),
+            (&["interference", "--position", "0,0,50", "--clearance", value], "--clearance"),
+        ];
+        for (args, option) in cases {
+            let args = [&args[..1], &pair[..], &args[1..]].concat();
+            let o = run(&args);
+            assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+            let message = stderr(&o);
+            assert!(message.contains(option) && !message.contains("panicked"), "{args:?}: {message}");
+        }
+    }
+    assert!(!root().join("never.svg").exists());
+    // the order of the window is checked after its numbers
+    let o = run(&["intervals", "example:block", "example:l-corner", "--from-deg", "10", "--to-deg", "5"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--from-deg (10) must not exceed --to-deg (5)"), "{}", stderr(&o));
+}
+
 fn write_stack(dir: &std::path::Path, positions: &[[f64; 3]]) -> std::path::PathBuf {
     let placements: Vec<Value> = positions
         .iter()

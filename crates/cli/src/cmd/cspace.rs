@@ -44,7 +44,7 @@ pub struct Args {
     /// Also give the insertion obstacles (positions from which straight-down insertion is blocked).
     #[arg(long)]
     pub insertion: bool,
-    /// Also give the slice of every obstacle at p_z = Z (a convex polygon); the SVG draws this slice (default 0).
+    /// Also give the slice of every obstacle at p_z = Z (mm; a convex polygon); the SVG draws this slice (default 0).
     #[arg(long, value_name = "Z")]
     pub slice_z: Option<f64>,
     /// Split concave sheet-metal faces by plain triangulation (the seed's component counts).
@@ -194,6 +194,9 @@ fn in_degrees(e: ExtrapolateError) -> anyhow::Error {
 pub fn obstacles(args: &Args) -> anyhow::Result<Vec<PairObstacle>> {
     anyhow::ensure!(args.theta_deg.is_finite(), "--theta-deg must be finite");
     anyhow::ensure!(args.extrapolate_from.is_none_or(f64::is_finite), "--extrapolate-from must be finite");
+    if let Some(z) = args.slice_z {
+        crate::input::check_lengths("--slice-z", &[z])?;
+    }
     let PartPair { moving, fixed, fixed_pose, only } =
         load_pair(&args.moving, &args.fixed, args.triangulate, args.fixed_pose.as_deref(), args.pair.as_deref())?;
     let (fixed_rotation, fixed_position) = (fixed_pose.rotation, fixed_pose.position);

@@ -81,7 +81,10 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let PartPair { moving, fixed, fixed_pose, only } =
         load_pair(&args.moving, &args.fixed, args.triangulate, args.fixed_pose.as_deref(), args.pair.as_deref())?;
     let (rotation, translation) = (fixed_pose.rotation, fixed_pose.position);
-    anyhow::ensure!(args.from_deg <= args.to_deg, "--from-deg must not exceed --to-deg");
+    let (from_deg, to_deg) = (args.from_deg, args.to_deg);
+    anyhow::ensure!(from_deg.is_finite(), "--from-deg must be a finite angle in degrees, got {from_deg}");
+    anyhow::ensure!(to_deg.is_finite(), "--to-deg must be a finite angle in degrees, got {to_deg}");
+    anyhow::ensure!(from_deg <= to_deg, "--from-deg ({from_deg}) must not exceed --to-deg ({to_deg})");
     let mut pairs = Vec::new();
     for (i, a) in moving.components.iter().enumerate() {
         for (j, b) in fixed.components.iter().enumerate() {
