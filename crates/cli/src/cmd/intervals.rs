@@ -21,7 +21,8 @@ pub struct Args {
     /// Only this pair: moving component I, fixed component J.
     #[arg(long, value_name = "I,J")]
     pub pair: Option<String>,
-    /// Only intervals reaching past this angle (degrees).
+    /// Only intervals reaching past this angle (degrees; the window [A, B] is moved by whole turns so that A lies
+    /// in (-360, 360)).
     #[arg(long, default_value_t = 0.0)]
     pub from_deg: f64,
     /// Only intervals starting before this angle (degrees).
@@ -76,15 +77,27 @@ fn event_json(e: &Event) -> serde_json::Value {
     v
 }
 
-/// Runs `intervals`.
-pub fn run(args: &Args) -> anyhow::Result<Outcome> {
-    let PartPair { moving, fixed, fixed_pose, only } =
-        load_pair(&args.moving, &args.fixed, args.triangulate, args.fixed_pose.as_deref(), args.pair.as_deref())?;
-    let (rotation, translation) = (fixed_pose.rotation, fixed_pose.position);
-    let (from_deg, to_deg) = (args.from_deg, args.to_deg);
+/// The window `[--from-deg, --to-deg]` moved by whole turns so that its start lies in `(-360, 360)` (the start
+/// reduced exactly, `from % 360`, the end by the same shift up to rounding), or `None` when it spans a turn or more
+/// (every interval overlaps it). An error names an option that is not finite, or a start beyond the end.
+pub fn window(from_deg: f64, to_deg: f64) -> anyhow::Result<Option<(f64, f64)>> {
     anyhow::ensure!(from_deg.is_finite(), "--from-deg must be a finite angle in degrees, got {from_deg}");
     anyhow::ensure!(to_deg.is_finite(), "--to-deg must be a finite angle in degrees, got {to_deg}");
     anyhow::ensure!(from_deg <= to_deg, "--from-deg ({from_deg}) must not exceed --to-deg ({to_deg})");
+    let length = to_deg - from_deg;
+    if length >= 360.0 {
+        return Ok(None);
+    }
+    let from = from_deg % 360.0;
+    Ok(Some((from, from + length)))
+}
+
+/// Runs `intervals`.
+pub fn run(args: &Args) -> anyhow::Result<Outcome> {
+    let window = window(args.from_deg, args.to_deg)?;
+    let PartPair { moving, fixed, fixed_pose, only } =
+        load_pair(&args.moving, &args.fixed, args.triangulate, args.fixed_pose.as_deref(), args.pair.as_deref())?;
+    let (rotation, translation) = (fixed_pose.rotation, fixed_pose.position);
     let mut pairs = Vec::new();
     for (i, a) in moving.components.iter().enumerate() {
         for (j, b) in fixed.components.iter().enumerate() {
@@ -96,8 +109,9 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
             let mut intervals = Vec::new();
             for t in events.full_turn() {
                 let (s, e) = (t.start.to_degrees(), t.end.to_degrees());
-                // the interval or its copy one turn earlier overlaps [from, to]
-                let overlaps = [-360.0, 0.0, 360.0].iter().any(|k| s + k < args.to_deg && e + k > args.from_deg);
+                // the interval or its copy one turn earlier or later overlaps the window (starting in (-360, 360))
+                let overlaps =
+                    window.is_none_or(|(from, to)| [-360.0, 0.0, 360.0].iter().any(|k| s + k < to && e + k > from));
                 if overlaps {
                     intervals.push(IntervalJson {
                         start_deg: s,
