@@ -6,7 +6,7 @@ use crate::Outcome;
 use crate::input::{PartPair, load_pair};
 use crate::output;
 use serde::Serialize;
-use stackplan::orient_interval::{Event, PairEvents};
+use stackplan::orient_interval::{Event, PairEvents, TurnInterval};
 
 /// Arguments of `intervals`.
 #[derive(Debug, clap::Args)]
@@ -39,9 +39,9 @@ pub struct Args {
 /// JSON of one interval.
 #[derive(Debug, Serialize)]
 pub struct IntervalJson {
-    /// Start (degrees, in [0, 360)).
+    /// Start (degrees, in [0, 360)); the same number as the previous interval's `end_deg`.
     pub start_deg: f64,
-    /// End (degrees, > start; above 360 for the interval that wraps).
+    /// End (degrees, > start; above 360 for the interval that wraps, whose end is the first start plus 360).
     pub end_deg: f64,
     /// Whether this is an event window (overlapping degenerate configurations) rather than a constant interval.
     pub degenerate: bool,
@@ -92,6 +92,22 @@ pub fn window(from_deg: f64, to_deg: f64) -> anyhow::Result<Option<(f64, f64)>> 
     Ok(Some((from, from + length)))
 }
 
+/// The full-turn partition in degrees: `(start_deg, end_deg, interval)`, each boundary converted once, so that an
+/// interval's end is bit for bit the next one's start and the last one's end is the first start plus 360
+/// (`PairEvents::full_turn` shares the boundaries the same way in radians).
+fn turn_in_degrees(turn: &[TurnInterval]) -> Vec<(f64, f64, &TurnInterval)> {
+    let starts: Vec<f64> = turn.iter().map(|t| t.start.to_degrees()).collect();
+    (0..turn.len())
+        .map(|k| {
+            let end = match starts.get(k + 1) {
+                Some(&next) => next,
+                None => starts[0] + 360.0,
+            };
+            (starts[k], end, &turn[k])
+        })
+        .collect()
+}
+
 /// Runs `intervals`.
 pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let window = window(args.from_deg, args.to_deg)?;
@@ -107,8 +123,8 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
             let placed = b.transformed(rotation, translation);
             let events = PairEvents::new(a, &placed);
             let mut intervals = Vec::new();
-            for t in events.full_turn() {
-                let (s, e) = (t.start.to_degrees(), t.end.to_degrees());
+            let turn = events.full_turn();
+            for (s, e, t) in turn_in_degrees(&turn) {
                 // the interval or its copy one turn earlier or later overlaps the window (starting in (-360, 360))
                 let overlaps =
                     window.is_none_or(|(from, to)| [-360.0, 0.0, 360.0].iter().any(|k| s + k < to && e + k > from));
