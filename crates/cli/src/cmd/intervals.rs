@@ -93,10 +93,16 @@ pub fn window(from_deg: f64, to_deg: f64) -> anyhow::Result<Option<(f64, f64)>> 
 }
 
 /// The full-turn partition in degrees: `(start_deg, end_deg, interval)`, each boundary converted once, so that an
-/// interval's end is bit for bit the next one's start and the last one's end is the first start plus 360
-/// (`PairEvents::full_turn` shares the boundaries the same way in radians).
+/// interval's end is bit for bit the next one's start (`PairEvents::full_turn` shares the boundaries the same way in
+/// radians), and the last one's end is the first start plus 360 exactly: the first start, the one boundary that is
+/// written both ways, is rounded to the precision of numbers in `[360, 720)` (by less than 3e-14 degree), so that
+/// `end - 360` gives it back.
 fn turn_in_degrees(turn: &[TurnInterval]) -> Vec<(f64, f64, &TurnInterval)> {
-    let starts: Vec<f64> = turn.iter().map(|t| t.start.to_degrees()).collect();
+    let mut starts: Vec<f64> = turn.iter().map(|t| t.start.to_degrees()).collect();
+    if let Some(first) = starts.first_mut() {
+        // `(s + 360) - 360` is exact (Sterbenz), so the rounded `s` and `s + 360` are both doubles
+        *first = (*first + 360.0) - 360.0;
+    }
     (0..turn.len())
         .map(|k| {
             let end = match starts.get(k + 1) {
