@@ -188,7 +188,7 @@ fn obstacle(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
     let mut kinds: std::collections::BTreeMap<&'static str, usize> = Default::default();
     let mut hull_route = 0usize;
     for theta in &angles {
-        let r = stackplan_geom::DMat3::from_rotation_z(theta.to_radians());
+        let r = stackplan_geom::DMat3::from_rotation_z(stackplan_geom::pose::radians_mod_turn(*theta));
         let (mut v_row, mut f_row, mut vol_row) = (Vec::new(), Vec::new(), Vec::new());
         for (i, a) in moving.components.iter().enumerate() {
             for (j, b) in placed.iter().enumerate() {

@@ -22,7 +22,8 @@
 //!   from the flag's conditions, and the cross products are not even formed.
 //! * **Clearance** `delta > 0`: pairs whose Euclidean distance is below `delta` are reported too. The SAT gap is only a
 //!   lower bound on the distance of separated polytopes, so candidates with `tol < gap < delta` get their exact
-//!   distance from parry3d-f64's GJK (`query::distance`) on the two polyhedra.
+//!   distance by closest features ([`pair_distance`], [`crate::distance`]; parry3d-f64's GJK, used before, answered 0
+//!   or more than the clearance a few tolerances from touching).
 
 use glam::{DMat3, DVec3};
 use parry3d_f64::bounding_volume::Aabb;
@@ -220,7 +221,8 @@ pub enum PairContact {
         /// Signed separation (mm), within the tolerance of zero.
         gap: f64,
     },
-    /// Disjoint; `gap` is a lower bound on the distance (the exact distance when it came from GJK).
+    /// Disjoint; `gap` is a lower bound on the distance (the exact distance, [`pair_distance`], when a clearance
+    /// asked for it).
     Separated {
         /// Separation (mm).
         gap: f64,
@@ -315,14 +317,15 @@ pub fn sat_gap_all_axes(a: &PlacedConvex, b: &PlacedConvex, stop_above: f64) -> 
 }
 
 /// [`classify_pair`]'s decisions on a gap: penetrating below `-tol`, touching within `tol`, separated above (with
-/// `clearance > tol` and a gap below it, the exact distance from GJK).
+/// `clearance > tol` and a gap below it, the exact distance, [`pair_distance`], or the gap itself, a lower bound of
+/// it, when a point set has no 3-D hull).
 fn classify_gap(a: &PlacedConvex, b: &PlacedConvex, gap: f64, tol: f64, clearance: f64) -> PairContact {
     if gap < -tol {
         PairContact::Penetrating { depth: -gap }
     } else if gap <= tol {
         PairContact::Touching { gap }
     } else if clearance > tol && gap < clearance {
-        PairContact::Separated { gap: gjk_distance(a, b).unwrap_or(gap) }
+        PairContact::Separated { gap: pair_distance(a, b).unwrap_or(gap) }
     } else {
         PairContact::Separated { gap }
     }
@@ -335,18 +338,23 @@ pub fn classify_pair_all_axes(a: &PlacedConvex, b: &PlacedConvex, tol: f64, clea
 }
 
 /// Classifies a convex pair with tolerance `tol`; with `clearance > 0`, a separated pair closer than `clearance` gets
-/// its exact distance (GJK) in `Separated { gap }`.
+/// its exact distance ([`pair_distance`]) in `Separated { gap }`.
 pub fn classify_pair(a: &PlacedConvex, b: &PlacedConvex, tol: f64, clearance: f64) -> PairContact {
     classify_gap(a, b, sat_gap(a, b, tol.max(clearance)), tol, clearance)
 }
 
-/// Euclidean distance of two disjoint placed polytopes by parry3d-f64's GJK (`None` if parry cannot build a shape).
+/// Euclidean distance of two disjoint placed polytopes, exact up to rounding at every distance: closest features of
+/// the exact hulls of their vertices ([`crate::distance::convex_distance`]; `None` when either has no 3-D hull). Not
+/// below the separating-axis gap (a lower bound of the distance) beyond rounding.
+pub fn pair_distance(a: &PlacedConvex, b: &PlacedConvex) -> Option<f64> {
+    crate::distance::convex_distance(&a.vertices, &b.vertices)
+}
+
+/// [`pair_distance`] under its former name: it was parry3d-f64's GJK, which answered 0, or more than the clearance,
+/// for pairs a few tolerances apart ([`crate::distance`]). The planner's narrow phase (`stackplan-planner`'s
+/// `detect`) calls it by this name, and must agree with [`classify_pair`] bit for bit.
 pub fn gjk_distance(a: &PlacedConvex, b: &PlacedConvex) -> Option<f64> {
-    use parry3d_f64::math::Pose;
-    use parry3d_f64::shape::ConvexPolyhedron;
-    let sa = ConvexPolyhedron::from_convex_hull(&a.vertices)?;
-    let sb = ConvexPolyhedron::from_convex_hull(&b.vertices)?;
-    parry3d_f64::query::distance(&Pose::IDENTITY, &sa, &Pose::IDENTITY, &sb).ok().map(|d| d.distance)
+    pair_distance(a, b)
 }
 
 /// A part placed in the world: `world = rotation . part + position`.

@@ -8,9 +8,12 @@
 //!   condition 4) and slices at constant `p_z`;
 //! * [`interference`]: interference pairs between placed parts (\[A\] eq. 6-8): a BVH broad phase and an exact
 //!   separating-axis narrow phase reporting penetrating vs touching;
+//! * [`distance`]: the distance of two disjoint convex polytopes by closest features (the separated pairs within a
+//!   clearance);
 //! * [`cache`]: an obstacle cache with construction/hit counters.
 
 pub mod cache;
+pub mod distance;
 mod edge_table;
 pub mod interference;
 pub mod minkowski;

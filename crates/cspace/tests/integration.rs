@@ -3,6 +3,7 @@
 //! filters by module, e.g. `tightness::`.
 
 mod common;
+mod distance;
 mod interference;
 mod interference_axes;
 mod near_tolerance;

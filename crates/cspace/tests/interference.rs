@@ -80,7 +80,7 @@ proptest! {
                             if let Some(d) = d {
                                 prop_assert!(
                                     (d - gap).abs() < 1e-6 || (d * d - gap * gap).abs() < 1e-6,
-                                    "GJK gap {} vs QP distance {}", gap, d
+                                    "gap {} vs QP distance {}", gap, d
                                 );
                             }
                         }

@@ -13,6 +13,19 @@ use serde::{Deserialize, Serialize};
 /// Tolerance of the orthonormality and determinant checks (absolute, on matrix entries).
 pub const ROTATION_TOLERANCE: f64 = 1e-9;
 
+/// An angle given in degrees, reduced modulo one turn, in radians: `(degrees % 360).to_radians()`, what every angle
+/// a user gives in degrees to turn a part goes through (the command line's `--theta-deg` and `--extrapolate-from`,
+/// the regression scenarios' `theta_deg`).
+///
+/// The remainder of two doubles is exact and keeps the sign of `degrees`: an angle in `(-360, 360)` is converted as
+/// given, bit for bit, and `T` and `T + 360 k` (both doubles, of one sign) give the same radians, so the same
+/// rotation. Converting a huge angle directly is off by whole degrees (1e17 degrees turned a part by 4.4 degrees too
+/// much, 1e20 by 118): the product with `pi / 180` is rounded to the double's precision before the sine reduces it.
+/// A huge angle means the double it is (1e20 is 280 modulo 360). NaN and infinities give NaN.
+pub fn radians_mod_turn(degrees: f64) -> f64 {
+    (degrees % 360.0).to_radians()
+}
+
 /// Why a matrix is not a proper rotation.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PoseError {
@@ -148,6 +161,34 @@ impl TryFrom<PoseRecord> for Pose {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    #[test]
+    fn angles_are_reduced_modulo_a_turn_exactly() {
+        // as given inside (-360, 360)
+        for t in [0.0, 30.0, -30.0, 17.3, -359.75, 1e-300] {
+            assert_eq!(radians_mod_turn(t).to_bits(), t.to_radians().to_bits(), "{t}");
+        }
+        // T and T + 360 k of one sign, k up to 2^40 (every sum a double: T has few fraction bits)
+        for t in [17.25f64, 359.5, 0.125, 90.0] {
+            for k in [1.0f64, 7.0, 1e6, 2f64.powi(40)] {
+                let (up, down) = (t + 360.0 * k, -t - 360.0 * k);
+                assert_eq!(up - 360.0 * k, t, "T + 360 k must be a double");
+                assert_eq!(radians_mod_turn(up).to_bits(), radians_mod_turn(t).to_bits(), "{t} + 360 * {k}");
+                assert_eq!(radians_mod_turn(down).to_bits(), radians_mod_turn(-t).to_bits(), "-{t} - 360 * {k}");
+                // of opposite signs: the same rotation to rounding
+                let r = DMat3::from_rotation_z(radians_mod_turn(t - 360.0 * k));
+                let expected = DMat3::from_rotation_z(radians_mod_turn(t));
+                assert!(r.abs_diff_eq(expected, 1e-15), "{t} - 360 * {k}");
+            }
+        }
+        // the doubles 1e17 and 1e20 are 280 modulo 360 (100 000 000 000 000 000 000 = 277 777 777 777 777 777 * 360 + 280)
+        for t in [1e17, 1e20, -1e20] {
+            let r = DMat3::from_rotation_z(radians_mod_turn(t));
+            let expected = DMat3::from_rotation_z(280f64.copysign(t).to_radians());
+            assert!(r.abs_diff_eq(expected, 1e-15), "{t}: {r}");
+        }
+        assert!(radians_mod_turn(f64::NAN).is_nan() && radians_mod_turn(f64::INFINITY).is_nan());
+    }
 
     fn close(a: DVec3, b: DVec3) -> bool {
         (a - b).length() <= 1e-9 * (1.0 + a.length().max(b.length()))

@@ -21,7 +21,7 @@ pub struct Args {
     pub moving: String,
     /// The fixed part A (file or `example:NAME`).
     pub fixed: String,
-    /// Lower bounds `X,Y,Z,RX,RY,RZ` (mm, degrees).
+    /// Lower bounds `X,Y,Z,RX,RY,RZ` (mm, degrees; rotations at most 360 in magnitude).
     #[arg(long, value_name = "X,Y,Z,RX,RY,RZ", allow_hyphen_values = true)]
     pub t_min: String,
     /// Upper bounds `X,Y,Z,RX,RY,RZ` (mm, degrees).
@@ -60,9 +60,20 @@ fn parse_list(s: &str, n: usize, what: &str) -> anyhow::Result<Vec<f64>> {
     Ok(v)
 }
 
+/// The largest rotation bound in magnitude (degrees): a full turn either way. A bound is the end of a range, not an
+/// angle that could be reduced modulo 360; beyond a turn the range repeats orientations, and at huge magnitudes the
+/// conversion to radians alone is off by whole degrees.
+pub const MAX_ROTATION_BOUND_DEG: f64 = 360.0;
+
 fn config(s: &str, what: &str) -> anyhow::Result<[f64; 6]> {
     let v = parse_list(s, 6, what)?;
     crate::input::check_lengths(&format!("{what} (X,Y,Z)"), &v[..3])?;
+    if let Some(r) = v[3..].iter().find(|r| r.abs() > MAX_ROTATION_BOUND_DEG) {
+        anyhow::bail!(
+            "{what} (RX,RY,RZ): {} is beyond {MAX_ROTATION_BOUND_DEG} degrees in magnitude",
+            crate::input::short_number(*r)
+        );
+    }
     Ok([v[0], v[1], v[2], v[3].to_radians(), v[4].to_radians(), v[5].to_radians()])
 }
 

@@ -14,6 +14,7 @@ use serde::Serialize;
 use stackplan::cspace::minkowski::{FaceKind, Feature, Obstacle, obstacle};
 use stackplan::cspace::offset::{HalfSpaces, clearance, insertion, insertion_polytope, slice};
 use stackplan::orient_interval::{ExtrapolateError, extrapolate_from};
+use stackplan_geom::pose::radians_mod_turn;
 use stackplan_geom::{ConvexPolytope, DMat3, DVec2, Plane};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -28,11 +29,11 @@ pub struct Args {
     /// Pose of the fixed part: JSON `{"position": [x, y, z], "rotation": [[row 0], [row 1], [row 2]]}`.
     #[arg(long, value_name = "POSE.json")]
     pub fixed_pose: Option<PathBuf>,
-    /// Rotation of the moving part about world z (degrees).
+    /// Rotation of the moving part about world z (degrees; any finite angle, reduced exactly modulo 360).
     #[arg(long, default_value_t = 0.0)]
     pub theta_deg: f64,
-    /// Build each obstacle at this angle (degrees) and extrapolate it to --theta-deg (an error when --theta-deg is
-    /// outside the obstacle's constant-structure interval around this angle).
+    /// Build each obstacle at this angle (degrees, reduced modulo 360) and extrapolate it to --theta-deg (an error
+    /// when --theta-deg is outside the obstacle's constant-structure interval around this angle).
     #[arg(long, value_name = "T0")]
     pub extrapolate_from: Option<f64>,
     /// Only this pair: moving component I, fixed component J.
@@ -44,7 +45,7 @@ pub struct Args {
     /// Also give the insertion obstacles (positions from which straight-down insertion is blocked).
     #[arg(long)]
     pub insertion: bool,
-    /// Also give the slice of every obstacle at p_z = Z (a convex polygon); the SVG draws this slice (default 0).
+    /// Also give the slice of every obstacle at p_z = Z (mm; a convex polygon); the SVG draws this slice (default 0).
     #[arg(long, value_name = "Z")]
     pub slice_z: Option<f64>,
     /// Split concave sheet-metal faces by plain triangulation (the seed's component counts).
@@ -169,20 +170,21 @@ pub struct OutsideInterval {
     pub theta: f64,
     /// Where the obstacle was built (degrees).
     pub built_at: f64,
-    /// Interval start (degrees, unwrapped: may be negative).
+    /// Interval start (degrees, around `built_at` reduced modulo 360, unwrapped: may be negative).
     pub start: f64,
     /// Interval end (degrees).
     pub end: f64,
 }
 
-/// The library's extrapolation error, with an angle outside the interval given in degrees ([`OutsideInterval`]).
-fn in_degrees(e: ExtrapolateError) -> anyhow::Error {
+/// The library's extrapolation error, with an angle outside the interval given in degrees ([`OutsideInterval`]):
+/// the interval's ends converted, the two angles as the options gave them (`theta_deg`, `built_at_deg`).
+fn in_degrees(e: ExtrapolateError, theta_deg: f64, built_at_deg: f64) -> anyhow::Error {
     // 7 decimals: event windows are a few 1e-6 degrees wide; the user's own angles print as given
     let deg = |rad: f64| (rad.to_degrees() * 1e7).round() / 1e7;
     match e {
-        ExtrapolateError::OutsideInterval { theta, built_at, start, end } => anyhow::Error::new(OutsideInterval {
-            theta: deg(theta),
-            built_at: deg(built_at),
+        ExtrapolateError::OutsideInterval { start, end, .. } => anyhow::Error::new(OutsideInterval {
+            theta: theta_deg,
+            built_at: built_at_deg,
             start: deg(start),
             end: deg(end),
         }),
@@ -194,10 +196,14 @@ fn in_degrees(e: ExtrapolateError) -> anyhow::Error {
 pub fn obstacles(args: &Args) -> anyhow::Result<Vec<PairObstacle>> {
     anyhow::ensure!(args.theta_deg.is_finite(), "--theta-deg must be finite");
     anyhow::ensure!(args.extrapolate_from.is_none_or(f64::is_finite), "--extrapolate-from must be finite");
+    if let Some(z) = args.slice_z {
+        crate::input::check_lengths("--slice-z", &[z])?;
+    }
     let PartPair { moving, fixed, fixed_pose, only } =
         load_pair(&args.moving, &args.fixed, args.triangulate, args.fixed_pose.as_deref(), args.pair.as_deref())?;
     let (fixed_rotation, fixed_position) = (fixed_pose.rotation, fixed_pose.position);
-    let rotation = DMat3::from_rotation_z(args.theta_deg.to_radians());
+    let theta = radians_mod_turn(args.theta_deg);
+    let rotation = DMat3::from_rotation_z(theta);
     let placed: Vec<ConvexPolytope> =
         fixed.components.iter().map(|c| c.transformed(fixed_rotation, fixed_position)).collect();
     let mut out = Vec::new();
@@ -210,8 +216,8 @@ pub fn obstacles(args: &Args) -> anyhow::Result<Vec<PairObstacle>> {
             let (o, interval) = match args.extrapolate_from {
                 None => (obstacle(a, rotation, b).with_context(what)?, None),
                 Some(t0) => {
-                    let (o, iv) = extrapolate_from(a, b, t0.to_radians(), args.theta_deg.to_radians())
-                        .map_err(in_degrees)
+                    let (o, iv) = extrapolate_from(a, b, radians_mod_turn(t0), theta)
+                        .map_err(|e| in_degrees(e, args.theta_deg, t0))
                         .with_context(what)?;
                     (o, Some([iv.start.to_degrees(), iv.end.to_degrees()]))
                 }

@@ -22,7 +22,8 @@ pub struct Args {
     /// Position of the moving part `X,Y,Z` (mm).
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
     pub position: String,
-    /// Rotation of the moving part about world z (degrees), applied before the translation.
+    /// Rotation of the moving part about world z (degrees; any finite angle, reduced exactly modulo 360), applied
+    /// before the translation.
     #[arg(long, default_value_t = 0.0)]
     pub theta_deg: f64,
     /// Pose of the fixed part: JSON `{"position": [x, y, z], "rotation": [[row 0], [row 1], [row 2]]}`.
@@ -94,7 +95,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         load_pair(&args.moving, &args.fixed, args.triangulate, args.fixed_pose.as_deref(), None)?;
     let (fixed_rotation, fixed_position) = (fixed_pose.rotation, fixed_pose.position);
     let scene = PlacedScene::new(&[Placement { part: &fixed, rotation: fixed_rotation, position: fixed_position }]);
-    let rotation = DMat3::from_rotation_z(args.theta_deg.to_radians());
+    let rotation = DMat3::from_rotation_z(stackplan_geom::pose::radians_mod_turn(args.theta_deg));
     let found = scene.interference_pairs(&moving, rotation, position, args.clearance);
     let pairs: Vec<PairJson> = found
         .iter()
