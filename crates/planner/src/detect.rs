@@ -1,6 +1,7 @@
 //! Interference pairs of the new part at a configuration (\[A\] eq. 8, section 5.1.3): a broad phase on axis-aligned
 //! boxes and the exact separating-axis narrow phase of `stackplan-cspace` on the complete axis set
-//! (`classify_pair_all_axes`, GJK distance for pairs closer than the clearance).
+//! (`classify_pair_all_axes`, and for pairs closer than the clearance their distance by closest features of the exact
+//! hulls, `stackplan_cspace::distance`, reached through its former name `gjk_distance`).
 //!
 //! * Without clearance a pair is reported only when it *penetrates* by more than the tolerance; touching is free.
 //! * With clearance `delta > 0`, a pair closer than `delta` is reported (touching included).
@@ -373,8 +374,8 @@ fn box_bound(a: &(DVec3, DVec3), b: &(DVec3, DVec3), weight: f64, slack: f64) ->
 /// first, then moving, then stack component).
 ///
 /// Every pair that passes the boxes stays *open*, not scanned, with an upper bound of its violation from the boxes
-/// alone (`box_bound`; the distance that `classify_pair` takes from GJK is at least the separating-axis gap, up to
-/// GJK's accuracy, for which the bound keeps a margin). [`CandidateQueue::next`] returns a pair only when its exact
+/// alone (`box_bound`; the distance that `classify_pair` takes from the closest features is at least the
+/// separating-axis gap, and the bound keeps a margin that once covered parry's GJK error). [`CandidateQueue::next`] returns a pair only when its exact
 /// violation is at least every open bound (ties by the same index order), scanning open pairs (normal axes, then
 /// cross axes) in the order of their bounds: the sequence is the one of sorting the exact violations, but the pairs
 /// whose bounds lie below the violation the search cuts with are never scanned.
@@ -475,8 +476,10 @@ impl CandidateQueue {
     }
 
     /// Upper bound of a pair's violation from a lower bound `best` of its scan's largest value, plus (with a
-    /// clearance, where `classify_pair` replaces the gap by parry's GJK distance, which is the true distance only up
-    /// to GJK's own accuracy) a margin of `1e-3 clearance + tol` covering GJK's error.
+    /// clearance, where `classify_pair` replaces the gap by the pair's distance) a margin of `1e-3 clearance + tol`.
+    /// The margin covered parry's GJK, whose distance was the true one only up to its own accuracy; the distance is now
+    /// exact up to rounding (`stackplan_cspace::distance`) and never below the gap, so the margin only loosens the
+    /// bound (a few more pairs scanned), never the order of the candidates.
     fn bound(&self, best: f64) -> f64 {
         if self.horizontal {
             -best
