@@ -250,6 +250,20 @@ pub fn reachable(pc: &PrincipalContact, a: &SurfaceElements, b: &SurfaceElements
     true
 }
 
+/// Whether face `fa` of A and face `fb` of B can lie flat on each other (opposite normals, the f-f criterion's first
+/// term) for some configuration in `bounds`: a rotation by at most `theta` ([`ConfigBox::max_rotation_angle`]) turns
+/// B's normal by at most `theta`, so `n_A = -R n_B` needs the angle between `n_A` and `-n_B` to be at most `theta`
+/// (`n_A . n_B <= -cos theta`, with `1e-9` for rounding). The hypotheses' mapping merges into f-f only such pairs
+/// (the strict check at a configuration only merged PCs that hold there, [`crate::manifold::Manifolds::state_at`]).
+pub fn can_face<'s>(
+    sa: &'s SurfaceElements,
+    sb: &'s SurfaceElements,
+    bounds: &ConfigBox,
+) -> impl Fn(usize, usize) -> bool + 's {
+    let limit = 1e-9 - bounds.max_rotation_angle().cos();
+    move |fa, fb| sa.faces[fa].plane.normal.dot(sb.faces[fb].plane.normal) <= limit
+}
+
 /// Lower and upper bounds on the distance between points of two elements of one part: the minimum (exact for
 /// elements of a valid boundary, which meet only along shared boundary: end points and boundary edges against the
 /// other element) and the maximum (over vertex pairs; the elements are convex).
@@ -504,6 +518,7 @@ pub fn generate(
         }
     }
     let mut feasible_ppcs: Vec<PrincipalContact> = Vec::new();
+    let faces_can_face = can_face(sa, sb, &bounds);
     while let Some((level, batch)) = queue.pop_first() {
         if level > settings.max_level {
             break;
@@ -545,7 +560,9 @@ pub fn generate(
                 }
                 let mut pcs = s.pcs.clone();
                 pcs.push(*p);
-                let c = ContactState::canonical(pcs, sa, sb);
+                let c = ContactState::canonical_with(pcs, sa, sb, |m| {
+                    m.kind() != PcType::FaceFace || faces_can_face(m.a.index, m.b.index)
+                });
                 if c.level() > s.level() && seen.insert(c.clone()) {
                     queue.entry(c.level()).or_default().push(c);
                 }

@@ -629,6 +629,20 @@ impl<'a> Manifolds<'a> {
         (holding, ambiguous)
     }
 
+    /// The contact state at `t`: the PPCs in contact (distance `<= hold`) in highest-level form, with only merged
+    /// PCs that hold at `t` (criterion `<= clear`; [`ContactState::canonical_with`]: at degenerate configurations the
+    /// mapping's rules can name a PC that does not hold, such as two coplanar faces with equal normals).
+    pub fn state_at(&self, t: &Config) -> ContactState {
+        self.state_of(self.holding(t).0, &Pose::from_config(t))
+    }
+
+    fn state_of(&self, holding: Vec<PrincipalContact>, pose: &Pose) -> ContactState {
+        let clear = self.clear();
+        ContactState::canonical_with(holding, &self.fixed.surface, &self.moving.surface, |m| {
+            pc_criterion(m, self.fixed, self.moving, pose, &self.weights) <= clear
+        })
+    }
+
     /// The strict check of `state` at `t` (see the module documentation).
     pub fn verify(&self, state: &ContactState, t: &Config, bounds: &ConfigBox) -> Result<(), Rejection> {
         if !bounds.contains(t) {
@@ -650,7 +664,7 @@ impl<'a> Manifolds<'a> {
         if let Some((pc, distance)) = ambiguous {
             return Err(Rejection::Ambiguous { pc: pc.label(), distance });
         }
-        let actual = ContactState::canonical(holding, &self.fixed.surface, &self.moving.surface);
+        let actual = self.state_of(holding, &pose);
         if &actual != state {
             return Err(Rejection::OtherState { holding: actual.label() });
         }
@@ -893,6 +907,43 @@ mod tests {
         // and the interior search finds a strict witness from there
         let w = m.interior_witness(&state, &[flat], &bounds, 3, 20).expect("witness");
         assert!(m.verify(&state, &w, &bounds).is_ok());
+    }
+
+    #[test]
+    fn faces_side_by_side_are_no_face_face_contact() {
+        // two aligned unit cubes, B on top of A: the top and bottom faces lie flat on each other, and the side faces
+        // of the two cubes are coplanar with equal normals, touching only along their common edge line; the points
+        // on that line used to merge them into f-f PCs such as f1-f0, whose criterion (opposite normals) fails
+        let a = box_part("a", DVec3::ZERO, DVec3::ONE);
+        let b = box_part("b", DVec3::ZERO, DVec3::ONE);
+        let t = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0];
+        let e = 1e-9;
+        let bounds = ConfigBox::new([-e, -e, 1.0, -e, -e, -e], [e, e, 1.0, e, e, e]).expect("box");
+        let m = Manifolds::new(&a, &b, all_ppcs(&a.surface, &b.surface), StrictTolerances::default());
+        let state = m.state_at(&t);
+        let pose = Pose::from_config(&t);
+        for pc in &state.pcs {
+            let value = pc_criterion(pc, &a, &b, &pose, &m.weights);
+            assert!(value <= m.hold(), "{} in {} has criterion {value}", pc.label(), state.label());
+        }
+        let ff: Vec<&PrincipalContact> = state.pcs.iter().filter(|pc| pc.kind() == PcType::FaceFace).collect();
+        assert_eq!(ff.len(), 1, "{}", state.label());
+        let (na, nb) = (a.surface.faces[ff[0].a.index].plane.normal, b.surface.faces[ff[0].b.index].plane.normal);
+        assert!((na - DVec3::Z).length() < 1e-12 && (nb + DVec3::Z).length() < 1e-12, "{}", state.label());
+        // the strict check of a single PPC names that state, the one it finds there
+        let single = ContactState::single(*ff[0]);
+        match m.verify(&single, &t, &bounds) {
+            Err(Rejection::OtherState { holding }) => assert_eq!(holding, state.label()),
+            other => panic!("{other:?}"),
+        }
+        // and the hypotheses' mapping does not merge faces that cannot face each other within the box
+        let (sa, sb) = (&a.surface, &b.surface);
+        let holding = m.holding(&t).0;
+        let can_face = crate::acsg::can_face(sa, sb, &bounds);
+        let merged = ContactState::canonical_with(holding, sa, sb, |m| {
+            m.kind() != PcType::FaceFace || can_face(m.a.index, m.b.index)
+        });
+        assert!(merged.pcs.iter().all(|m| m.kind() != PcType::FaceFace || m == ff[0]), "{}", merged.label());
     }
 
     #[test]
