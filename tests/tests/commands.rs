@@ -437,6 +437,36 @@ fn contacts_table_names_its_units() {
     assert!(text.contains("3.491e-2") && !text.contains("2.000e0"), "{text}");
 }
 
+/// The GA's effort is bounded (`--population 100000 --generations 100000`, each within its range, ran for hours):
+/// per search, `population x (generations + 1)` at most 10 million, and per graph 1e9 evaluations, checked before
+/// each level with every hypothesis counted as a search. Both are errors (exit 2) at once, naming the options.
+#[test]
+fn contacts_ga_effort_beyond_the_limits_is_an_error() {
+    let cube_box = ["--t-min", "-1.5,-1.5,-1.5,-5,-5,-5", "--t-max", "1.5,1.5,1.5,5,5,5"];
+    let cases = [
+        (
+            ["--population", "100000", "--generations", "100000"],
+            "population x (generations + 1) = 100000 x (100000 + 1) = 10000100000 GA evaluations per search, more \
+             than the limit of 10000000: lower population or generations",
+        ),
+        // 1e7 per search is allowed, but not for the hundreds of level-1 hypotheses of two cubes
+        (
+            ["--population", "10000", "--generations", "999"],
+            "hypotheses of level 1 x 10001200 evaluations per GA search",
+        ),
+    ];
+    for (ga, message) in cases {
+        let start = std::time::Instant::now();
+        let o = run(&[&["contacts", "example:cube", "example:cube"][..], &cube_box, &ga].concat());
+        assert_eq!(o.status.code(), Some(2), "{ga:?}: {}", stderr(&o));
+        assert!(stderr(&o).starts_with("error: --population / --generations: "), "{ga:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(message), "{ga:?}: {}", stderr(&o));
+        assert!(stdout(&o).is_empty(), "{ga:?}");
+        // no search ran
+        assert!(start.elapsed().as_secs_f64() < 30.0, "{ga:?}: {:?}", start.elapsed());
+    }
+}
+
 /// Inputs found by fuzzing the command line that used to panic (capacity overflow: exit 101), run out of memory, or
 /// fail deep in a solver: each is now an error (exit 2) that names the option, or the file and the place, and writes
 /// nothing.

@@ -80,6 +80,11 @@ impl Default for AcsgSettings {
 /// with its cube.
 pub const MAX_ANALYTIC_STEPS: usize = 64;
 
+/// The most objective evaluations the GA searches of one graph may need ([`SettingsError::TotalEffort`], checked
+/// before each level with every hypothesis counted as a search; about 15 minutes of one core for the block example's
+/// objective, 250 times the default run's 4 million).
+pub const MAX_GRAPH_EVALUATIONS: usize = 1_000_000_000;
+
 /// The most witness attempts per start ([`AcsgSettings::witness_attempts`]) and projections per extremal search
 /// ([`AcsgSettings::extremal_budget`]).
 pub const MAX_ATTEMPTS: usize = 1_000_000;
@@ -248,6 +253,20 @@ pub fn reachable(pc: &PrincipalContact, a: &SurfaceElements, b: &SurfaceElements
         }
     }
     true
+}
+
+/// Whether face `fa` of A and face `fb` of B can lie flat on each other (opposite normals, the f-f criterion's first
+/// term) for some configuration in `bounds`: a rotation by at most `theta` ([`ConfigBox::max_rotation_angle`]) turns
+/// B's normal by at most `theta`, so `n_A = -R n_B` needs the angle between `n_A` and `-n_B` to be at most `theta`
+/// (`n_A . n_B <= -cos theta`, with `1e-9` for rounding). The hypotheses' mapping merges into f-f only such pairs
+/// (the strict check at a configuration only merged PCs that hold there, [`crate::manifold::Manifolds::state_at`]).
+pub fn can_face<'s>(
+    sa: &'s SurfaceElements,
+    sb: &'s SurfaceElements,
+    bounds: &ConfigBox,
+) -> impl Fn(usize, usize) -> bool + 's {
+    let limit = 1e-9 - bounds.max_rotation_angle().cos();
+    move |fa, fb| sa.faces[fa].plane.normal.dot(sb.faces[fb].plane.normal) <= limit
 }
 
 /// Lower and upper bounds on the distance between points of two elements of one part: the minimum (exact for
@@ -472,7 +491,9 @@ impl Context<'_> {
 /// Generates the ACSG of the moving part B against the fixed part A within `bounds`.
 ///
 /// # Errors
-/// Settings that [`AcsgSettings::check`] rejects.
+/// Settings that [`AcsgSettings::check`] rejects, before any search; [`SettingsError::TotalEffort`] before a level
+/// whose GA searches could take the graph beyond [`MAX_GRAPH_EVALUATIONS`] objective evaluations (level 1, the
+/// reachable PPCs, is checked before any search).
 pub fn generate(
     fixed: &ContactPart,
     moving: &ContactPart,
@@ -504,9 +525,21 @@ pub fn generate(
         }
     }
     let mut feasible_ppcs: Vec<PrincipalContact> = Vec::new();
+    let faces_can_face = can_face(sa, sb, &bounds);
     while let Some((level, batch)) = queue.pop_first() {
         if level > settings.max_level {
             break;
+        }
+        // the level's GA work, every hypothesis counted as a search, within the graph's limit (before any search)
+        let per_search = settings.ga.evaluations_per_search();
+        if stats.evaluations.saturating_add(batch.len().saturating_mul(per_search)) > MAX_GRAPH_EVALUATIONS {
+            return Err(SettingsError::TotalEffort {
+                level,
+                hypotheses: batch.len(),
+                per_search,
+                spent: stats.evaluations,
+                max: MAX_GRAPH_EVALUATIONS,
+            });
         }
         let feasible_so_far: Vec<&StateRecord> =
             order.iter().filter_map(|s| known.get(s)).filter(|r| r.feasible).collect();
@@ -521,8 +554,7 @@ pub fn generate(
                 stats.from_neighbours += 1;
             } else {
                 stats.searched += 1;
-                stats.evaluations +=
-                    settings.ga.population * (settings.ga.generations + 1) + settings.ga.polish_evaluations;
+                stats.evaluations += per_search;
             }
             if !r.feasible && r.rejection.is_some() {
                 stats.rejected_candidates += 1;
@@ -545,7 +577,9 @@ pub fn generate(
                 }
                 let mut pcs = s.pcs.clone();
                 pcs.push(*p);
-                let c = ContactState::canonical(pcs, sa, sb);
+                let c = ContactState::canonical_with(pcs, sa, sb, |m| {
+                    m.kind() != PcType::FaceFace || faces_can_face(m.a.index, m.b.index)
+                });
                 if c.level() > s.level() && seen.insert(c.clone()) {
                     queue.entry(c.level()).or_default().push(c);
                 }
@@ -671,6 +705,8 @@ mod tests {
             (with_ga(GaSettings { population: 3, ..base.ga }), "population"),
             (with_ga(GaSettings { generations: usize::MAX, ..base.ga }), "generations"),
             (with_ga(GaSettings { polish_evaluations: usize::MAX, ..base.ga }), "polish_evaluations"),
+            // each size within its range, but 1e10 evaluations per search (hours per hypothesis)
+            (with_ga(GaSettings { population: 100_000, generations: 100_000, ..base.ga }), "population x (generations"),
             (AcsgSettings { analytic_steps: 65, ..base }, "analytic_steps"),
             (AcsgSettings { witness_attempts: usize::MAX, ..base }, "witness_attempts"),
             (AcsgSettings { extremal_budget: usize::MAX, ..base }, "extremal_budget"),
@@ -680,6 +716,30 @@ mod tests {
             let err = generate(&slab, &cube, bounds, settings).expect_err(name);
             assert!(err.to_string().starts_with(name), "{name}: {err}");
         }
+    }
+
+    #[test]
+    fn the_whole_graphs_ga_effort_is_bounded_before_any_search() {
+        // 1e7 evaluations per search is allowed, but not for the 240 PPCs of two cubes that can touch anywhere
+        let a = box_part("a", DVec3::splat(-0.5), DVec3::splat(0.5));
+        let b = box_part("b", DVec3::splat(-0.5), DVec3::splat(0.5));
+        let bounds = ConfigBox::new([-1.5, -1.5, -1.5, -0.1, -0.1, -0.1], [1.5, 1.5, 1.5, 0.1, 0.1, 0.1]).expect("box");
+        let ga = GaSettings { population: 10_000, generations: 999, polish_evaluations: 0, seed: 1 };
+        let settings = AcsgSettings { ga, ..AcsgSettings::default() };
+        assert_eq!(settings.check(), Ok(()));
+        let start = std::time::Instant::now();
+        match generate(&a, &b, bounds, settings) {
+            Err(SettingsError::TotalEffort { level: 1, hypotheses, per_search: 10_000_000, spent: 0, max }) => {
+                assert_eq!(max, MAX_GRAPH_EVALUATIONS);
+                assert!(hypotheses * 10_000_000 > max, "{hypotheses}");
+            }
+            other => panic!("{other:?}"),
+        }
+        // no search ran (one would take seconds)
+        assert!(start.elapsed().as_secs_f64() < 1.0, "{:?}", start.elapsed());
+        // the message names the settings to lower
+        let err = generate(&a, &b, bounds, settings).expect_err("effort").to_string();
+        assert!(err.contains("population, generations or polish_evaluations"), "{err}");
     }
 
     #[test]

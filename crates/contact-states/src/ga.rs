@@ -85,6 +85,11 @@ pub const MAX_GA_SIZE: usize = 100_000;
 /// The largest [`GaSettings::polish_evaluations`] accepted by [`GaSettings::check`].
 pub const MAX_POLISH_EVALUATIONS: usize = 10_000_000;
 
+/// The most GA evaluations of one search, `population x (generations + 1)`, accepted by [`GaSettings::check`]
+/// (8 000 times the default 40 x 31; about 10 s of one core for the block example's objective). The two sizes alone
+/// may each be up to [`MAX_GA_SIZE`], but not both.
+pub const MAX_GA_EVALUATIONS: usize = 10_000_000;
+
 /// Settings that no search can run with: a count outside its supported range, or a tolerance that is negative or not
 /// finite (the name is the setting's field).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -99,6 +104,42 @@ pub enum SettingsError {
         /// The smallest supported value.
         min: usize,
         /// The largest supported value.
+        max: usize,
+    },
+    /// One GA search would evaluate the objective more than [`MAX_GA_EVALUATIONS`] times.
+    #[error(
+        "population x (generations + 1) = {population} x ({generations} + 1) = {evaluations} GA evaluations per \
+         search, more than the limit of {max}: lower population or generations"
+    )]
+    Effort {
+        /// The population.
+        population: usize,
+        /// The generations.
+        generations: usize,
+        /// `population x (generations + 1)` (saturating).
+        evaluations: usize,
+        /// [`MAX_GA_EVALUATIONS`].
+        max: usize,
+    },
+    /// The GA searches of a whole graph could evaluate the objective more than
+    /// [`crate::acsg::MAX_GRAPH_EVALUATIONS`] times: checked before each level of the graph is searched, with every
+    /// hypothesis of the level counted as one GA search (an upper bound: pruned hypotheses and those verified from
+    /// their neighbours run none).
+    #[error(
+        "{hypotheses} hypotheses of level {level} x {per_search} evaluations per GA search (population x \
+         (generations + 1) + polish_evaluations), after {spent} spent on the levels below, could exceed the limit of \
+         {max} GA evaluations per graph: lower population, generations or polish_evaluations"
+    )]
+    TotalEffort {
+        /// The level about to be searched.
+        level: usize,
+        /// Its hypotheses.
+        hypotheses: usize,
+        /// Evaluations of one GA search with its polish.
+        per_search: usize,
+        /// Evaluations spent on the lower levels.
+        spent: usize,
+        /// [`crate::acsg::MAX_GRAPH_EVALUATIONS`].
         max: usize,
     },
     /// A tolerance or fraction that is negative or not finite.
@@ -118,12 +159,34 @@ pub(crate) fn check_count(name: &'static str, value: usize, min: usize, max: usi
 
 impl GaSettings {
     /// Checks the sizes: a population of 4 to [`MAX_GA_SIZE`], at most [`MAX_GA_SIZE`] generations and
-    /// [`MAX_POLISH_EVALUATIONS`] polish evaluations. [`minimise`] allocates the population it is given, so settings
+    /// [`MAX_POLISH_EVALUATIONS`] polish evaluations, and at most [`MAX_GA_EVALUATIONS`] evaluations
+    /// `population x (generations + 1)` per search. [`minimise`] allocates the population it is given, so settings
     /// from users should pass this first ([`crate::generate`] checks them).
     pub fn check(&self) -> Result<(), SettingsError> {
         check_count("population", self.population, 4, MAX_GA_SIZE)?;
         check_count("generations", self.generations, 0, MAX_GA_SIZE)?;
-        check_count("polish_evaluations", self.polish_evaluations, 0, MAX_POLISH_EVALUATIONS)
+        check_count("polish_evaluations", self.polish_evaluations, 0, MAX_POLISH_EVALUATIONS)?;
+        let evaluations = self.ga_evaluations();
+        if evaluations > MAX_GA_EVALUATIONS {
+            return Err(SettingsError::Effort {
+                population: self.population,
+                generations: self.generations,
+                evaluations,
+                max: MAX_GA_EVALUATIONS,
+            });
+        }
+        Ok(())
+    }
+
+    /// The objective evaluations of the GA proper, `population x (generations + 1)` (saturating).
+    pub fn ga_evaluations(&self) -> usize {
+        self.population.saturating_mul(self.generations.saturating_add(1))
+    }
+
+    /// The objective evaluations of one search with its polish, `population x (generations + 1) +
+    /// polish_evaluations` (saturating).
+    pub fn evaluations_per_search(&self) -> usize {
+        self.ga_evaluations().saturating_add(self.polish_evaluations)
     }
 }
 

@@ -26,16 +26,20 @@
 //! witness is projected; if the strict check fails, seeded random perturbations of growing size
 //! (`1e-4 .. 0.1` of the box widths) are projected and checked until one passes.
 //!
-//! **Extremals** (\[P\] eq. 9-10 solved on the manifold): from a configuration of the state, a compass search on
-//! `±t_k` whose trial moves change one variable `t_j` by a step and let the other variables restore the closure of
-//! the state (projection with `t_j` frozen onto the equalities, the bounding terms and non-penetration, so a move
-//! blocked by a face boundary or another contact is restored by the other variables, e.g. a turn that lets a face
-//! slide further over an edge); a trial is accepted when it improves `±t_k`, stays in the box and satisfies eq. 8
-//! to `hold` (closure: other contacts may hold at an extremal). Steps double after a success and halve after a
-//! failed sweep, down to `1e-7` of the box width; the search ends at once when `t_k` reaches its bound. Unlike the
-//! penalty formulation of eq. 11-12, every accepted point lies on the manifold, so the search does not stop short by
-//! the penalty's slack; it is local (a compass search stops at a point where no single-variable move with
-//! restoration improves, e.g. a corner of a curved boundary).
+//! **Extremals** (\[P\] eq. 9-10 solved on the manifold): from a configuration of the state, a local search on `±t_k`
+//! whose sweeps try (1) a *tangent move*: the objective's direction projected onto the tangent space of the state's
+//! equalities and of the active inequalities it would violate (bounding terms and penetration at their boundary,
+//! variables at a box bound), a step limited per variable, restored by the closure projection with `t_k` frozen, or
+//! else by the plain closure projection (a gradient projection); (2) *compass moves* of one variable `t_j`, restored by
+//! the projection with `t_j` frozen onto the equalities, the bounding terms and non-penetration (a move blocked by a
+//! face boundary or another contact is restored by the other variables, e.g. a turn that lets a face slide further over
+//! an edge); (3) when that sweep failed, *pair moves* of `t_k` with one other variable, both frozen. A trial is accepted
+//! when it improves `±t_k`, stays in the box and satisfies eq. 8 to `hold` (closure: other contacts may hold at an
+//! extremal); a trial the projection did not reach to `1e-11 L` is accepted when every PC and the penetration term are
+//! within `hold` there ([`Manifolds::holds_at`]). Steps double after a success and shrink to a quarter after a failed
+//! sweep, down to `1e-7` of the box width; the search ends at once when `t_k` reaches its bound. Unlike the penalty
+//! formulation of eq. 11-12, every accepted point lies on the manifold, so the search does not stop short by the
+//! penalty's slack; it is local (it can stop where the extreme lies in another region of the state).
 
 use crate::criteria::{ContactPart, Objective, Weights, face_point_distance_2d, pc_criterion, pc_terms, penetration};
 use crate::ga::SplitMix64;
@@ -149,6 +153,142 @@ fn solve_spd6(a: &[[f64; 6]; 6], b: &[f64; 6]) -> Option<[f64; 6]> {
         x[i] = s / l[i][i];
     }
     Some(x)
+}
+
+/// The factor of the extremal search's steps after a sweep without improvement.
+const STALL_SHRINK: f64 = 0.25;
+
+/// The smallest step (fraction of the width) of the extremal search's moves of two variables together.
+const PAIR_MIN_STEP: f64 = 1e-3;
+
+/// Eigenvalues and eigenvectors (the columns of the returned matrix) of the symmetric 6x6 matrix `a` (cyclic Jacobi
+/// rotations; converges quadratically, a dozen sweeps at most for 6x6).
+fn symmetric_eigen6(mut a: [[f64; 6]; 6]) -> ([f64; 6], [[f64; 6]; 6]) {
+    let mut v = [[0.0; 6]; 6];
+    for (i, row) in v.iter_mut().enumerate() {
+        row[i] = 1.0;
+    }
+    for _ in 0..50 {
+        let off: f64 = (0..6).flat_map(|p| (p + 1..6).map(move |q| (p, q))).map(|(p, q)| a[p][q] * a[p][q]).sum();
+        let diag: f64 = (0..6).map(|p| a[p][p] * a[p][p]).sum();
+        if off <= 1e-30 * diag || off == 0.0 {
+            break;
+        }
+        for p in 0..6 {
+            for q in p + 1..6 {
+                if a[p][q] == 0.0 {
+                    continue;
+                }
+                // the rotation that zeroes a[p][q] (Golub & Van Loan, 8.5.2)
+                let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+                let t = if theta == 0.0 { 1.0 } else { t };
+                let c = 1.0 / (t * t + 1.0).sqrt();
+                let s = t * c;
+                for k in 0..6 {
+                    let (akp, akq) = (a[k][p], a[k][q]);
+                    a[k][p] = c * akp - s * akq;
+                    a[k][q] = s * akp + c * akq;
+                }
+                for k in 0..6 {
+                    let (apk, aqk) = (a[p][k], a[q][k]);
+                    a[p][k] = c * apk - s * aqk;
+                    a[q][k] = s * apk + c * aqk;
+                }
+                for row in v.iter_mut() {
+                    let (vp, vq) = (row[p], row[q]);
+                    row[p] = c * vp - s * vq;
+                    row[q] = s * vp + c * vq;
+                }
+            }
+        }
+    }
+    (std::array::from_fn(|i| a[i][i]), v)
+}
+
+/// The projection of `goal` onto the common null space of `rows` (each normalised) and of the unit vectors of the
+/// variables in `fixed`: the part of `goal` that keeps every row's value to first order (eigenvectors of
+/// `sum r r^T + sum e_j e_j^T` with eigenvalue at most `1e-9` of the largest, so nearly dependent rows are harmless).
+fn null_space_projection(goal: &[f64; 6], rows: &[[f64; 6]], fixed: &[bool; 6]) -> [f64; 6] {
+    let mut a = [[0.0; 6]; 6];
+    for row in rows {
+        let norm = row.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if norm <= 0.0 || !norm.is_finite() {
+            continue;
+        }
+        for p in 0..6 {
+            for q in 0..6 {
+                a[p][q] += row[p] * row[q] / (norm * norm);
+            }
+        }
+    }
+    for j in (0..6).filter(|&j| fixed[j]) {
+        a[j][j] += 1.0;
+    }
+    let (values, vectors) = symmetric_eigen6(a);
+    let largest = values.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+    let mut d = [0.0; 6];
+    for i in (0..6).filter(|&i| values[i].abs() <= 1e-9 * largest) {
+        let along: f64 = (0..6).map(|p| vectors[p][i] * goal[p]).sum();
+        for p in 0..6 {
+            d[p] += along * vectors[p][i];
+        }
+    }
+    d
+}
+
+/// A direction (scaled variables, unit length) that improves the objective `sign t_k` (decreases it) while keeping
+/// the state's closure to first order: the objective's gradient projected onto the tangent space of the equalities
+/// (rows `..equalities` of the closure Jacobian `jac`), with every active inequality (a bounding term or the
+/// penetration term, rows `equalities..`, whose row is not zero: at or past its boundary) that the direction would
+/// increase, and every variable at a bound of `bounds` that it would leave, added to the constraints until none is
+/// violated. `None` when nothing is left (the point is stationary for these constraints).
+fn tangent_direction(
+    jac: &[[f64; 6]],
+    equalities: usize,
+    k: usize,
+    sign: f64,
+    at: &Config,
+    bounds: &ConfigBox,
+) -> Option<[f64; 6]> {
+    let mut goal = [0.0; 6];
+    goal[k] = -sign;
+    let mut rows: Vec<[f64; 6]> = jac[..equalities.min(jac.len())].to_vec();
+    let mut added = vec![false; jac.len()];
+    let mut fixed: [bool; 6] = std::array::from_fn(|j| bounds.width(j) <= 0.0);
+    for _ in 0..=jac.len() + 6 {
+        let d = null_space_projection(&goal, &rows, &fixed);
+        let norm = d.iter().map(|x| x * x).sum::<f64>().sqrt();
+        // the improvement rate of t_k per unit move (scaled) is |d|: below 1e-6 it is rounding, or the first-order
+        // gain is negligible (at the extremum, where the objective's row lies in the span of the constraints')
+        if norm <= 1e-6 {
+            return None;
+        }
+        let mut violated = false;
+        for i in equalities.min(jac.len())..jac.len() {
+            let row = &jac[i];
+            let row_norm = row.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if added[i] || row_norm <= 1e-12 {
+                continue;
+            }
+            let rate: f64 = (0..6).map(|p| row[p] * d[p]).sum();
+            if rate > 1e-9 * row_norm * norm {
+                added[i] = true;
+                rows.push(*row);
+                violated = true;
+            }
+        }
+        for j in 0..6 {
+            if !fixed[j] && ((at[j] >= bounds.max[j] && d[j] > 0.0) || (at[j] <= bounds.min[j] && d[j] < 0.0)) {
+                fixed[j] = true;
+                violated = true;
+            }
+        }
+        if !violated {
+            return Some(d.map(|x| x / norm));
+        }
+    }
+    None
 }
 
 /// The variables that the equalities pin locally: a change of `t_j` alone cannot be compensated by the other
@@ -629,6 +769,20 @@ impl<'a> Manifolds<'a> {
         (holding, ambiguous)
     }
 
+    /// The contact state at `t`: the PPCs in contact (distance `<= hold`) in highest-level form, with only merged
+    /// PCs that hold at `t` (criterion `<= clear`; [`ContactState::canonical_with`]: at degenerate configurations the
+    /// mapping's rules can name a PC that does not hold, such as two coplanar faces with equal normals).
+    pub fn state_at(&self, t: &Config) -> ContactState {
+        self.state_of(self.holding(t).0, &Pose::from_config(t))
+    }
+
+    fn state_of(&self, holding: Vec<PrincipalContact>, pose: &Pose) -> ContactState {
+        let clear = self.clear();
+        ContactState::canonical_with(holding, &self.fixed.surface, &self.moving.surface, |m| {
+            pc_criterion(m, self.fixed, self.moving, pose, &self.weights) <= clear
+        })
+    }
+
     /// The strict check of `state` at `t` (see the module documentation).
     pub fn verify(&self, state: &ContactState, t: &Config, bounds: &ConfigBox) -> Result<(), Rejection> {
         if !bounds.contains(t) {
@@ -650,7 +804,7 @@ impl<'a> Manifolds<'a> {
         if let Some((pc, distance)) = ambiguous {
             return Err(Rejection::Ambiguous { pc: pc.label(), distance });
         }
-        let actual = ContactState::canonical(holding, &self.fixed.surface, &self.moving.surface);
+        let actual = self.state_of(holding, &pose);
         if &actual != state {
             return Err(Rejection::OtherState { holding: actual.label() });
         }
@@ -773,6 +927,20 @@ impl<'a> Manifolds<'a> {
         Err(first.unwrap_or(last))
     }
 
+    /// Whether every PC of the state holds at `t` (criterion at most `hold`), nothing penetrates (`L d_G` at most
+    /// `hold`) and `t` is in the box: the first part of [`Self::verify`], without the other contacts. The extremal
+    /// search accepts a trial point that its projection did not reach to `1e-11 L` on this test (a start within the
+    /// strict tolerance of an ill-conditioned system; a translation along the faces in contact).
+    pub fn holds_at(&self, state: &ContactState, t: &Config, bounds: &ConfigBox) -> bool {
+        if !bounds.contains(t) {
+            return false;
+        }
+        let pose = Pose::from_config(t);
+        let hold = self.hold();
+        state.pcs.iter().all(|pc| pc_criterion(pc, self.fixed, self.moving, &pose, &self.weights) <= hold)
+            && self.weights.length * penetration(self.fixed, self.moving, &pose) <= hold
+    }
+
     /// Whether `t` lies in the closure of the state: eq. 8 at most `hold` inside the box.
     pub fn in_closure(&self, state: &ContactState, t: &Config, bounds: &ConfigBox) -> bool {
         // each PC's criterion and the penetration term may each be up to `hold` at a verified witness
@@ -781,8 +949,10 @@ impl<'a> Manifolds<'a> {
                 <= self.hold() * (state.pcs.len() + 1) as f64
     }
 
-    /// The extremal of `t_k` (lower, or upper when `upper`) by the compass search on the manifold from `start`
-    /// (a configuration in the closure of the state). Returns the configuration reached and the evaluations spent.
+    /// The extremal of `t_k` (lower, or upper when `upper`) by a local search on the manifold from `start` (a
+    /// configuration in the closure of the state): projected-gradient moves along the tangent space of the state's
+    /// equalities and active inequalities, and compass moves of single variables, each restored onto the closure by
+    /// projection (see the module documentation). Returns the configuration reached and the projections spent.
     pub fn extremal(
         &self,
         state: &ContactState,
@@ -793,17 +963,71 @@ impl<'a> Manifolds<'a> {
         budget: usize,
     ) -> (Config, usize) {
         let sign = if upper { -1.0 } else { 1.0 };
+        let length = self.weights.length;
         let mut best = start;
         let mut used = 0;
         let min_step = 1e-7;
         let mut step = [0.05f64; 6];
+        // the tangent move's step: the first-order change of t_k, as a fraction of its width
+        let mut tangent_step = 0.05f64;
         let mut frozen = [false; 6];
         let mut base_jacobian = self.closure_jacobian(state, &best);
         let mut equality_rows = Vec::new();
         self.residuals_at(state, &best, &mut equality_rows);
         let equalities = equality_rows.len().min(base_jacobian.len());
+        let improves = |q: &Config, best: &Config| sign * (q[k] - best[k]) < -1e-12 * bounds.width(k).max(1e-12);
         let at_bound = |t: &Config| if upper { t[k] >= bounds.max[k] } else { t[k] <= bounds.min[k] };
-        while used < budget && step.iter().any(|s| *s >= min_step) && !at_bound(&best) {
+        while used < budget && (tangent_step >= min_step || step.iter().any(|s| *s >= min_step)) && !at_bound(&best) {
+            // a move along the tangent space towards better t_k, restored with t_k frozen (coordinated moves of
+            // several variables that no single-variable move finds)
+            if tangent_step >= min_step {
+                // d in scaled variables: t_k changes by d_k / scale(k) per unit; none left: stationary for the
+                // constraints, until a compass move leads elsewhere
+                let direction =
+                    tangent_direction(&base_jacobian, equalities, k, sign, &best, bounds).filter(|d| d[k] != 0.0);
+                match direction {
+                    Some(d) => {
+                        // no variable moves by more than `tangent_step` of its width (a trust region: the boundary
+                        // the move follows is curved), and the move stops at the box (clamping would leave the
+                        // tangent space)
+                        let mut alpha = f64::INFINITY;
+                        for j in (0..6).filter(|&j| d[j] != 0.0) {
+                            let rate = d[j] / scale(j, length);
+                            alpha = alpha.min(tangent_step * bounds.width(j) / rate.abs());
+                            let room = if rate > 0.0 { bounds.max[j] - best[j] } else { bounds.min[j] - best[j] };
+                            alpha = alpha.min(room / rate);
+                        }
+                        let mut trial = best;
+                        for j in 0..6 {
+                            trial[j] += alpha * d[j] / scale(j, length);
+                        }
+                        bounds.clamp(&mut trial);
+                        frozen[k] = true;
+                        let mut projected = self
+                            .project_closure_with(state, &trial, bounds, &frozen, Some(&base_jacobian))
+                            .or_else(|| self.holds_at(state, &trial, bounds).then_some(trial));
+                        frozen[k] = false;
+                        used += 1;
+                        // t_k beyond what the closure allows there (a curved boundary): the nearest point of the
+                        // closure, which trades part of the gain for the other variables (a gradient projection)
+                        if projected.is_none_or(|q| !improves(&q, &best)) && used < budget {
+                            projected = self.project_closure_with(state, &trial, bounds, &frozen, Some(&base_jacobian));
+                            used += 1;
+                        }
+                        if let Some(q) = projected
+                            && improves(&q, &best)
+                            && self.in_closure(state, &q, bounds)
+                        {
+                            best = q;
+                            base_jacobian = self.closure_jacobian(state, &best);
+                            tangent_step = (tangent_step * 2.0).min(0.5);
+                            continue;
+                        }
+                        tangent_step *= 0.5;
+                    }
+                    None => tangent_step = 0.0,
+                }
+            }
             let mut improved = false;
             // the objective's own variable first, then the others
             let order = std::iter::once(k).chain((0..6).filter(|&j| j != k));
@@ -826,25 +1050,65 @@ impl<'a> Manifolds<'a> {
                         continue;
                     }
                     frozen[j] = true;
-                    let projected = self.project_closure_with(state, &trial, bounds, &frozen, Some(&base_jacobian));
+                    // (a start within the strict tolerance of an ill-conditioned system may not project to 1e-11 L,
+                    // while the move itself stays in the closure: a translation along a face)
+                    let projected = self
+                        .project_closure_with(state, &trial, bounds, &frozen, Some(&base_jacobian))
+                        .or_else(|| self.holds_at(state, &trial, bounds).then_some(trial));
                     frozen[j] = false;
                     used += 1;
                     let Some(q) = projected else { continue };
-                    if sign * (q[k] - best[k]) < -1e-12 * bounds.width(k).max(1e-12)
-                        && self.in_closure(state, &q, bounds)
-                    {
+                    if improves(&q, &best) && self.in_closure(state, &q, bounds) {
                         best = q;
                         base_jacobian = self.closure_jacobian(state, &best);
                         // (the pinned set is recomputed from it at the next sweep)
                         step[j] = (step[j] * 2.0).min(0.5);
+                        // from the new point the tangent space may lead on
+                        tangent_step = tangent_step.max(step[j]);
                         improved = true;
                         break;
                     }
                 }
             }
+            // stalled: moves of t_k together with one other variable, both frozen while the others restore the
+            // closure (a tilt limited by an edge that a lift clears); coarse steps only (they escape a corner, the
+            // fine steps above converge)
+            if !improved && step[k] >= PAIR_MIN_STEP && bounds.width(k) > 0.0 {
+                'pairs: for j in (0..6).filter(|&j| j != k && bounds.width(j) > 0.0) {
+                    for dir in [-1.0, 1.0] {
+                        if used >= budget {
+                            break 'pairs;
+                        }
+                        let mut trial = best;
+                        trial[k] = (trial[k] - sign * step[k] * bounds.width(k)).clamp(bounds.min[k], bounds.max[k]);
+                        trial[j] = (trial[j] + dir * step[k] * bounds.width(j)).clamp(bounds.min[j], bounds.max[j]);
+                        if trial[j] == best[j] {
+                            continue;
+                        }
+                        frozen[k] = true;
+                        frozen[j] = true;
+                        let projected = self
+                            .project_closure_with(state, &trial, bounds, &frozen, Some(&base_jacobian))
+                            .or_else(|| self.holds_at(state, &trial, bounds).then_some(trial));
+                        frozen[k] = false;
+                        frozen[j] = false;
+                        used += 1;
+                        if let Some(q) = projected
+                            && improves(&q, &best)
+                            && self.in_closure(state, &q, bounds)
+                        {
+                            best = q;
+                            base_jacobian = self.closure_jacobian(state, &best);
+                            tangent_step = tangent_step.max(step[k]);
+                            improved = true;
+                            break 'pairs;
+                        }
+                    }
+                }
+            }
             if !improved {
                 for s in &mut step {
-                    *s *= 0.5;
+                    *s *= STALL_SHRINK;
                 }
             }
         }
@@ -893,6 +1157,112 @@ mod tests {
         // and the interior search finds a strict witness from there
         let w = m.interior_witness(&state, &[flat], &bounds, 3, 20).expect("witness");
         assert!(m.verify(&state, &w, &bounds).is_ok());
+    }
+
+    #[test]
+    fn faces_side_by_side_are_no_face_face_contact() {
+        // two aligned unit cubes, B on top of A: the top and bottom faces lie flat on each other, and the side faces
+        // of the two cubes are coplanar with equal normals, touching only along their common edge line; the points
+        // on that line used to merge them into f-f PCs such as f1-f0, whose criterion (opposite normals) fails
+        let a = box_part("a", DVec3::ZERO, DVec3::ONE);
+        let b = box_part("b", DVec3::ZERO, DVec3::ONE);
+        let t = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0];
+        let e = 1e-9;
+        let bounds = ConfigBox::new([-e, -e, 1.0, -e, -e, -e], [e, e, 1.0, e, e, e]).expect("box");
+        let m = Manifolds::new(&a, &b, all_ppcs(&a.surface, &b.surface), StrictTolerances::default());
+        let state = m.state_at(&t);
+        let pose = Pose::from_config(&t);
+        for pc in &state.pcs {
+            let value = pc_criterion(pc, &a, &b, &pose, &m.weights);
+            assert!(value <= m.hold(), "{} in {} has criterion {value}", pc.label(), state.label());
+        }
+        let ff: Vec<&PrincipalContact> = state.pcs.iter().filter(|pc| pc.kind() == PcType::FaceFace).collect();
+        assert_eq!(ff.len(), 1, "{}", state.label());
+        let (na, nb) = (a.surface.faces[ff[0].a.index].plane.normal, b.surface.faces[ff[0].b.index].plane.normal);
+        assert!((na - DVec3::Z).length() < 1e-12 && (nb + DVec3::Z).length() < 1e-12, "{}", state.label());
+        // the strict check of a single PPC names that state, the one it finds there
+        let single = ContactState::single(*ff[0]);
+        match m.verify(&single, &t, &bounds) {
+            Err(Rejection::OtherState { holding }) => assert_eq!(holding, state.label()),
+            other => panic!("{other:?}"),
+        }
+        // and the hypotheses' mapping does not merge faces that cannot face each other within the box
+        let (sa, sb) = (&a.surface, &b.surface);
+        let holding = m.holding(&t).0;
+        let can_face = crate::acsg::can_face(sa, sb, &bounds);
+        let merged = ContactState::canonical_with(holding, sa, sb, |m| {
+            m.kind() != PcType::FaceFace || can_face(m.a.index, m.b.index)
+        });
+        assert!(merged.pcs.iter().all(|m| m.kind() != PcType::FaceFace || m == ff[0]), "{}", merged.label());
+    }
+
+    #[test]
+    fn eigen_decomposition_and_null_space() {
+        // a symmetric matrix with a known spectrum: Q diag(0, 0, 1, 2, 3, 4) Q^T for a rotation Q in the (0, 1), (2,
+        // 5) and (3, 4) planes
+        let (c, s) = (0.6, 0.8);
+        let mut q = [[0.0; 6]; 6];
+        for (i, row) in q.iter_mut().enumerate() {
+            row[i] = 1.0;
+        }
+        for (p, r) in [(0, 1), (2, 5), (3, 4)] {
+            q[p][p] = c;
+            q[r][r] = c;
+            q[p][r] = -s;
+            q[r][p] = s;
+        }
+        let diag = [0.0, 0.0, 1.0, 2.0, 3.0, 4.0];
+        let a: [[f64; 6]; 6] =
+            std::array::from_fn(|i| std::array::from_fn(|j| (0..6).map(|m| q[i][m] * diag[m] * q[j][m]).sum()));
+        let (values, vectors) = symmetric_eigen6(a);
+        let mut sorted = values;
+        sorted.sort_by(f64::total_cmp);
+        for (x, y) in sorted.iter().zip(diag) {
+            assert!((x - y).abs() < 1e-12, "{values:?}");
+        }
+        for i in 0..6 {
+            // A v = lambda v
+            for p in 0..6 {
+                let av: f64 = (0..6).map(|m| a[p][m] * vectors[m][i]).sum();
+                assert!((av - values[i] * vectors[p][i]).abs() < 1e-12);
+            }
+        }
+        // the null space of two rows and one fixed variable: what is left of the goal is orthogonal to all three
+        let rows = [[1.0, 1.0, 0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 2.0, 0.0, 0.0, 0.0]];
+        let mut fixed = [false; 6];
+        fixed[5] = true;
+        let d = null_space_projection(&[1.0, 0.0, 1.0, 1.0, 0.0, 1.0], &rows, &fixed);
+        let expected = [0.5, -0.5, 0.0, 1.0, 0.0, 0.0];
+        assert!(d.iter().zip(expected).all(|(x, y)| (x - y).abs() < 1e-12), "{d:?}");
+    }
+
+    /// The cube's face on a 2 x 2 plate, `|rz| <= pi/4`: the farthest x is `1 + sqrt(2)/2`, a corner first at
+    /// `rz = +-pi/4`, where the corner's bounding condition and the rz bound meet. Moves of one variable (restored by
+    /// projection) approach it slowly; a move along the tangent space of the active constraints follows the plate's
+    /// edge with x and rz together.
+    #[test]
+    fn the_extremal_search_follows_the_active_constraints() {
+        let plate = box_part("plate", DVec3::new(-1.0, -1.0, -1.0), DVec3::new(1.0, 1.0, 0.0));
+        let cube = box_part("cube", DVec3::splat(-0.5), DVec3::splat(0.5));
+        let q = std::f64::consts::FRAC_PI_4;
+        let bounds = ConfigBox::new([-3.0, -3.0, 0.45, -0.02, -0.02, -q], [3.0, 3.0, 0.7, 0.02, 0.02, q]).expect("box");
+        let face = |s: &crate::surface::SurfaceElements, n: DVec3| {
+            s.faces.iter().position(|f| (f.plane.normal - n).length() < 1e-12).expect("face")
+        };
+        let pc = PrincipalContact::new(
+            Element::face(face(&plate.surface, DVec3::Z)),
+            Element::face(face(&cube.surface, -DVec3::Z)),
+        );
+        let state = ContactState::single(pc.expect("f-f"));
+        let m = Manifolds::new(&plate, &cube, all_ppcs(&plate.surface, &cube.surface), StrictTolerances::default());
+        let witness = [0.1, -0.2, 0.5, 0.0, 0.0, 0.1];
+        assert!(m.verify(&state, &witness, &bounds).is_ok());
+        let reach = 1.0 + 0.5 * 2f64.sqrt();
+        for (k, upper, target) in [(0, true, reach), (0, false, -reach), (1, true, reach)] {
+            let (t, used) = m.extremal(&state, witness, k, upper, &bounds, 100);
+            assert!((t[k] - target).abs() < 1e-6, "variable {k} upper {upper}: {t:?} after {used} projections");
+            assert!(m.in_closure(&state, &t, &bounds));
+        }
     }
 
     #[test]

@@ -18,6 +18,13 @@
 //!   between them crosses that face's interior, and with non-penetration the face must lie flat (a cube touching a
 //!   plane with two diagonal corners lies on its face).
 //!
+//! The rules assume contact points in general position. At a known configuration a merge is made only when the merged
+//! PC holds there ([`ContactState::canonical_with`] with its criterion): collinear points force coplanar faces with
+//! *equal* normals together (the side faces of two aligned stacked cubes, touching only along a common edge line), and
+//! an e-e contact at an edge's end is the same point as that end's vertex contact; neither makes an f-f or f-e PC.
+//! Without a configuration (the hypotheses of the ACSG) f-f merges are made only for faces that can face each other
+//! within the box ([`crate::acsg::can_face`]).
+//!
 //! Then PCs whose elements both lie within another PC's elements are dropped (they are not principal).
 //!
 //! **Neighbours** (\[P\] IV-A): `pa` is a close less constrained neighbour (CLCN) PC of `pb` when one element is the
@@ -167,15 +174,34 @@ impl ContactState {
         Self { pcs: vec![pc] }
     }
 
-    /// The highest-level description of a combination of PCs (see the module docs).
-    pub fn canonical(mut pcs: Vec<PrincipalContact>, sa: &SurfaceElements, sb: &SurfaceElements) -> Self {
+    /// The highest-level description of a combination of PCs (see the module docs), merging wherever the contact
+    /// points force it (no configuration known). At a known configuration use [`Self::canonical_with`].
+    pub fn canonical(pcs: Vec<PrincipalContact>, sa: &SurfaceElements, sb: &SurfaceElements) -> Self {
+        Self::canonical_with(pcs, sa, sb, |_| true)
+    }
+
+    /// [`Self::canonical`], making a merged PC only when `accept` says it can hold (at a configuration: its
+    /// criterion vanishes). The rules assume contact points in general position; at a degenerate configuration they
+    /// can name a PC that does not hold: two aligned stacked cubes touch along the common edge lines of their side
+    /// faces, whose points force those coplanar faces together, but the faces' normals are equal, not opposite (no
+    /// f-f contact); an e-e contact at the end of an edge is the same point as that end's vertex contact, not a
+    /// second point of the edge (no f-e / e-f contact).
+    pub fn canonical_with<F>(
+        mut pcs: Vec<PrincipalContact>,
+        sa: &SurfaceElements,
+        sb: &SurfaceElements,
+        accept: F,
+    ) -> Self
+    where
+        F: Fn(&PrincipalContact) -> bool,
+    {
         pcs.sort();
         pcs.dedup();
         loop {
             let mut merged = None;
             'search: for i in 0..pcs.len() {
                 for j in i + 1..pcs.len() {
-                    if let Some(m) = merge(&pcs[i], &pcs[j], sa, sb) {
+                    if let Some(m) = merge(&pcs[i], &pcs[j], sa, sb).filter(|m| accept(m)) {
                         merged = Some((i, j, m));
                         break 'search;
                     }

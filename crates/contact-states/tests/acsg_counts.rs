@@ -151,9 +151,10 @@ fn face_on_face_extremal_translations_are_exact() {
     let r = ff.range.expect("range");
     let reach = 1.0 + 0.5 * 2f64.sqrt();
     for k in 0..2 {
-        // within 2e-4 mm (3e-5 of the box width): the compass search approaches this optimum, which sits on the
-        // rz bound at the corner of a curved boundary, slowly
-        assert!((r.max[k] - reach).abs() < 2e-4 && (r.min[k] + reach).abs() < 2e-4, "{r:?} vs {reach}");
+        // within 1e-6 mm: the optimum sits on the rz bound at the corner of a curved boundary, which moves of one
+        // variable approached slowly (2e-4 mm after 400 projections); moves along the tangent space of the active
+        // constraints (x and rz together) reach it
+        assert!((r.max[k] - reach).abs() < 1e-6 && (r.min[k] + reach).abs() < 1e-6, "{r:?} vs {reach}");
     }
     assert!((r.min[2] - 0.5).abs() < 1e-9 && (r.max[2] - 0.5).abs() < 1e-9, "{r:?}");
 }

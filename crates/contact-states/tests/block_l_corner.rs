@@ -91,6 +91,22 @@ fn block_into_l_corner() {
         for e in &s.extremals {
             assert!(e.converged && e.objective <= 2.0 * g.hold * s.state.pcs.len() as f64, "{} {e:?}", s.label);
         }
+        // each extremal is at least as extreme as every configuration of the state the program knows (its witness
+        // and the other extremals: the audit found z max 0.130 of {f6-e10} where its rz maximum had z = 13.85), and
+        // the range is the lowest and highest value of each variable over the extremal configurations
+        let known: Vec<&[f64; 6]> = std::iter::once(&w).chain(s.extremals.iter().map(|e| &e.t)).collect();
+        for e in &s.extremals {
+            let k = e.variable;
+            let beaten = known.iter().find(|t| if e.upper { t[k] > e.value } else { t[k] < e.value });
+            assert!(beaten.is_none(), "{} {} {}: {} beaten by {beaten:?}", s.label, e.name, e.upper, e.value);
+            assert_eq!(e.value, e.t[k]);
+        }
+        let range = s.range.expect("range");
+        for k in 0..6 {
+            let lo = s.extremals.iter().map(|e| e.t[k]).fold(f64::INFINITY, f64::min);
+            let hi = s.extremals.iter().map(|e| e.t[k]).fold(f64::NEG_INFINITY, f64::max);
+            assert!(range.min[k] == lo && range.max[k] == hi, "{}: {range:?} variable {k}: {lo} {hi}", s.label);
+        }
     }
     assert!(failures.is_empty(), "{} of {total} states fail the independent check: {failures:?}", failures.len());
     let in_graph: HashSet<&ContactState> = feasible.iter().copied().collect();

@@ -33,10 +33,10 @@ pub struct Args {
     /// GA seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// GA population (4 to 100000).
+    /// GA population (4 to 100000; population x (generations + 1) at most 10 million).
     #[arg(long, default_value_t = GaSettings::default().population)]
     pub population: usize,
-    /// GA generations (at most 100000).
+    /// GA generations (at most 100000; population x (generations + 1) at most 10 million).
     #[arg(long, default_value_t = GaSettings::default().generations)]
     pub generations: usize,
     /// Split concave sheet-metal faces by plain triangulation.
@@ -110,7 +110,9 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         },
         ..AcsgSettings::default()
     };
-    let graph = generate(&fixed, &moving, bounds, settings)?;
+    // the GA's effort per search and per graph is bounded; a request beyond it names these options
+    settings.ga.check().context("--population / --generations")?;
+    let graph = generate(&fixed, &moving, bounds, settings).context("--population / --generations")?;
     if let Some(path) = &args.dot {
         output::write_atomic(path, graph.to_dot().as_bytes())?;
     }
