@@ -217,8 +217,9 @@ pub fn lowest_release(
     let mut intervals: Vec<(f64, f64)> = Vec::new();
     for (fi, sc) in scene.components.iter().enumerate() {
         let (slo, shi) = sc.placed.aabb;
-        // a stack component the sweep cannot come near, or (with insertion: nothing above the release matters more
-        // than what the search saw) wholly below the part at rest
+        // a stack component the segment's part never comes near horizontally, or wholly below the part at rest, holds
+        // no height of the segment; without insertion neither does one wholly above the part at the search's release
+        // (with insertion it does: the path down to a release passes it)
         if slo.x > hi.x || shi.x < lo.x || slo.y > hi.y || shi.y < lo.y || shi.z < lo.z - tol {
             continue;
         }
