@@ -29,9 +29,7 @@ pub mod triangulate;
 pub mod vertex_cycle;
 
 pub use glam::{DMat3, DVec2, DVec3};
-pub use hull::{
-    ConvexHull, HullError, MAX_HULL_COORDINATE, MIN_COORDINATE, ROUNDING_CREASE, convex_hull, convex_hull_merged,
-};
+pub use hull::{ConvexHull, HullError, MAX_HULL_COORDINATE, MIN_COORDINATE, convex_hull, convex_hull_merged};
 pub use io::{IoError, ReadOptions, read_part, write_part};
 pub use mass::MassProperties;
 pub use part::{BoundaryFace, Part, PartError, PartOrigin};

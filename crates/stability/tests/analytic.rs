@@ -41,6 +41,44 @@ fn box_on_floor_is_stable_with_margin_half_the_smaller_side() {
     assert!((margin - 0.5).abs() < 1e-5, "{margin}");
 }
 
+/// The same box written turned by a general rotation, as a part file exported in another orientation: its faces are
+/// planar only to rounding (the exact hull splits them, and the c.g. projects onto a crease), yet it has the same six
+/// resting poses with the same margins. Before the poses were taken from the hull with its creases merged, the turned
+/// box had none, and the built-in Triangle's bottom face a margin of 56.4 mm instead of 65.0.
+#[test]
+fn a_box_turned_in_its_file_rests_on_its_six_faces() {
+    let turn = DMat3::from_euler(glam::EulerRot::ZYX, 0.17, 0.35, 0.52);
+    let corners: Vec<DVec3> = (0..8)
+        .map(|i| {
+            let c = |bit: usize, e: f64| if i & bit == 0 { 0.0 } else { e };
+            turn * DVec3::new(c(1, 4.0), c(2, 6.0), c(4, 2.0)) + DVec3::new(100.0, -30.0, 7.0)
+        })
+        .collect();
+    let text = format!(
+        r#"{{"name": "turned", "convex_pieces": [[{}]]}}"#,
+        corners.iter().map(|v| format!("[{:?}, {:?}, {:?}]", v.x, v.y, v.z)).collect::<Vec<_>>().join(", ")
+    );
+    let part =
+        stackplan_geom::io::parse_part_json(text.as_bytes(), std::path::Path::new("turned.json"), &Default::default())
+            .expect("a turned box");
+    let poses = resting_poses(&part).expect("poses");
+    let mut margins: Vec<f64> = poses.iter().map(|p| p.margin).collect();
+    margins.sort_by(f64::total_cmp);
+    let expected = [1.0, 1.0, 1.0, 1.0, 2.0, 2.0]; // 4 x 2 and 6 x 2 sides: 1; the 4 x 6 sides: 2
+    assert_eq!(margins.len(), 6, "{margins:?}");
+    for (m, e) in margins.iter().zip(expected) {
+        assert!((m - e).abs() < 1e-9, "margins {margins:?}");
+    }
+    // the built-in Triangle: its bottom face holds the c.g. 65 mm inside (the seed's Fig. 14(b) part lying flat)
+    let triangle = stackplan_geom::examples::part_by_name("triangle", Default::default()).expect("triangle");
+    let poses = resting_poses(&triangle).expect("poses");
+    assert!(
+        poses.iter().any(|p| (p.margin - 65.0).abs() < 1e-6),
+        "{:?}",
+        poses.iter().map(|p| p.margin).collect::<Vec<_>>()
+    );
+}
+
 #[test]
 fn tall_box_margin_is_limited_by_tipping() {
     // base 2 x 4, c.g. height 5: tipping at alpha = min(1, 2) / 5 = 0.2 < mu

@@ -3,8 +3,8 @@
 //! * `{"name", "sheet_metal": {"thickness", "faces": [{"outline": [[x,y,z],...], "holes": [[[x,y,z],...],...]}]},
 //!   "density"?}` — the sheet-metal model of \[A\] V-A-1, built by [`SheetMetal::build_part`];
 //! * `{"name", "convex_pieces": [[[x,y,z],...],...], "density"?}` — each piece is the exact convex hull of its
-//!   points with its rounding creases merged ([`convex_hull_merged`]: facets meeting at less than 1e-9 rad are one
-//!   face); a flat, collinear or coincident piece is an error naming its index.
+//!   points with its rounding creases merged ([`convex_hull_merged`]: facets lying in one plane within the length
+//!   tolerance are one face); a flat, collinear or coincident piece is an error naming its index.
 //!
 //! Unknown keys are rejected (`deny_unknown_fields`) so typos do not pass silently; serde_json rejects `NaN` and
 //! `Infinity` literals and numbers that overflow `f64` (`1e400`); every coordinate is further checked against
@@ -13,8 +13,8 @@
 //! The writer emits the convex-pieces form with every component's vertices. Floats are printed with the shortest
 //! representation that parses back to the same `f64` (serde_json uses ryu), so a part reads back as its exact form:
 //! the hull of each component's vertices, which has the component's vertices and faces (as sets; the order is the
-//! hull's), a face that is planar only to rounding (a rotated sheet-metal face) included: its facets meet at a crease
-//! far below 1e-9 rad and are merged again. Its origin becomes `ConvexPieces`.
+//! hull's), a face that is planar only to rounding (a rotated sheet-metal face) included: its facets lie in one plane
+//! within the length tolerance and are merged again. Its origin becomes `ConvexPieces`.
 
 use super::{IoError, Place, ReadOptions, check_coordinate, resolve_density, stem_name};
 use crate::hull::convex_hull_merged;
