@@ -103,3 +103,47 @@ fn an_export_that_fails_for_one_format_writes_none() {
     assert!(!dir.path().join("c.glb").exists(), "the GLB is not written when the OBJ cannot be");
     assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 0, "no temporary file left behind");
 }
+
+/// A turned box as an OBJ whose coordinates were rounded to `f32` but are written with all the digits of the `f64`
+/// values (as a program computing in `f32` prints them): its quadrilateral faces are planar only to about 1e-5 mm,
+/// beyond the default tolerance for coordinates taken as written. `part info` rejects it with a message that names
+/// `--mesh-tolerance`, reads it as a box of six faces with `--mesh-tolerance 0.001`, and a bad tolerance is a clear
+/// error (exit 2) before any file is read.
+#[test]
+fn mesh_tolerance_reads_a_mesh_planar_only_to_single_precision() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (a, b, c) = (0.3f64, 0.7f64, 1.1f64);
+    let rz = [[a.cos(), -a.sin(), 0.0], [a.sin(), a.cos(), 0.0], [0.0, 0.0, 1.0]];
+    let ry = [[b.cos(), 0.0, b.sin()], [0.0, 1.0, 0.0], [-b.sin(), 0.0, b.cos()]];
+    let rx = [[1.0, 0.0, 0.0], [0.0, c.cos(), -c.sin()], [0.0, c.sin(), c.cos()]];
+    let apply = |m: [[f64; 3]; 3], v: [f64; 3]| -> [f64; 3] {
+        [0, 1, 2].map(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
+    };
+    let mut text = String::from("o box\n");
+    for i in 0..8usize {
+        let bit = |k: usize, e: f64| if i & k == 0 { 0.0 } else { e };
+        let p = apply(rz, apply(ry, apply(rx, [bit(1, 40.0), bit(2, 25.0), bit(4, 3.0)])));
+        let p = p.map(|x| (x + 100.0) as f32 as f64);
+        text.push_str(&format!("v {:?} {:?} {:?}\n", p[0], p[1], p[2]));
+    }
+    for q in [[1, 3, 4, 2], [5, 6, 8, 7], [1, 2, 6, 5], [3, 7, 8, 4], [1, 5, 7, 3], [2, 4, 8, 6]] {
+        text.push_str(&format!("f {} {} {} {}\n", q[0], q[1], q[2], q[3]));
+    }
+    let path = dir.path().join("turned.obj");
+    std::fs::write(&path, &text).expect("write");
+    let file = path.to_str().expect("utf-8 path");
+    let o = run(&["part", "info", file]);
+    assert_eq!(o.status.code(), Some(2), "{}", stdout(&o));
+    assert!(stderr(&o).contains("turned.obj") && stderr(&o).contains("mesh tolerance"), "{}", stderr(&o));
+    let o = run(&["part", "info", file, "--json", "--mesh-tolerance", "0.001"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let info: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("json");
+    let pieces = info["pieces"].as_array().expect("pieces");
+    assert_eq!(pieces.len(), 1);
+    assert_eq!(pieces[0]["faces"].as_array().map(Vec::len), Some(6), "{info}");
+    for bad in ["0", "-1", "NaN", "inf"] {
+        let o = run(&["part", "info", file, &format!("--mesh-tolerance={bad}")]);
+        assert_eq!(o.status.code(), Some(2), "{bad}");
+        assert!(stderr(&o).contains("--mesh-tolerance must be a positive"), "{bad}: {}", stderr(&o));
+    }
+}

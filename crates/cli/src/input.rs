@@ -31,14 +31,43 @@ pub fn load_part(args: &PartArgs) -> anyhow::Result<Part> {
     load_part_spec(&args.part, args.decomposition(), args.decompose)
 }
 
-/// Reads a part from a path or `example:NAME`.
+/// `--mesh-tolerance` as bits of an `f64` (NaN bits: not given), set once by `main`.
+static MESH_TOLERANCE: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(u64::MAX);
+
+/// Sets `--mesh-tolerance` for every part read after it (once, from `main`).
+pub fn set_mesh_tolerance(tolerance: Option<f64>) {
+    MESH_TOLERANCE.store(tolerance.map_or(u64::MAX, f64::to_bits), std::sync::atomic::Ordering::Relaxed);
+}
+
+/// `--mesh-tolerance`, if given.
+pub fn mesh_tolerance() -> Option<f64> {
+    let bits = MESH_TOLERANCE.load(std::sync::atomic::Ordering::Relaxed);
+    (bits != u64::MAX).then(|| f64::from_bits(bits))
+}
+
+/// Checks `--mesh-tolerance`: positive and finite, if given.
+pub fn check_mesh_tolerance() -> anyhow::Result<()> {
+    match mesh_tolerance() {
+        Some(t) if !(t > 0.0 && t.is_finite()) => {
+            anyhow::bail!("--mesh-tolerance must be a positive, finite length (mm), got {}", short_number(t))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Reads a part from a path or `example:NAME` (with `--mesh-tolerance`, if given).
 pub fn load_part_spec(spec: &str, decomposition: Decomposition, decompose_mesh: bool) -> anyhow::Result<Part> {
     if let Some(name) = spec.strip_prefix("example:") {
         return stackplan_geom::examples::part_by_name(name, decomposition).with_context(|| {
             format!("no built-in example named {name:?} (try channel, triangle, complex, cube, l-corner, block)")
         });
     }
-    let options = stackplan_geom::io::ReadOptions { decomposition, decompose_mesh, ..Default::default() };
+    let options = stackplan_geom::io::ReadOptions {
+        decomposition,
+        decompose_mesh,
+        mesh_tolerance: mesh_tolerance(),
+        ..Default::default()
+    };
     Ok(stackplan_geom::io::read_part(std::path::Path::new(spec), &options)?)
 }
 

@@ -36,6 +36,11 @@ pub struct Cli {
     /// Worker threads (default: all cores). Results do not depend on it.
     #[arg(long, global = true)]
     pub threads: Option<usize>,
+    /// For STL and OBJ parts: a length within which a mesh polygon counts as lying in a face plane of the part's
+    /// convex pieces, for meshes written with fewer digits than a turned part's faces need (default: 1e-9 of the
+    /// part's size, and for single-precision coordinates 16 roundings to f32 of the largest; see docs/formats.md).
+    #[arg(long, global = true, value_name = "MM")]
+    pub mesh_tolerance: Option<f64>,
     /// The command.
     #[command(subcommand)]
     pub command: Command,
@@ -98,12 +103,13 @@ pub fn main() -> ExitCode {
     };
     init_logging(cli.verbose, cli.quiet);
     output::set_quiet(cli.quiet);
+    input::set_mesh_tolerance(cli.mesh_tolerance);
     if let Some(n) = cli.threads
         && let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build_global()
     {
         tracing::warn!("could not set the thread count: {e}");
     }
-    let result = match &cli.command {
+    let result = input::check_mesh_tolerance().and_then(|()| match &cli.command {
         Command::Part(c) => cmd::part::run(c),
         Command::Plan(a) => cmd::plan::run(a),
         Command::Render(a) => cmd::render::run(a),
@@ -115,7 +121,7 @@ pub fn main() -> ExitCode {
         Command::Interference(a) => cmd::interference::run(a),
         Command::Check(a) => cmd::check::run(a),
         Command::Contacts(a) => cmd::contacts::run(a),
-    };
+    });
     match result {
         Ok(Outcome::Success) => ExitCode::SUCCESS,
         Ok(Outcome::ChecksFailed) => ExitCode::from(1),

@@ -179,7 +179,15 @@ pub fn convex_hull(points: &[DVec3]) -> Result<ConvexHull, HullError> {
 /// part's piece as the readers build it (see the module documentation, "Creases"). When the merged faces do not close
 /// up into a polytope (a merge left a face with fewer than three corners), the exact hull.
 pub fn convex_hull_merged(points: &[DVec3]) -> Result<ConvexHull, HullError> {
-    let tol = crate::tolerance::Tolerance::for_scale(crate::tolerance::bounding_diagonal(points)).linear;
+    convex_hull_merged_within(points, 0.0)
+}
+
+/// [`convex_hull_merged`] with a length tolerance of at least `tolerance` (never below the kernel's, `1e-9 x` the
+/// points' extent; a tolerance that is not finite counts as 0): for points known only to a coarser precision, such as
+/// the single-precision coordinates of an STL file, whose faces are planar only to that precision.
+pub fn convex_hull_merged_within(points: &[DVec3], tolerance: f64) -> Result<ConvexHull, HullError> {
+    let kernel = crate::tolerance::Tolerance::for_scale(crate::tolerance::bounding_diagonal(points)).linear;
+    let tol = if tolerance.is_finite() { tolerance.max(kernel) } else { kernel };
     match hull_with(points, Some(tol)) {
         Ok(hull) => Ok(hull),
         // the exact hull of the same points (its errors are the input's, reported as such)
@@ -706,6 +714,17 @@ fn merge(p: &[DVec3], tris: &[Tri], merge_tolerance: Option<f64>) -> Result<Conv
         let len = n.length();
         if !(len > 0.0 && len.is_finite()) {
             return Err(HullError::Internal(PolytopeError::DegenerateFace { face: faces.len() }));
+        }
+        if creased[g] {
+            // a face planar only to the tolerance: its cycle starts at its lexicographically smallest corner, so that
+            // the fans of its triangles (its mass properties, its mesh triangles) depend on the face, not on the order
+            // of the input points
+            let first = (0..cycle.len())
+                .min_by(|&x, &y| {
+                    vertices[cycle[x]].to_array().partial_cmp(&vertices[cycle[y]].to_array()).unwrap_or(Ordering::Equal)
+                })
+                .unwrap_or(0);
+            cycle.rotate_left(first);
         }
         let normal = n / len;
         let offset = cycle.iter().map(|&i| normal.dot(vertices[i])).fold(f64::NEG_INFINITY, f64::max);

@@ -29,7 +29,10 @@ pub mod triangulate;
 pub mod vertex_cycle;
 
 pub use glam::{DMat3, DVec2, DVec3};
-pub use hull::{ConvexHull, HullError, MAX_HULL_COORDINATE, MIN_COORDINATE, convex_hull, convex_hull_merged};
+pub use hull::{
+    ConvexHull, HullError, MAX_HULL_COORDINATE, MIN_COORDINATE, convex_hull, convex_hull_merged,
+    convex_hull_merged_within,
+};
 pub use io::{IoError, ReadOptions, read_part, write_part};
 pub use mass::MassProperties;
 pub use part::{BoundaryFace, Part, PartError, PartOrigin};

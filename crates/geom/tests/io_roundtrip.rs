@@ -4,7 +4,9 @@ use proptest::prelude::*;
 use stackplan_geom::io::glb::{GlbItem, glb_bytes};
 use stackplan_geom::io::stack::{StackPart, read_stack, write_stack, write_stack_with_extras};
 use stackplan_geom::io::{self, IoError, ReadOptions, atomic};
-use stackplan_geom::{ConvexPolytope, DMat3, DVec3, Part, PartOrigin, Pose, convex_hull, convex_hull_merged};
+use stackplan_geom::{
+    ConvexPolytope, DMat3, DVec3, Part, PartOrigin, Pose, convex_hull, convex_hull_merged, convex_hull_merged_within,
+};
 use std::path::Path;
 
 const BRACKET: &str = r#"{
@@ -116,7 +118,9 @@ fn every_example_reads_back_from_every_format() {
             .iter()
             .map(|c| {
                 let rounded: Vec<DVec3> = c.vertices().iter().map(|v| v.as_vec3().as_dvec3()).collect();
-                convex_hull_merged(&rounded).expect("hull").polytope
+                // the binary STL reader's tolerance: 16 roundings to f32 of the largest coordinate
+                let largest = part.all_vertices().map(|v| v.abs().max_element()).fold(0.0, f64::max);
+                convex_hull_merged_within(&rounded, 8.0 * f64::from(f32::EPSILON) * largest).expect("hull").polytope
             })
             .collect();
         Part::from_components(part.name.clone(), components, part.density, PartOrigin::ConvexPieces).expect("part")
@@ -169,6 +173,215 @@ fn stl_round_trips_separate_touching_components() {
         assert_eq!(back.components.len(), part.components.len(), "ascii = {ascii}");
         same_components(&part, &back); // coordinates are dyadic, so even f32 is exact
     }
+}
+
+/// A part as a file exported in another orientation would hold it: every component's vertices turned by a general
+/// rotation (rounded), each piece the hull of its points with its rounding creases merged.
+fn turned(part: &Part, rotation: DMat3) -> Part {
+    let offset = DVec3::new(123.25, -45.5, 7.0);
+    let components = part
+        .components
+        .iter()
+        .map(|c| {
+            let points: Vec<DVec3> = c.vertices().iter().map(|&v| rotation * v + offset).collect();
+            convex_hull_merged(&points).expect("hull").polytope
+        })
+        .collect();
+    Part::from_components(part.name.clone(), components, part.density, PartOrigin::ConvexPieces).expect("part")
+}
+
+/// Components touching along a face that is planar only to rounding: each component's exact hull splits the face
+/// along another diagonal (the fold seen from the other side), so the STL holds the shared face twice, triangulated
+/// differently. The shell splitter must still separate the components (the other component's triangle is on the
+/// same half-plane within the length tolerance), and each shell passes the convexity check. Before session 33, 48 of
+/// 114 turned parts of an audit failed to read back from STL ("the polygon at byte 84 does not lie in a face plane of
+/// the shell's convex hull": two touching components linked into one shell), the built-in Triangle, Complex and
+/// L-corner among them.
+#[test]
+fn turned_parts_with_touching_components_round_trip_through_stl() {
+    let cube = |o: DVec3| {
+        let pts: Vec<DVec3> =
+            (0..8).map(|i| o + DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64)).collect();
+        convex_hull(&pts).expect("cube").polytope
+    };
+    let two_cubes =
+        Part::from_components("two", vec![cube(DVec3::ZERO), cube(DVec3::X)], 1.0, PartOrigin::ConvexPieces)
+            .expect("part");
+    let mut parts = vec![two_cubes, bracket()];
+    for name in ["triangle", "complex", "l-corner", "channel"] {
+        parts.push(stackplan_geom::examples::part_by_name(name, Default::default()).expect("example"));
+    }
+    let opts = ReadOptions::default();
+    let mut split_shared_faces = 0;
+    for (k, part) in parts.iter().enumerate() {
+        for (i, angles) in [(0.3, 0.7, 1.1), (2.1, -0.4, 0.9), (-1.3, 0.25, 2.6)].into_iter().enumerate() {
+            let rotation = DMat3::from_euler(glam::EulerRot::ZYX, angles.0, angles.1, angles.2);
+            let turned = turned(part, rotation);
+            let (own, exact) = face_counts(&turned);
+            split_shared_faces += exact - own;
+            let text = io::stl_ascii_string(&turned);
+            let back = io::parse_stl(text.as_bytes(), Path::new("turned.stl"), &opts)
+                .unwrap_or_else(|e| panic!("{} turned {i}: {e}", part.name));
+            same_components(&turned, &back);
+            assert_eq!(back.components.len(), part.components.len(), "part {k}");
+        }
+    }
+    assert!(split_shared_faces > 0, "the test has teeth: some turned faces are split by their exact hulls");
+}
+
+/// The same turned parts through binary STL, whose coordinates are `f32`: each component comes back with its faces
+/// (the folds that rounding to `f32` puts into a turned face, about 1e-7 of the coordinates, are within the STL
+/// reader's single-precision tolerance and merged), its vertices rounded, and the touching components apart.
+#[test]
+fn turned_parts_read_back_from_binary_stl_with_their_faces() {
+    let opts = ReadOptions::default();
+    let mut parts = vec![bracket()];
+    for name in ["triangle", "complex", "l-corner", "channel", "cube"] {
+        parts.push(stackplan_geom::examples::part_by_name(name, Default::default()).expect("example"));
+    }
+    let mut split_by_rounding = 0;
+    for part in &parts {
+        for (i, angles) in
+            [(0.3, 0.7, 1.1), (2.1, -0.4, 0.9), (-1.3, 0.25, 2.6), (0.05, 3.0, -0.7)].into_iter().enumerate()
+        {
+            let turned = turned(part, DMat3::from_euler(glam::EulerRot::ZYX, angles.0, angles.1, angles.2));
+            let back = io::parse_stl(&io::stl_binary_bytes(&turned), Path::new("turned.stl"), &opts)
+                .unwrap_or_else(|e| panic!("{} turned {i}: {e}", part.name));
+            assert_eq!(back.components.len(), turned.components.len(), "{} turned {i}", part.name);
+            let mut expected: Vec<(usize, Vec<[u64; 3]>)> = turned
+                .components
+                .iter()
+                .map(|c| {
+                    let rounded: Vec<DVec3> = c.vertices().iter().map(|v| v.as_vec3().as_dvec3()).collect();
+                    split_by_rounding += convex_hull(&rounded).expect("hull").polytope.faces().len() - c.faces().len();
+                    let mut k: Vec<[u64; 3]> = rounded.iter().map(|v| v.to_array().map(f64::to_bits)).collect();
+                    k.sort_unstable();
+                    (c.faces().len(), k)
+                })
+                .collect();
+            let mut got: Vec<(usize, Vec<[u64; 3]>)> =
+                back.components.iter().map(|c| (c.faces().len(), key(c))).collect();
+            expected.sort();
+            got.sort();
+            assert_eq!(got, expected, "{} turned {i}: faces and rounded vertices per component", part.name);
+            let (v0, v1) = (turned.mass.volume, back.mass.volume);
+            assert!((v0 - v1).abs() <= 1e-5 * v0, "{} turned {i}: volume {v0} vs {v1}", part.name);
+        }
+    }
+    assert!(split_by_rounding > 0, "the test has teeth: rounding to f32 splits some faces of the exact hulls");
+}
+
+/// OBJ files of a turned part whose faces are planar only to single precision. Written with six decimals (as
+/// many exporters do: at most 9 significant digits) the reader takes the coordinates as single precision and reads
+/// the part with its faces. Rounded to `f32` but written with the shortest text of the `f64` values (up to 17 digits,
+/// as a program computing in `f32` may print them), the coordinates are taken as written: the folds of 1e-5 mm are
+/// beyond the kernel's tolerance (1e-9 of the extent) and the file is rejected, with a message that names the mesh
+/// tolerance, which reads it. A tolerance that is not positive and finite is an error naming it.
+#[test]
+fn obj_files_planar_only_to_single_precision_read_with_their_faces() {
+    let part = stackplan_geom::examples::part_by_name("complex", Default::default()).expect("complex");
+    let turned = turned(&part, DMat3::from_euler(glam::EulerRot::ZYX, 0.3, 0.7, 1.1));
+    let rewritten = |coordinate: &dyn Fn(f64) -> String| -> String {
+        io::obj_string(&turned)
+            .lines()
+            .map(|line| match line.strip_prefix("v ") {
+                Some(rest) => {
+                    let xs: Vec<String> =
+                        rest.split_whitespace().map(|w| coordinate(w.parse::<f64>().expect("number"))).collect();
+                    format!("v {}\n", xs.join(" "))
+                }
+                None => format!("{line}\n"),
+            })
+            .collect()
+    };
+    let faces = |p: &Part| {
+        let mut f: Vec<usize> = p.components.iter().map(|c| c.faces().len()).collect();
+        f.sort_unstable();
+        f
+    };
+    let six_decimals = rewritten(&|x| format!("{x:.6}"));
+    let back = io::parse_obj(six_decimals.as_bytes(), Path::new("six.obj"), &ReadOptions::default())
+        .expect("six decimals are single precision");
+    assert_eq!(faces(&back), faces(&turned));
+
+    let f32_as_f64 = rewritten(&|x| format!("{:?}", x as f32 as f64));
+    let err = io::parse_obj(f32_as_f64.as_bytes(), Path::new("f32.obj"), &ReadOptions::default())
+        .expect_err("folds of 1e-5 mm are beyond the kernel's tolerance");
+    assert!(matches!(err, IoError::NotConvex { .. }), "{err}");
+    assert!(err.to_string().contains("mesh tolerance"), "the message says what to do: {err}");
+    let options = ReadOptions { mesh_tolerance: Some(1e-3), ..Default::default() };
+    let back = io::parse_obj(f32_as_f64.as_bytes(), Path::new("f32.obj"), &options).expect("within 1e-3 mm");
+    assert_eq!(faces(&back), faces(&turned));
+    for bad in [f64::NAN, -1.0, 0.0, f64::INFINITY] {
+        let options = ReadOptions { mesh_tolerance: Some(bad), ..Default::default() };
+        let err = io::parse_obj(six_decimals.as_bytes(), Path::new("six.obj"), &options).expect_err("bad tolerance");
+        assert!(matches!(err, IoError::NotPositive { .. }) && err.to_string().contains("mesh_tolerance"), "{err}");
+    }
+}
+
+/// A turned box as another tool writes it: each face (planar only to rounding) cut into two triangles along either
+/// diagonal, one of which can cross an exact crease of the hull. It reads as the box: six faces, eight vertices.
+#[test]
+fn a_turned_box_triangulated_along_either_diagonal_reads_as_a_box() {
+    let rotation = DMat3::from_euler(glam::EulerRot::ZYX, 0.41, -0.83, 1.37);
+    let corner = |i: usize| {
+        let c = |bit: usize, e: f64| if i & bit == 0 { 0.0 } else { e };
+        rotation * DVec3::new(c(1, 40.0), c(2, 25.0), c(4, 3.0)) + DVec3::new(10.0, 20.0, 30.0)
+    };
+    let points: Vec<DVec3> = (0..8).map(corner).collect();
+    // the six faces, counter-clockwise seen from outside
+    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let mut crossed_a_crease = false;
+    for diagonals in 0..64u32 {
+        let mut triangles = Vec::new();
+        for (f, q) in quads.iter().enumerate() {
+            if diagonals & (1 << f) == 0 {
+                triangles.push([q[0], q[1], q[2]]);
+                triangles.push([q[0], q[2], q[3]]);
+            } else {
+                triangles.push([q[1], q[2], q[3]]);
+                triangles.push([q[1], q[3], q[0]]);
+            }
+        }
+        crossed_a_crease |= !oracle_convex(&points, &triangles);
+        let part =
+            io::parse_stl(ascii_stl(&points, &triangles).as_bytes(), Path::new("box.stl"), &ReadOptions::default())
+                .unwrap_or_else(|e| panic!("diagonals {diagonals:06b}: {e}"));
+        assert_eq!(part.components.len(), 1);
+        assert_eq!(part.components[0].faces().len(), 6, "diagonals {diagonals:06b}");
+        assert_eq!(part.components[0].vertices().len(), 8);
+        assert!((part.mass.volume - 3000.0).abs() < 1e-9, "{}", part.mass.volume);
+    }
+    assert!(crossed_a_crease, "the test has teeth: some triangulations are not exactly convex");
+}
+
+/// A dent or fold deeper than the length tolerance is still not convex: one corner of the turned box pushed in by
+/// 1e-6 of its extent (a thousand tolerances).
+#[test]
+fn a_turned_box_with_a_corner_pushed_in_is_not_convex() {
+    let rotation = DMat3::from_euler(glam::EulerRot::ZYX, 0.41, -0.83, 1.37);
+    let mut points: Vec<DVec3> = (0..8)
+        .map(|i: usize| {
+            let c = |bit: usize, e: f64| if i & bit == 0 { 0.0 } else { e };
+            rotation * DVec3::new(c(1, 40.0), c(2, 25.0), c(4, 3.0))
+        })
+        .collect();
+    let inward = rotation * DVec3::new(-1.0, -1.0, -1.0).normalize();
+    points[7] += inward * 5e-5; // the diagonal is 47.3: 1e-6 of it
+    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    // triangulated so that the pushed-in corner is a concave fold of each face it is on
+    let triangles: Vec<[usize; 3]> = quads
+        .iter()
+        .flat_map(|q| {
+            let k = q.iter().position(|&v| v == 7).unwrap_or(0);
+            let r = [q[k], q[(k + 1) % 4], q[(k + 2) % 4], q[(k + 3) % 4]];
+            [[r[0], r[1], r[2]], [r[0], r[2], r[3]]]
+        })
+        .collect();
+    assert!(!oracle_convex(&points, &triangles));
+    let err = io::parse_stl(ascii_stl(&points, &triangles).as_bytes(), Path::new("dent.stl"), &ReadOptions::default())
+        .expect_err("a dent of a thousand tolerances");
+    assert!(matches!(err, IoError::NotConvex { .. }), "{err}");
 }
 
 #[test]

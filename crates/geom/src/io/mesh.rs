@@ -1,40 +1,60 @@
-//! Meshes to parts: welding, shell splitting, the exact convexity check and the optional VHACD decomposition.
+//! Meshes to parts: welding, shell splitting, the convexity check and the optional VHACD decomposition.
 //!
-//! **Welding.** Vertices with exactly equal coordinates (`-0.0` and `0.0` identified) become one vertex; nothing
-//! is merged within a tolerance, so the check below stays exact. O(n) expected (hashing).
+//! **Welding.** Vertices with exactly equal coordinates (`-0.0` and `0.0` identified) become one vertex; nothing is
+//! merged within a tolerance, so the check below stays exact. O(n) expected (hashing).
 //!
 //! **Shells (STL).** Triangles are linked across edges: a triangle's directed edge `a -> b` is paired with a triangle
 //! that traverses `b -> a`. When several do (convex components of one part touching along a face or an edge, as the
 //! prisms of a sheet-metal part do), the partner is the first one met when the triangle's half-plane is rotated about
-//! the edge into the solid (away from its outward normal); a triangle lying exactly on the same half-plane (exact
-//! `orient3d == 0`, the touching face of the neighbouring component) is met last. This is the classical rule for
-//! separating closed shells that touch (each solid's interior lies between a triangle and its partner). Shells are
-//! the connected components of these links (union-find), numbered by their first triangle in file order. A directed
-//! edge with no partner means the shell is open, which is reported as not convex. O(T log T).
+//! the edge into the solid (away from its outward normal); a triangle lying on the same half-plane (the touching face
+//! of the neighbouring component: exact `orient3d == 0`, or its far vertex within the length tolerance (below) of the
+//! plane, for a shared face planar only to rounding that each component triangulates along another diagonal) is met
+//! last. This is the classical rule for separating closed shells that touch (each solid's interior lies between a
+//! triangle and its partner). Shells are the connected components of these links (union-find), numbered by their first
+//! triangle in file order. A directed edge with no partner means the shell is open, which is reported as not convex.
+//! O(T log T).
 //!
-//! **Convexity (exact).** A closed shell bounds a convex solid iff (1) its vertices have a 3-D hull (`convex_hull`,
-//! exact), (2) every polygon of the shell lies in the plane of one hull face — decided by the exact `orient3d` of every
-//! polygon vertex against three non-collinear vertices of that face ([`crate::polytope::ConvexPolytope::face_frame`])
-//! — and (3) the shell covers the hull boundary exactly once with outward orientation: its signed enclosed volume
+//! **Convexity.** A closed shell bounds a convex solid iff (1) its vertices have a 3-D hull (`convex_hull`, exact), (2)
+//! every polygon of the shell lies in the plane of one hull face — decided by the exact `orient3d` of every polygon
+//! vertex against three non-collinear vertices of that face ([`crate::polytope::ConvexPolytope::face_frame`]) — or,
+//! failing that, lies within the length tolerance (below) of the plane of one face of the hull with its rounding
+//! creases merged ([`convex_hull_merged_within`]: a face of a part exported in some orientation is planar only to
+//! rounding, and another tool triangulates it along either diagonal, one of them across an exact crease), and (3) the
+//! shell covers the hull boundary exactly once with outward orientation: its signed enclosed volume
 //! `sum det(p0 - o, pi - o, pi+1 - o) / 6` equals the hull's volume. (1)-(2) are exact; (3) compares two rounded sums,
-//! with the tolerance `1e-13 T d^3 + 1e-12 V` (T fan triangles, d the shell's bounding diagonal, V the hull volume),
-//! a few dozen times the worst rounding of the sum; a missing, doubled or inverted polygon changes the volume by far
-//! more. Cost: the hull plus, per polygon, exact plane tests against the faces around one of its hull vertices
-//! (O(polygons x face degree) for a convex mesh); only polygons with no hull vertex (fine subdivisions of a face)
-//! fall back to the best-aligned face and then to all faces, O(polygons x faces) in the worst case.
+//! with the tolerance `1e-13 T d^3 + 1e-12 V + 2 t d^2` (T fan triangles, d the shell's bounding diagonal, V the hull
+//! volume, t the length tolerance below), a few dozen times the worst rounding of the sum plus what a shell within the
+//! length tolerance of the hull's boundary can enclose more or less; a missing, doubled or inverted polygon changes the
+//! volume by far more. So a shell is accepted exactly when it is convex, up to the length tolerance in (2) only; a dent
+//! or fold deeper than the tolerance is rejected. Cost: the hull plus, per polygon, exact plane tests against the faces
+//! around one of its hull vertices (O(polygons x face degree) for a convex mesh); only polygons with no hull vertex
+//! (fine subdivisions of a face) fall back to the best-aligned face and then to all faces, O(polygons x faces) in the
+//! worst case.
+//!
+//! **The length tolerance** of the two tests above that use one (the shared-face rule and (2)'s fallback, and the merge
+//! of rounding creases in the piece) is the largest of: the kernel's, `1e-9 x` the mesh's extent
+//! ([`crate::tolerance`]); for single-precision coordinates, `16 x 2^-24 x` the largest coordinate magnitude, 16
+//! roundings to `f32`; and [`super::ReadOptions::mesh_tolerance`] when given, for files written with fewer digits
+//! still. Coordinates are single precision in binary STL (`f32`), and in a text file (ASCII STL, OBJ) when none is
+//! written with more than 9 significant digits, the most an `f32` needs to be written exactly ([`Precision`]):
+//! exporters write 6 to 9 (the STL specification says that ASCII STL is single precision too), while a file written
+//! with the shortest text of `f64` values, as the writers here do, has 15 to 17 for a part turned into place, and is
+//! then taken as written. The rounding of a face's corners moves them off its plane by at most one rounding each, and
+//! its exact facets then fold by a few roundings.
 //!
 //! **Decomposition.** With [`super::ReadOptions::decompose_mesh`], a shell failing (2)-(3) is handed to parry3d-f64's
 //! VHACD (voxel-based approximate convex decomposition, K. Mamou, *Volumetric hierarchical approximate convex
 //! decomposition*, Game Engine Gems 3, 2016) with default parameters; each returned hull is rebuilt with our exact
-//! hull, and the part is marked [`PartOrigin::ApproximateDecomposition`]: its components only approximate the mesh
-//! and may overlap slightly.
+//! hull, and the part is marked [`PartOrigin::ApproximateDecomposition`]: its components only approximate the mesh and
+//! may overlap slightly.
 
 use super::{IoError, Place, ReadOptions, resolve_density};
-use crate::hull::{HullError, convex_hull, convex_hull_merged};
+use crate::accurate_normal::accurate_cross;
+use crate::hull::{HullError, convex_hull, convex_hull_merged_within};
 use crate::part::{Part, PartOrigin};
 use crate::polytope::{ConvexPolytope, newell_normal};
 use crate::predicates::side;
-use crate::tolerance::bounding_diagonal;
+use crate::tolerance::{Tolerance, bounding_diagonal};
 use glam::DVec3;
 use std::cmp::Ordering;
 use std::collections::HashMap;
@@ -110,7 +130,11 @@ pub(crate) fn written_faces(component: &ConvexPolytope, points: &[DVec3]) -> Vec
 
 /// Splits triangles into closed shells. See the module documentation. Triangles with a repeated vertex are dropped.
 /// Returns the shells and, per shell, the first open edge found (a polygon index within the shell), if any.
-pub(crate) fn split_shells(points: &[DVec3], triangles: Vec<MeshPolygon>) -> Vec<(Shell, Option<usize>)> {
+pub(crate) fn split_shells(
+    points: &[DVec3],
+    triangles: Vec<MeshPolygon>,
+    tolerance: f64,
+) -> Vec<(Shell, Option<usize>)> {
     let triangles: Vec<MeshPolygon> = triangles
         .into_iter()
         .filter(|t| {
@@ -137,7 +161,7 @@ pub(crate) fn split_shells(points: &[DVec3], triangles: Vec<MeshPolygon>) -> Vec
             let partner = match candidates {
                 [] => None,
                 [only] => Some(*only),
-                many => Some(first_met(points, a, b, c, many, &triangles)),
+                many => Some(first_met(points, (a, b, c), many, &triangles, tolerance)),
             };
             match partner {
                 Some(s) => union(&mut parent, t, s),
@@ -164,9 +188,16 @@ pub(crate) fn split_shells(points: &[DVec3], triangles: Vec<MeshPolygon>) -> Vec
 }
 
 /// Among triangles `candidates` (each traversing `b -> a`), the one first met when rotating the half-plane of
-/// triangle `(a, b, c)` about the edge into its solid.
-fn first_met(points: &[DVec3], a: usize, b: usize, c: usize, candidates: &[usize], tris: &[MeshPolygon]) -> usize {
+/// triangle `(a, b, c)` about the edge into its solid; one on that half-plane (within `tolerance`) is met last.
+fn first_met(
+    points: &[DVec3],
+    (a, b, c): (usize, usize, usize),
+    candidates: &[usize],
+    tris: &[MeshPolygon],
+    tolerance: f64,
+) -> usize {
     let (pa, pb, pc) = (points[a], points[b], points[c]);
+    let unit_normal = accurate_cross(pa, pb, pc).normalize_or_zero();
     let u = (pb - pa).normalize_or_zero();
     let reject = |p: DVec3| {
         let w = p - pa;
@@ -180,7 +211,8 @@ fn first_met(points: &[DVec3], a: usize, b: usize, c: usize, candidates: &[usize
         };
         let pd = points[d];
         let w = reject(pd);
-        if side(pa, pb, pc, pd) == Ordering::Equal && w.dot(x) > 0.0 {
+        let in_plane = side(pa, pb, pc, pd) == Ordering::Equal || (pd - pa).dot(unit_normal).abs() <= tolerance;
+        if in_plane && w.dot(x) > 0.0 {
             return std::f64::consts::TAU; // on our own half-plane: the touching neighbour's face, met last
         }
         let theta = w.dot(y).atan2(w.dot(x));
@@ -214,7 +246,7 @@ fn union(parent: &mut [usize], a: usize, b: usize) {
 }
 
 /// The exact convexity check of the module documentation; returns the shell's convex polytope.
-fn convex_shell(points: &[DVec3], shell: &Shell) -> Result<ConvexPolytope, Defect> {
+fn convex_shell(points: &[DVec3], shell: &Shell, tolerance: f64) -> Result<ConvexPolytope, Defect> {
     let mut local: Vec<DVec3> = Vec::new();
     let mut local_of: HashMap<usize, usize> = HashMap::new(); // welded index -> index into `local`
     for p in &shell.polygons {
@@ -239,6 +271,8 @@ fn convex_shell(points: &[DVec3], shell: &Shell) -> Result<ConvexPolytope, Defec
         }
     }
     let frames: Vec<Option<(DVec3, DVec3, DVec3)>> = (0..hull.faces().len()).map(|f| hull.face_frame(f)).collect();
+    // the piece: the hull with its rounding creases merged; built lazily for the tolerant test, else at the end
+    let mut merged: Option<ConvexPolytope> = None;
     let on_face = |f: usize, pts: &[DVec3]| {
         frames[f].is_some_and(|(a, b, c)| pts.iter().all(|&p| side(a, b, c, p) == Ordering::Equal))
     };
@@ -264,6 +298,16 @@ fn convex_shell(points: &[DVec3], shell: &Shell) -> Result<ConvexPolytope, Defec
             found = best.is_some_and(|f| on_face(f, &pts)) || (0..hull.faces().len()).any(|f| on_face(f, &pts));
         }
         if !found {
+            // a face planar only to rounding, triangulated across an exact crease: within the length tolerance of a
+            // merged face's plane
+            if merged.is_none() {
+                merged = Some(convex_hull_merged_within(&local, tolerance).map_err(Defect::Hull)?.polytope);
+            }
+            found = merged.as_ref().is_some_and(|m| {
+                m.faces().iter().any(|f| pts.iter().all(|&p| f.plane.signed_distance(p).abs() <= tolerance))
+            });
+        }
+        if !found {
             return Err(Defect::OffHull { polygon: i });
         }
     }
@@ -279,14 +323,72 @@ fn convex_shell(points: &[DVec3], shell: &Shell) -> Result<ConvexPolytope, Defec
     }
     let hull_volume = hull.volume();
     let d = bounding_diagonal(&local);
-    let tol = 1e-13 * fans as f64 * d * d * d + 1e-12 * hull_volume;
+    // a shell within the length tolerance of the hull's boundary (test (2)) encloses a volume within the tolerance
+    // times the hull's area of the hull's, and that area is at most the bounding box's, 2 d^2
+    let tol = 1e-13 * fans as f64 * d * d * d + 1e-12 * hull_volume + 2.0 * tolerance * d * d;
     let within = (shell_volume - hull_volume).abs() <= tol; // false for NaN as well
     if !within {
         return Err(Defect::Volume { shell: shell_volume, hull: hull_volume });
     }
     // the shell bounds the exact hull; the piece is that hull with its rounding creases merged (as the JSON reader's
     // pieces): a face planar only to rounding is one face, not its exact facets
-    convex_hull_merged(&local).map(|h| h.polytope).map_err(Defect::Hull)
+    match merged {
+        Some(m) => Ok(m),
+        None => convex_hull_merged_within(&local, tolerance).map(|h| h.polytope).map_err(Defect::Hull),
+    }
+}
+
+/// The coordinate precision of a mesh file, for [`mesh_tolerance`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Precision {
+    /// Coordinates as written: the kernel's tolerance.
+    AsWritten,
+    /// Single-precision coordinates (binary STL; text with at most 9 significant digits per coordinate).
+    Single,
+}
+
+impl Precision {
+    /// The precision of a text file whose coordinates have at most `digits` significant digits.
+    pub(crate) fn of_text(digits: usize) -> Self {
+        if digits <= 9 { Precision::Single } else { Precision::AsWritten }
+    }
+}
+
+/// The number of significant digits of a decimal number as written (`-0.012500e3`: 5; leading zeros do not count,
+/// trailing ones do). Text that is not a decimal number (`inf`, `NaN`) has none.
+pub(crate) fn significant_digits(token: &str) -> usize {
+    let mantissa = token.split(['e', 'E']).next().unwrap_or("");
+    mantissa.bytes().filter(u8::is_ascii_digit).skip_while(|&b| b == b'0').count()
+}
+
+/// The length tolerance of the module documentation for a mesh with welded vertices `points`.
+pub(crate) fn mesh_tolerance(
+    file: &Path,
+    points: &[DVec3],
+    precision: Precision,
+    options: &ReadOptions,
+) -> Result<f64, IoError> {
+    let kernel = Tolerance::for_points(points).linear;
+    let format = match precision {
+        Precision::AsWritten => 0.0,
+        Precision::Single => {
+            let largest = points.iter().map(|p| p.abs().max_element()).fold(0.0, f64::max);
+            16.0 * f64::from(f32::EPSILON) / 2.0 * largest
+        }
+    };
+    let given = match options.mesh_tolerance {
+        None => 0.0,
+        Some(t) if t > 0.0 && t.is_finite() => t,
+        Some(value) => {
+            return Err(IoError::NotPositive {
+                file: file.to_path_buf(),
+                at: super::Place::Key("mesh_tolerance".into()),
+                what: "the mesh tolerance",
+                value,
+            });
+        }
+    };
+    Ok(kernel.max(format).max(given))
 }
 
 /// Checks every shell (or decomposes it) and builds the part.
@@ -296,6 +398,7 @@ pub(crate) fn part_from_shells(
     points: &[DVec3],
     shells: Vec<(Shell, Option<usize>)>,
     options: &ReadOptions,
+    tolerance: f64,
 ) -> Result<Part, IoError> {
     if shells.is_empty() {
         return Err(IoError::Empty { file: file.to_path_buf(), at: Place::WholeFile, what: "the mesh has no faces" });
@@ -315,15 +418,17 @@ pub(crate) fn part_from_shells(
                 "the shell is open: the polygon at {} has an edge that no other polygon traverses backwards",
                 shell.polygons[*p].place
             ))),
-            None => convex_shell(points, shell).map_err(|defect| match defect {
+            None => convex_shell(points, shell, tolerance).map_err(|defect| match defect {
                 Defect::Hull(source) => IoError::DegeneratePiece {
                     file: file.to_path_buf(),
                     at: shell.polygons.first().map(|p| p.place.clone()).unwrap_or(Place::Piece(index)),
                     source,
                 },
                 Defect::OffHull { polygon } => not_convex(format!(
-                    "the polygon at {} does not lie in a face plane of the shell's convex hull",
-                    shell.polygons[polygon].place
+                    "the polygon at {} does not lie in a face plane of the shell's convex hull (nor within {} mm \
+                     of one; a mesh written with few digits may need a larger mesh tolerance)",
+                    shell.polygons[polygon].place,
+                    super::short_number(tolerance)
                 )),
                 Defect::Volume { shell: s, hull } => not_convex(format!(
                     "the shell encloses volume {s} but its convex hull has volume {hull} \
@@ -334,7 +439,7 @@ pub(crate) fn part_from_shells(
         match checked {
             Ok(polytope) => components.push(polytope),
             Err(IoError::NotConvex { .. }) if options.decompose_mesh => {
-                let pieces = decompose(points, shell).map_err(|detail| IoError::Decomposition {
+                let pieces = decompose(points, shell, tolerance).map_err(|detail| IoError::Decomposition {
                     file: file.to_path_buf(),
                     shell: index,
                     detail,
@@ -352,7 +457,7 @@ pub(crate) fn part_from_shells(
 }
 
 /// VHACD on one shell; every output hull rebuilt with the exact hull.
-fn decompose(points: &[DVec3], shell: &Shell) -> Result<Vec<ConvexPolytope>, String> {
+fn decompose(points: &[DVec3], shell: &Shell, tolerance: f64) -> Result<Vec<ConvexPolytope>, String> {
     use parry3d_f64::transformation::vhacd::{VHACD, VHACDParameters};
     let mut local_index: HashMap<usize, u32> = HashMap::new();
     let mut local: Vec<DVec3> = Vec::new();
@@ -381,10 +486,52 @@ fn decompose(points: &[DVec3], shell: &Shell) -> Result<Vec<ConvexPolytope>, Str
         decomposition.compute_exact_convex_hulls(&local, &triangles)
     })
     .map_err(|_| "VHACD panicked on this mesh".to_string())?;
-    let pieces: Vec<ConvexPolytope> =
-        hulls.iter().filter_map(|(pts, _)| convex_hull_merged(pts).ok().map(|h| h.polytope)).collect();
+    let pieces: Vec<ConvexPolytope> = hulls
+        .iter()
+        .filter_map(|(pts, _)| convex_hull_merged_within(pts, tolerance).ok().map(|h| h.polytope))
+        .collect();
     if pieces.is_empty() {
         return Err(format!("VHACD returned {} hulls, none of them solid", hulls.len()));
     }
     Ok(pieces)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn significant_digits_count_as_written() {
+        for (token, digits) in [
+            ("0", 0),
+            ("12.5", 3),
+            ("-0.012500e3", 5),
+            ("1.234567e+01", 7),
+            ("123.456789", 9),
+            ("12.345678329467773", 17),
+            ("+1E-7", 1),
+            ("0.000001", 1),
+            ("inf", 0),
+            ("NaN", 0),
+        ] {
+            assert_eq!(significant_digits(token), digits, "{token}");
+        }
+        assert_eq!(Precision::of_text(9), Precision::Single);
+        assert_eq!(Precision::of_text(10), Precision::AsWritten);
+    }
+
+    #[test]
+    fn the_tolerance_is_the_largest_of_the_kernel_the_format_and_the_option() {
+        let file = Path::new("t.stl");
+        let points = [DVec3::new(1000.0, 0.0, 0.0), DVec3::new(1010.0, 10.0, 0.0)];
+        let kernel = Tolerance::for_points(&points).linear;
+        let as_written = mesh_tolerance(file, &points, Precision::AsWritten, &ReadOptions::default()).expect("ok");
+        assert_eq!(as_written, kernel);
+        let single = mesh_tolerance(file, &points, Precision::Single, &ReadOptions::default()).expect("ok");
+        assert_eq!(single, 16.0 * 2f64.powi(-24) * 1010.0);
+        let given = ReadOptions { mesh_tolerance: Some(0.5), ..Default::default() };
+        assert_eq!(mesh_tolerance(file, &points, Precision::Single, &given).expect("ok"), 0.5);
+        let small = ReadOptions { mesh_tolerance: Some(1e-12), ..Default::default() };
+        assert_eq!(mesh_tolerance(file, &points, Precision::AsWritten, &small).expect("ok"), kernel);
+    }
 }

@@ -333,6 +333,12 @@ pub struct ReadOptions {
     pub decompose_mesh: bool,
     /// Density; when given it overrides the file's `density` (JSON). Default: the file's, else 1.0.
     pub density: Option<f64>,
+    /// A length (mm, positive and finite) within which a mesh (STL, OBJ) polygon counts as lying in the plane of a
+    /// hull face, and facets in one plane are one face, for meshes written with fewer digits than their geometry
+    /// needs (a part turned into place and written with six decimals). The readers never use less than their own
+    /// tolerance: the kernel's (`1e-9 x` the mesh's extent), and for STL, whose coordinates are single precision,
+    /// 16 `f32` roundings of its largest coordinate ([`mesh`]).
+    pub mesh_tolerance: Option<f64>,
 }
 
 /// Reads a part, choosing the format by extension: `.json`, `.stl`, `.obj` (case-insensitive).

@@ -4,7 +4,8 @@
 //! `f i j k ...` a polygon with vertex references `i`, `i/t`, `i//n` or `i/t/n`; indices are 1-based, negative
 //! indices count back from the last vertex defined so far (`-1` is the latest). `o` and `g` start a new object/group;
 //! each non-empty object/group (faces before the first `o`/`g` form an unnamed one) is one convex piece and must bound
-//! a convex solid, checked exactly as for STL shells ([`super::mesh`]) unless decomposition is requested. `vt`,
+//! a convex solid, checked as for STL shells ([`super::mesh`]: exactly, or within the length tolerance, which is that
+//! of single precision when no coordinate has more than 9 significant digits) unless decomposition is requested. `vt`,
 //! `vn`, `vp`, `s`, `usemtl`, `mtllib`, `l`, `p` and other statements are ignored; `#` starts a comment. Vertices are
 //! welded by exact coordinates. O(file size) parsing.
 //!
@@ -14,7 +15,9 @@
 //! form, component by component (the part's vertices and faces, as sets, when its faces are exactly planar; see the
 //! JSON writer).
 
-use super::mesh::{MeshPolygon, Shell, Welder, part_from_shells, written_faces};
+use super::mesh::{
+    MeshPolygon, Precision, Shell, Welder, mesh_tolerance, part_from_shells, significant_digits, written_faces,
+};
 use super::{IoError, Place, ReadOptions, check_coordinate, stem_name};
 use crate::part::Part;
 use crate::pose::Pose;
@@ -36,6 +39,7 @@ pub fn parse_obj(bytes: &[u8], file: &Path, options: &ReadOptions) -> Result<Par
         |line: usize, message: String| IoError::Syntax { file: file.to_path_buf(), at: Place::Line(line), message };
     let mut welder = Welder::default();
     let mut vertex_ids: Vec<usize> = Vec::new(); // OBJ vertex k (0-based) -> welded index
+    let mut digits = 0; // the most significant digits of any vertex coordinate
     let mut groups: Vec<Shell> = vec![Shell { name: None, polygons: Vec::new() }];
     for (i, raw) in text.lines().enumerate() {
         let line = i + 1;
@@ -53,6 +57,7 @@ pub fn parse_obj(bytes: &[u8], file: &Path, options: &ReadOptions) -> Result<Par
                     let value: f64 = w.parse().map_err(|_| syntax(line, format!("`{w}` is not a number")))?;
                     if k < 3 {
                         p[k] = check_coordinate(value, file, || Place::Line(line))?;
+                        digits = digits.max(significant_digits(w));
                     }
                 }
                 vertex_ids.push(welder.index(DVec3::from_array(p)));
@@ -98,7 +103,8 @@ pub fn parse_obj(bytes: &[u8], file: &Path, options: &ReadOptions) -> Result<Par
     if shells.is_empty() {
         return Err(IoError::Empty { file: file.to_path_buf(), at: Place::WholeFile, what: "the OBJ has no faces" });
     }
-    part_from_shells(file, stem_name(file), &welder.points, shells, options)
+    let tolerance = mesh_tolerance(file, &welder.points, Precision::of_text(digits), options)?;
+    part_from_shells(file, stem_name(file), &welder.points, shells, options, tolerance)
 }
 
 /// The part as OBJ text.

@@ -6,7 +6,9 @@
 //! a size mismatch is reported as [`IoError::Truncated`] with the byte offset where the records stop matching.
 //!
 //! **Reading.** Triangles are welded exactly and split into closed shells; each shell must bound a convex solid (or
-//! is decomposed on request): see [`super::mesh`]. Binary coordinates are `f32`, widened exactly to `f64`. Normals in
+//! is decomposed on request): see [`super::mesh`], whose length tolerance is that of single precision for binary
+//! files and for ASCII files with no coordinate of more than 9 significant digits. Binary coordinates are `f32`,
+//! widened exactly to `f64`. Normals in
 //! the file are ignored (the winding order defines the outside). O(file size) parsing.
 //!
 //! **Writing.** Every face of the exact convex hull of each component's vertices (the faces the reader rebuilds;
@@ -16,7 +18,9 @@
 //! stores `f32`: the vertices are rounded first and the hull taken of the rounded points, so the file reads back as
 //! the exact form of the rounded part (the same as ASCII's for coordinates representable in `f32`).
 
-use super::mesh::{MeshPolygon, Welder, part_from_shells, split_shells, written_faces};
+use super::mesh::{
+    MeshPolygon, Precision, Welder, mesh_tolerance, part_from_shells, significant_digits, split_shells, written_faces,
+};
 use super::{IoError, Place, ReadOptions, check_coordinate, stem_name};
 use crate::part::Part;
 use glam::DVec3;
@@ -33,10 +37,11 @@ pub fn read_stl(path: impl AsRef<Path>, options: &ReadOptions) -> Result<Part, I
 /// Parses STL from memory; `file` is only used in error messages and as the default name.
 pub fn parse_stl(bytes: &[u8], file: &Path, options: &ReadOptions) -> Result<Part, IoError> {
     let mut welder = Welder::default();
-    let (name, triangles) = if is_ascii(bytes) {
-        parse_ascii(bytes, file, &mut welder)?
+    let (name, triangles, precision) = if is_ascii(bytes) {
+        let (name, triangles, digits) = parse_ascii(bytes, file, &mut welder)?;
+        (name, triangles, Precision::of_text(digits))
     } else {
-        (None, parse_binary(bytes, file, &mut welder)?)
+        (None, parse_binary(bytes, file, &mut welder)?, Precision::Single)
     };
     if triangles.is_empty() {
         return Err(IoError::Empty {
@@ -45,9 +50,10 @@ pub fn parse_stl(bytes: &[u8], file: &Path, options: &ReadOptions) -> Result<Par
             what: "the STL has no triangles",
         });
     }
-    let shells = split_shells(&welder.points, triangles);
+    let tolerance = mesh_tolerance(file, &welder.points, precision, options)?;
+    let shells = split_shells(&welder.points, triangles, tolerance);
     let name = name.filter(|n| !n.is_empty()).unwrap_or_else(|| stem_name(file));
-    part_from_shells(file, name, &welder.points, shells, options)
+    part_from_shells(file, name, &welder.points, shells, options, tolerance)
 }
 
 fn binary_size(bytes: &[u8]) -> Option<(u64, u64)> {
@@ -132,7 +138,10 @@ impl<'a> Tokens<'a> {
     }
 }
 
-fn parse_ascii(bytes: &[u8], file: &Path, welder: &mut Welder) -> Result<(Option<String>, Vec<MeshPolygon>), IoError> {
+/// The name, the triangles and the most significant digits of any vertex coordinate.
+type AsciiStl = (Option<String>, Vec<MeshPolygon>, usize);
+
+fn parse_ascii(bytes: &[u8], file: &Path, welder: &mut Welder) -> Result<AsciiStl, IoError> {
     let text = String::from_utf8_lossy(bytes);
     let mut tokens = Tokens::new(&text);
     let syntax =
@@ -144,17 +153,18 @@ fn parse_ascii(bytes: &[u8], file: &Path, welder: &mut Welder) -> Result<(Option
             None => Err(syntax(tokens.line.max(1), format!("expected `{word}`, found the end of the file"))),
         }
     };
-    let number = |tokens: &mut Tokens<'_>, what: &str| -> Result<(f64, usize), IoError> {
+    let number = |tokens: &mut Tokens<'_>, what: &str| -> Result<(f64, usize, usize), IoError> {
         match tokens.next() {
             Some((t, line)) => t
                 .parse::<f64>()
-                .map(|v| (v, line))
+                .map(|v| (v, line, significant_digits(t)))
                 .map_err(|_| syntax(line, format!("expected a number ({what}), found `{t}`"))),
             None => Err(syntax(tokens.line.max(1), format!("expected a number ({what}), found the end of the file"))),
         }
     };
     let mut name = None;
     let mut triangles = Vec::new();
+    let mut digits = 0;
     expect(&mut tokens, "solid")?;
     let first_name = tokens.rest_of_line();
     name.get_or_insert(first_name);
@@ -187,8 +197,9 @@ fn parse_ascii(bytes: &[u8], file: &Path, welder: &mut Welder) -> Result<(Option
             expect(&mut tokens, "vertex")?;
             let mut p = [0.0; 3];
             for (c, axis) in p.iter_mut().zip(["x", "y", "z"]) {
-                let (v, l) = number(&mut tokens, axis)?;
+                let (v, l, d) = number(&mut tokens, axis)?;
                 *c = check_coordinate(v, file, || Place::Line(l))?;
+                digits = digits.max(d);
             }
             vertices.push(welder.index(DVec3::from_array(p)));
         }
@@ -196,7 +207,7 @@ fn parse_ascii(bytes: &[u8], file: &Path, welder: &mut Welder) -> Result<(Option
         expect(&mut tokens, "endfacet")?;
         triangles.push(MeshPolygon { vertices, place: Place::Line(line) });
     }
-    Ok((name, triangles))
+    Ok((name, triangles, digits))
 }
 
 /// Fan triangles `(a, b, c, outward normal)` of every written face ([`written_faces`]: those of the exact hull of the
