@@ -72,6 +72,25 @@ pub struct Part {
     pub origin: PartOrigin,
 }
 
+/// The point a part's moments are summed about (see `mass`: about the origin, a part far from it loses digits of
+/// its inertia): the centre of the components' bounding box rounded to a multiple of the smallest power of two at least
+/// the box's largest side. A part within about its size of the origin is summed about the origin itself, as it always
+/// was (its c.g. and inertia unchanged to the bit; the cancellation costs it at most about one digit); a part farther
+/// away about a point within its size of it.
+fn moment_reference(components: &[ConvexPolytope]) -> DVec3 {
+    let (lo, hi) = components
+        .iter()
+        .flat_map(|c| c.vertices())
+        .fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    let size = (hi - lo).max_element();
+    if !(size > 0.0 && lo.is_finite() && hi.is_finite()) {
+        return DVec3::ZERO;
+    }
+    let step = 2f64.powi(size.log2().ceil() as i32);
+    let reference = ((0.5 * lo + 0.5 * hi) / step).round() * step;
+    if reference.is_finite() { reference } else { DVec3::ZERO }
+}
+
 impl Part {
     /// Builds a part from its convex components. O(total size) plus a hash of faces for the boundary.
     pub fn from_components(
@@ -86,15 +105,16 @@ impl Part {
         if !(density > 0.0 && density.is_finite()) {
             return Err(PartError::BadDensity(density));
         }
+        let reference = moment_reference(&components);
         let mut total = Moments::default();
         for (i, c) in components.iter().enumerate() {
-            let m = Moments::of_polytope(c);
+            let m = Moments::of_polytope_about(c, reference);
             if m.volume.is_nan() || m.volume <= 0.0 {
                 return Err(PartError::ZeroVolume(i));
             }
             total.add(&m);
         }
-        let mass = total.properties(density).ok_or(PartError::ZeroVolume(0))?;
+        let mass = total.properties_about(density, reference).ok_or(PartError::ZeroVolume(0))?;
         let boundary = boundary_faces(&components);
         Ok(Self { name: name.into(), components, boundary, mass, density, origin })
     }
