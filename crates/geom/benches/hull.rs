@@ -4,10 +4,15 @@
 //!   clusters;
 //! * `random_400`: 400 uniformly random points in a cube;
 //! * `disc_prism_800`: a 400-gon disc of radius 500 extruded 0.5 thick (sheet metal), where parry's hull is wrong
-//!   (it drops one face; see `tests/hull_props.rs`), timed for completeness.
+//!   (it drops one face; see `tests/hull_props.rs`), timed for completeness;
+//! * `turned_disc_prism_800`: the same disc turned by a general rotation, so that its two 400-gons and side faces are
+//!   planar only to rounding (`stackplan-merged` merges the exact hull's creased facets back into them).
+//!
+//! `stackplan-merged/*` is `convex_hull_merged` (the hull the part readers build: the exact hull, then its facets in
+//! one plane within the length tolerance joined) on the same points.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use stackplan_geom::{DVec3, convex_hull};
+use stackplan_geom::{DMat3, DVec3, convex_hull, convex_hull_merged};
 use std::hint::black_box;
 
 fn box_vertices(lo: DVec3, hi: DVec3) -> Vec<DVec3> {
@@ -46,9 +51,17 @@ fn bench(c: &mut Criterion) {
             [DVec3::new(x, y, 0.0), DVec3::new(x, y, 0.5)]
         })
         .collect();
+    let turn = DMat3::from_euler(glam::EulerRot::ZYX, 0.3, 0.7, 1.1);
+    let turned_disc: Vec<DVec3> = disc.iter().map(|&p| turn * p + DVec3::new(12.5, -7.0, 300.0)).collect();
     let mut g = c.benchmark_group("hull");
-    for (name, pts) in [("box_differences_64", &diffs), ("random_400", &random), ("disc_prism_800", &disc)] {
+    for (name, pts) in [
+        ("box_differences_64", &diffs),
+        ("random_400", &random),
+        ("disc_prism_800", &disc),
+        ("turned_disc_prism_800", &turned_disc),
+    ] {
         g.bench_function(format!("stackplan/{name}"), |bch| bch.iter(|| convex_hull(black_box(pts))));
+        g.bench_function(format!("stackplan-merged/{name}"), |bch| bch.iter(|| convex_hull_merged(black_box(pts))));
         g.bench_function(format!("parry/{name}"), |bch| {
             bch.iter(|| parry3d_f64::transformation::try_convex_hull(black_box(pts)))
         });

@@ -465,7 +465,10 @@ fn find(parent: &mut [u32], mut x: u32) -> u32 {
 /// sliver in the planes of two faces joins one of them. The edges are visited in the order of the triangles, which
 /// decides only which of two faces such a sliver joins (its vertices, within `tol` of both, are dropped either way).
 /// O(triangles x the size of the groups joined).
-fn merge_creases(p: &[DVec3], tris: &[Tri], parent: &mut [u32], tol: f64) {
+/// Joins the exact facets (the groups of `parent`) that lie in one plane within `tol` (the module documentation,
+/// "Creases"); returns, per triangle index, whether it is the root of a face joined from two or more exact facets
+/// (a creased face: exactly coplanar facets are never two, the exact merge joined them).
+fn merge_creases(p: &[DVec3], tris: &[Tri], triangle_normal: &[DVec3], parent: &mut [u32], tol: f64) -> Vec<bool> {
     let n = tris.len();
     // each exact facet (at its root): twice its area times its unit normal, accurately; its vertices
     let mut facet_normal = vec![DVec3::ZERO; n];
@@ -473,8 +476,7 @@ fn merge_creases(p: &[DVec3], tris: &[Tri], parent: &mut [u32], tol: f64) {
         (0..n as u32).map(|i| if tris[i as usize].alive { find(parent, i) } else { NONE }).collect();
     for (i, t) in tris.iter().enumerate() {
         if t.alive {
-            let [a, b, c] = t.v.map(|v| p[v as usize]);
-            facet_normal[facet_of[i] as usize] += accurate_cross(a, b, c);
+            facet_normal[facet_of[i] as usize] += triangle_normal[i];
         }
     }
     let unit = |v: DVec3| v.try_normalize().unwrap_or(DVec3::ZERO);
@@ -504,10 +506,10 @@ fn merge_creases(p: &[DVec3], tris: &[Tri], parent: &mut [u32], tol: f64) {
             .map(|v| u.dot(p[v as usize] - at).abs())
             .fold(0.0f64, f64::max)
     };
-    // the joined groups: union-find over the facets' roots, each root with its facets and the sum of their normals
+    // the joined groups: union-find over the facets' roots, each root with the facets joined to it (besides itself:
+    // no allocation for a facet that joins nothing) and the sum of their normals
     let mut joined: Vec<u32> = (0..n as u32).collect();
-    let mut group_facets: Vec<Vec<u32>> =
-        (0..n as u32).map(|f| if facet_of[f as usize] == f { vec![f] } else { Vec::new() }).collect();
+    let mut group_facets: Vec<Vec<u32>> = vec![Vec::new(); n];
     let mut group_normal = facet_normal.clone();
     for (i, t) in tris.iter().enumerate() {
         if !t.alive {
@@ -532,7 +534,8 @@ fn merge_creases(p: &[DVec3], tris: &[Tri], parent: &mut [u32], tol: f64) {
             // faces' planes joins one of them, never both into one face)
             let u = unit(group_normal[ga as usize] + group_normal[gb as usize]);
             let (mut high, mut low) = (f64::NEG_INFINITY, f64::INFINITY);
-            for &f in group_facets[ga as usize].iter().chain(&group_facets[gb as usize]) {
+            let facets = [ga, gb].into_iter().chain(group_facets[ga as usize].iter().copied());
+            for f in facets.chain(group_facets[gb as usize].iter().copied()) {
                 for &m in &members[start[f as usize] as usize..start[f as usize + 1] as usize] {
                     for v in tris[m as usize].v {
                         let h = u.dot(p[v as usize]);
@@ -547,19 +550,23 @@ fn merge_creases(p: &[DVec3], tris: &[Tri], parent: &mut [u32], tol: f64) {
             let (root, other) = (ga.min(gb), ga.max(gb));
             joined[other as usize] = root;
             let moved = std::mem::take(&mut group_facets[other as usize]);
+            group_facets[root as usize].push(other);
             group_facets[root as usize].extend(moved);
             let added = group_normal[other as usize];
             group_normal[root as usize] += added;
         }
     }
+    let mut creased_root = vec![false; n];
     for f in 0..n {
         if facet_of[f] == f as u32 {
             let g = find(&mut joined, f as u32);
             if g != f as u32 {
                 parent[f] = g;
+                creased_root[g as usize] = true;
             }
         }
     }
+    creased_root
 }
 
 fn merge(p: &[DVec3], tris: &[Tri], merge_tolerance: Option<f64>) -> Result<ConvexHull, HullError> {
@@ -589,19 +596,37 @@ fn merge(p: &[DVec3], tris: &[Tri], merge_tolerance: Option<f64>) -> Result<Conv
             }
         }
     }
-    if let Some(tol) = merge_tolerance {
-        merge_creases(p, tris, &mut parent, tol);
-    }
+    // with a merge tolerance: each triangle's accurate normal (twice its area), for the creases and the planes
+    let triangle_normal: Vec<DVec3> = match merge_tolerance {
+        Some(_) => tris
+            .iter()
+            .map(|t| {
+                if t.alive {
+                    accurate_cross(p[t.v[0] as usize], p[t.v[1] as usize], p[t.v[2] as usize])
+                } else {
+                    DVec3::ZERO
+                }
+            })
+            .collect(),
+        None => Vec::new(),
+    };
+    let creased_root = match merge_tolerance {
+        Some(tol) => merge_creases(p, tris, &triangle_normal, &mut parent, tol),
+        None => Vec::new(),
+    };
     // group ids
     let mut group_of = vec![u32::MAX; n];
     let mut group_of_root = vec![u32::MAX; n];
     let mut group_count = 0u32;
+    // per group: joined from two or more exact facets across creases (its plane is then its facets' area normal)
+    let mut creased: Vec<bool> = Vec::new();
     for i in 0..n {
         if tris[i].alive {
             let r = find(&mut parent, i as u32) as usize;
             if group_of_root[r] == u32::MAX {
                 group_of_root[r] = group_count;
                 group_count += 1;
+                creased.push(creased_root.get(r).copied().unwrap_or(false));
             }
             group_of[i] = group_of_root[r];
         }
@@ -654,24 +679,16 @@ fn merge(p: &[DVec3], tris: &[Tri], merge_tolerance: Option<f64>) -> Result<Conv
     // whose accurate normal is the face's; for a group of facets merged across creases, the sum of its triangles'
     // accurate normals (twice their areas) instead
     let mut representative: Vec<u32> = vec![NONE; group_count as usize];
-    let mut creased: Vec<bool> = vec![false; group_count as usize];
     let mut area_normal: Vec<DVec3> = vec![DVec3::ZERO; group_count as usize];
     for (i, t) in tris.iter().enumerate() {
         if t.alive {
             let g = group_of[i] as usize;
             let r = &mut representative[g];
-            if *r != NONE && merge_tolerance.is_some() {
-                let [a, b, c] = tris[*r as usize].v.map(|v| p[v as usize]);
-                creased[g] |= side(a, b, c, p[t.v[0] as usize]) != Ordering::Equal
-                    || side(a, b, c, p[t.v[1] as usize]) != Ordering::Equal
-                    || side(a, b, c, p[t.v[2] as usize]) != Ordering::Equal;
-            }
             if *r == NONE || t.normal.length_squared() > tris[*r as usize].normal.length_squared() {
                 *r = i as u32;
             }
             if merge_tolerance.is_some() {
-                let [a, b, c] = t.v.map(|v| p[v as usize]);
-                area_normal[g] += accurate_cross(a, b, c);
+                area_normal[g] += triangle_normal[i];
             }
         }
     }
