@@ -456,14 +456,12 @@ fn contacts_ga_effort_beyond_the_limits_is_an_error() {
         ),
     ];
     for (ga, message) in cases {
-        let start = std::time::Instant::now();
+        // (were the check made after the searches, this would run for hours: the test has no clock of its own)
         let o = run(&[&["contacts", "example:cube", "example:cube"][..], &cube_box, &ga].concat());
         assert_eq!(o.status.code(), Some(2), "{ga:?}: {}", stderr(&o));
         assert!(stderr(&o).starts_with("error: --population / --generations: "), "{ga:?}: {}", stderr(&o));
         assert!(stderr(&o).contains(message), "{ga:?}: {}", stderr(&o));
         assert!(stdout(&o).is_empty(), "{ga:?}");
-        // no search ran
-        assert!(start.elapsed().as_secs_f64() < 30.0, "{ga:?}: {:?}", start.elapsed());
     }
 }
 

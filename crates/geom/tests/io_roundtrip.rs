@@ -777,8 +777,9 @@ proptest! {
 }
 
 #[test]
-fn a_large_convex_mesh_is_checked_quickly() {
-    // 4000 points on a sphere (a Fibonacci lattice): about 8000 hull triangles, each checked exactly
+fn a_large_convex_mesh_reads_back() {
+    // 4000 points on a sphere (a Fibonacci lattice): about 8000 hull triangles, each checked exactly (its time is the
+    // `mesh` benchmark's `ball_4000_ascii_stl`, 75 ms)
     let n = 4000;
     let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
     let pts: Vec<DVec3> = (0..n)
@@ -791,15 +792,12 @@ fn a_large_convex_mesh_is_checked_quickly() {
         .collect();
     let ball = convex_hull(&pts).expect("ball").polytope;
     let part = Part::from_components("ball", vec![ball], 1.0, PartOrigin::ConvexPieces).expect("part");
-    let start = std::time::Instant::now();
     let back = io::parse_stl(io::stl_ascii_string(&part).as_bytes(), Path::new("ball.stl"), &ReadOptions::default())
         .expect("convex");
     same_components(&part, &back);
     let back = io::parse_obj(io::obj_string(&part).as_bytes(), Path::new("ball.obj"), &ReadOptions::default())
         .expect("convex");
     same_components(&part, &back);
-    // generous bound (shared, loaded machine); the quadratic fallback would take minutes here
-    assert!(start.elapsed().as_secs_f64() < 20.0, "took {:?}", start.elapsed());
 }
 
 #[test]
