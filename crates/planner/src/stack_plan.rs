@@ -447,21 +447,25 @@ pub fn plan_stack_with_progress(
                 if polygon.is_some() {
                     candidate.0.contacts = sides_of_floor(&candidate.0.contacts, &request.floor, &options.floor, tol);
                 }
-                // the lowest release above the rest that keeps the clearance (the search's may float far above it)
+                let mut verdict = accept(&mut growing, part, &candidate.0, &mut stats)?;
+                // the lowest release above the rest that keeps the clearance (the search's may float far above it),
+                // for a candidate the checks accepted (most rejected ones fail the stability test, which does not
+                // depend on the release)
                 let search_drop = candidate.1;
                 let pose = candidate.0.pose();
-                candidate.1 = lowest_release(
-                    part,
-                    pose.rotation,
-                    pose.position,
-                    search_drop,
-                    search.scene(),
-                    &cache,
-                    options.clearance,
-                    options.insertion,
-                    tol,
-                )?;
-                let mut verdict = accept(&mut growing, part, &candidate.0, &mut stats)?;
+                if verdict.is_ok() {
+                    candidate.1 = lowest_release(
+                        part,
+                        pose.rotation,
+                        pose.position,
+                        search_drop,
+                        search.scene(),
+                        &cache,
+                        options.clearance,
+                        options.insertion,
+                        tol,
+                    )?;
+                }
                 // the clearance at the release position as the plan's check measures it: at the lowered release, else
                 // (should the check's measure and the search's obstacles disagree within their tolerances) at the
                 // search's own
