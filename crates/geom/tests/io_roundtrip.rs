@@ -684,8 +684,23 @@ proptest! {
         same_components(&exact, &back);
         let back = io::parse_stl(io::stl_ascii_string(&turned).as_bytes(), Path::new("r.stl"), &opts).expect("ascii stl");
         same_components(&exact, &back);
+        // binary STL: the f32-rounded vertices, and (the rounding's folds merged within the single-precision
+        // tolerance) the faces of the part before it was turned
         let back = io::parse_stl(&io::stl_binary_bytes(&turned), Path::new("r.stl"), &opts).expect("binary stl");
         prop_assert_eq!(back.components.len(), turned.components.len());
+        let mut expected: Vec<(usize, Vec<[u64; 3]>)> = turned
+            .components
+            .iter()
+            .map(|c| {
+                let mut k: Vec<[u64; 3]> = c.vertices().iter().map(|v| (v.as_vec3().as_dvec3() + DVec3::ZERO).to_array().map(f64::to_bits)).collect();
+                k.sort_unstable();
+                (c.faces().len(), k)
+            })
+            .collect();
+        let mut got: Vec<(usize, Vec<[u64; 3]>)> = back.components.iter().map(|c| (c.faces().len(), key(c))).collect();
+        expected.sort();
+        got.sort();
+        prop_assert_eq!(got, expected);
     }
 }
 
