@@ -384,3 +384,52 @@ fn the_default_floor_has_room_beside_a_square_part() {
     assert_eq!(plan["plan"]["placed"], 15, "{}", plan["plan"]["stopped"]);
     assert_eq!(plan["plan"]["options"]["floor"]["polygon"][0], serde_json::json!([-125.0, -125.0]));
 }
+
+/// A Channel turned into place by a general rotation and stored as binary STL (single precision: its faces planar
+/// only to about 1e-5 mm) plans a complete stack that `check` passes. Before session 33 the file did not read (its
+/// touching pieces linked into one shell); read with its faces merged but not flattened, the plan ended with an error
+/// ("LP for Chebyshev centre failed"). The reader now flattens the faces, and a cell no solver can solve is skipped
+/// and counted (`stats.cells_unsolved`), never the end of a plan.
+#[test]
+fn a_part_turned_and_stored_in_single_precision_plans_and_checks() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let o = run_in(dir.path(), &["part", "info", "example:channel", "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let info: Value = serde_json::from_str(&stdout(&o)).expect("json");
+    let (a, b, c) = (0.3f64, 0.7f64, 1.1f64);
+    let rz = [[a.cos(), -a.sin(), 0.0], [a.sin(), a.cos(), 0.0], [0.0, 0.0, 1.0]];
+    let ry = [[b.cos(), 0.0, b.sin()], [0.0, 1.0, 0.0], [-b.sin(), 0.0, b.cos()]];
+    let rx = [[1.0, 0.0, 0.0], [0.0, c.cos(), -c.sin()], [0.0, c.sin(), c.cos()]];
+    let apply = |m: [[f64; 3]; 3], v: [f64; 3]| -> [f64; 3] {
+        [0, 1, 2].map(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
+    };
+    let pieces: Vec<Vec<[f64; 3]>> = info["pieces"]
+        .as_array()
+        .expect("pieces")
+        .iter()
+        .map(|p| {
+            p["vertices"]
+                .as_array()
+                .expect("vertices")
+                .iter()
+                .map(|v| {
+                    let v = [0, 1, 2].map(|k| v[k].as_f64().expect("coordinate"));
+                    let t = apply(rz, apply(ry, apply(rx, v)));
+                    [t[0] + 123.25, t[1] - 45.5, t[2] + 7.0]
+                })
+                .collect()
+        })
+        .collect();
+    let turned = serde_json::json!({ "name": "turned", "convex_pieces": pieces });
+    std::fs::write(dir.path().join("turned.json"), turned.to_string()).expect("write");
+    let o = run_in(dir.path(), &["part", "export", "turned.json", "--stl", "turned.stl"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run_in(dir.path(), &["plan", "turned.stl", "--count", "8", "--w", "0.5", "--out", "p"]);
+    assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
+    let plan = read_json(&dir.path().join("p/plan.json"));
+    assert_eq!(plan["plan"]["placed"], 8, "{}", plan["plan"]["stopped"]);
+    let unsolved = plan["plan"]["stats"]["cells_unsolved"].as_u64().expect("cells_unsolved");
+    assert_eq!(unsolved > 0, stdout(&o).contains("could not be solved"), "the summary says so when cells were skipped");
+    let o = run_in(dir.path(), &["check", "p/plan.json"]);
+    assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
+}

@@ -213,6 +213,11 @@ pub struct PlacementStats {
     pub nodes_pushed: u64,
     /// Children found empty.
     pub cells_empty: u64,
+    /// Children whose cell could not be built (its LPs failed) or whose QP failed every solver (the exact active set,
+    /// the grown and reduced cell, clarabel): skipped with a warning, so the search no longer proves that what it returns is the cheapest (0 on well-formed parts;
+    /// parts whose faces are planar only to single precision can have c-space faces parallel to the last bit).
+    #[serde(default)]
+    pub cells_unsolved: u64,
     /// QPs solved.
     pub qp_solves: u64,
     /// Setup time (orientations, scene), ms.
@@ -1006,6 +1011,7 @@ fn merged_stats(searches: &[Search<'_, '_>]) -> PlacementStats {
         stats.nodes_expanded += s.nodes_expanded;
         stats.nodes_pushed += s.nodes_pushed;
         stats.cells_empty += s.cells_empty;
+        stats.cells_unsolved += s.cells_unsolved;
         stats.qp_solves += s.qp_solves;
         stats.time_setup_ms += s.time_setup_ms;
         stats.time_roots_ms += s.time_roots_ms;
@@ -2105,13 +2111,21 @@ impl Search<'_, '_> {
         start: &[f64; D],
         fixed_z: f64,
     ) -> Result<Option<(Cell<D>, QpOptimum<D>)>, PlacementError> {
-        let fs_err = |reason: String| PlacementError::FreeSpace { orientation, reason };
         // the child from the parent's optimum (it satisfies the parent and the obstacle's inside cuts; only the
         // child's outside face is violated): emptiness by a phase 1 from it (most children are empty), and a
         // non-empty child's interior point by a second phase 1 on the exact cell instead of the Chebyshev LP
         // (`Cell::with_halfspaces_from`; a cell thinner than the tolerance still gets the Chebyshev build). The QP's
         // optimum equals a cold build's up to rounding in the last bits.
-        let Some(cell) = parent.with_halfspaces_from(extra, start).map_err(|e| fs_err(e.to_string()))? else {
+        let built = match parent.with_halfspaces_from(extra, start) {
+            Ok(built) => built,
+            // the cell's LPs (phase 1, Chebyshev centre) failed: skipped and counted as an unsolved QP (below)
+            Err(e) => {
+                self.stats.cells_unsolved += 1;
+                tracing::warn!(orientation, reason = %e, "a free-space cell could not be built: skipped");
+                return Ok(None);
+            }
+        };
+        let Some(cell) = built else {
             self.stats.cells_empty += 1;
             return Ok(None);
         };
@@ -2121,10 +2135,17 @@ impl Search<'_, '_> {
         }
         self.stats.qp_solves += 1;
         let q = restrict_quadratic::<D>(&self.orientations[orientation].quadratic, fixed_z);
-        match minimise(&cell, &q).map_err(fs_err)? {
-            Some(opt) => Ok(Some((cell, opt))),
-            None => {
+        match minimise(&cell, &q) {
+            Ok(Some(opt)) => Ok(Some((cell, opt))),
+            Ok(None) => {
                 self.stats.cells_empty += 1;
+                Ok(None)
+            }
+            // no solver could find the cell's optimum: the cell is skipped (no placement is ever taken from it, so
+            // nothing returned interferes), and counted, since the search is then no longer exact
+            Err(reason) => {
+                self.stats.cells_unsolved += 1;
+                tracing::warn!(orientation, %reason, "a free-space cell could not be solved: skipped");
                 Ok(None)
             }
         }

@@ -197,6 +197,10 @@ pub struct PlanStats {
     /// Obstacles extrapolated within a constant-topology interval ([`crate::interval_obstacles`]).
     #[serde(default)]
     pub obstacles_extrapolated: u64,
+    /// Free-space cells whose QP no solver could solve, skipped ([`crate::search::SearchStats::cells_unsolved`]):
+    /// when not 0, a part's position is the cheapest of the cells solved, not proven the cheapest of all.
+    #[serde(default)]
+    pub cells_unsolved: u64,
     /// Seconds in the placement searches.
     pub seconds_search: f64,
     /// Seconds in the stack checks.
@@ -521,6 +525,7 @@ pub fn plan_stack_with_progress(
             stats.pairs_evaluated += searched.pairs_evaluated;
             stats.obstacles_constructed += searched.obstacles_constructed;
             stats.obstacles_extrapolated += searched.obstacles_extrapolated;
+            stats.cells_unsolved += searched.cells_unsolved;
             tracing::debug!(
                 index,
                 stage,

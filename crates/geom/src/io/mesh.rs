@@ -451,6 +451,15 @@ pub(crate) fn part_from_shells(
             Err(e) => return Err(e),
         }
     }
+    // faces planar only to a tolerance coarser than the kernel's (single precision): their corners moved onto their
+    // planes (`snap`), so that every later test, at the kernel's tolerance, sees them planar
+    if tolerance > Tolerance::for_points(points).linear {
+        let (flat, moved) = super::snap::flatten_faces(components, tolerance);
+        if moved > 0 {
+            tracing::debug!(file = %file.display(), corners = moved, "corners moved onto their faces' planes");
+        }
+        components = flat;
+    }
     let origin = if approximate { PartOrigin::ApproximateDecomposition } else { PartOrigin::Mesh };
     Part::from_components(name, components, density, origin)
         .map_err(|source| IoError::Part { file: file.to_path_buf(), source })

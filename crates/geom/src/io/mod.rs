@@ -19,6 +19,7 @@ pub mod glb;
 pub mod json;
 pub mod mesh;
 pub mod obj;
+mod snap;
 pub mod stack;
 pub mod stl;
 
