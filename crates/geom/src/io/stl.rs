@@ -16,7 +16,8 @@
 //! so no fan triangle is degenerate), with the face's outward normal. ASCII STL is written with the shortest text
 //! that parses back to the same `f64`, so a part reads back as its exact form (see the JSON writer). Binary STL
 //! stores `f32`: the vertices are rounded first and the hull taken of the rounded points, so the file reads back as
-//! the exact form of the rounded part (the same as ASCII's for coordinates representable in `f32`).
+//! the read form of the rounded part (the same as ASCII's for coordinates representable in `f32`): bit for bit where
+//! its faces are exactly planar in `f32`, else with those faces flattened (`super::snap`).
 
 use super::mesh::{
     MeshPolygon, Precision, Welder, mesh_tolerance, part_from_shells, significant_digits, split_shells, written_faces,
