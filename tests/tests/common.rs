@@ -38,3 +38,15 @@ pub fn stdout(o: &Output) -> String {
 pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
+
+/// `v` turned by `Rz(a) Ry(b) Rx(c)` (glam's `from_euler(ZYX, a, b, c)`): a general rotation, for parts written turned
+/// into place, whose faces are then planar only to rounding.
+pub fn turned_zyx((a, b, c): (f64, f64, f64), v: [f64; 3]) -> [f64; 3] {
+    let rz = [[a.cos(), -a.sin(), 0.0], [a.sin(), a.cos(), 0.0], [0.0, 0.0, 1.0]];
+    let ry = [[b.cos(), 0.0, b.sin()], [0.0, 1.0, 0.0], [-b.sin(), 0.0, b.cos()]];
+    let rx = [[1.0, 0.0, 0.0], [0.0, c.cos(), -c.sin()], [0.0, c.sin(), c.cos()]];
+    let apply = |m: [[f64; 3]; 3], v: [f64; 3]| -> [f64; 3] {
+        [0, 1, 2].map(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
+    };
+    apply(rz, apply(ry, apply(rx, v)))
+}

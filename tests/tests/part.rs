@@ -112,17 +112,10 @@ fn an_export_that_fails_for_one_format_writes_none() {
 #[test]
 fn mesh_tolerance_reads_a_mesh_planar_only_to_single_precision() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let (a, b, c) = (0.3f64, 0.7f64, 1.1f64);
-    let rz = [[a.cos(), -a.sin(), 0.0], [a.sin(), a.cos(), 0.0], [0.0, 0.0, 1.0]];
-    let ry = [[b.cos(), 0.0, b.sin()], [0.0, 1.0, 0.0], [-b.sin(), 0.0, b.cos()]];
-    let rx = [[1.0, 0.0, 0.0], [0.0, c.cos(), -c.sin()], [0.0, c.sin(), c.cos()]];
-    let apply = |m: [[f64; 3]; 3], v: [f64; 3]| -> [f64; 3] {
-        [0, 1, 2].map(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
-    };
     let mut text = String::from("o box\n");
     for i in 0..8usize {
         let bit = |k: usize, e: f64| if i & k == 0 { 0.0 } else { e };
-        let p = apply(rz, apply(ry, apply(rx, [bit(1, 40.0), bit(2, 25.0), bit(4, 3.0)])));
+        let p = turned_zyx((0.3, 0.7, 1.1), [bit(1, 40.0), bit(2, 25.0), bit(4, 3.0)]);
         let p = p.map(|x| (x + 100.0) as f32 as f64);
         text.push_str(&format!("v {:?} {:?} {:?}\n", p[0], p[1], p[2]));
     }

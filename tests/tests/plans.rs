@@ -396,13 +396,6 @@ fn a_part_turned_and_stored_in_single_precision_plans_and_checks() {
     let o = run_in(dir.path(), &["part", "info", "example:channel", "--json"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let info: Value = serde_json::from_str(&stdout(&o)).expect("json");
-    let (a, b, c) = (0.3f64, 0.7f64, 1.1f64);
-    let rz = [[a.cos(), -a.sin(), 0.0], [a.sin(), a.cos(), 0.0], [0.0, 0.0, 1.0]];
-    let ry = [[b.cos(), 0.0, b.sin()], [0.0, 1.0, 0.0], [-b.sin(), 0.0, b.cos()]];
-    let rx = [[1.0, 0.0, 0.0], [0.0, c.cos(), -c.sin()], [0.0, c.sin(), c.cos()]];
-    let apply = |m: [[f64; 3]; 3], v: [f64; 3]| -> [f64; 3] {
-        [0, 1, 2].map(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
-    };
     let pieces: Vec<Vec<[f64; 3]>> = info["pieces"]
         .as_array()
         .expect("pieces")
@@ -414,7 +407,7 @@ fn a_part_turned_and_stored_in_single_precision_plans_and_checks() {
                 .iter()
                 .map(|v| {
                     let v = [0, 1, 2].map(|k| v[k].as_f64().expect("coordinate"));
-                    let t = apply(rz, apply(ry, apply(rx, v)));
+                    let t = turned_zyx((0.3, 0.7, 1.1), v);
                     [t[0] + 123.25, t[1] - 45.5, t[2] + 7.0]
                 })
                 .collect()
