@@ -8,9 +8,11 @@
 //! parts placed 2 or 3 of 6 Triangle parts where the same part stored in `f64` placed all. This step moves every
 //! corner of such faces onto the planes it lies on, so that the part's faces are planar to `f64` rounding:
 //!
-//! 1. the faces of all components that share a corner and lie in one plane within the tolerance `t` (a face and the
-//!    touching face of the neighbouring component, coplanar faces of neighbouring components) form one **cluster**,
-//!    with one plane: the area-weighted normal of its faces (signs aligned) through the mean of its corners;
+//! 1. the faces of all components, and those of the whole part's hull (a face across several components, such as a
+//!    resting face on the tips of two flanges), that lie in one plane within the tolerance `t` (a face and the
+//!    touching face of the neighbouring component, coplanar faces of neighbouring components) form one **cluster**;
+//!    faces parallel within `4 t / D` (D the part's bounding diagonal) share one normal, the area-weighted normal of
+//!    their faces (signs aligned), and each cluster's plane goes through the mean of its corners;
 //! 2. a cluster is **creased** unless all its corners are exactly coplanar (exact `orient3d`);
 //! 3. every corner on a creased cluster moves by the least displacement `delta` that puts it on the planes of all
 //!    clusters it lies on, in the least-squares sense: `(N^T N + eps I) delta = N^T (d - N v)` with
@@ -21,6 +23,10 @@
 //!    read stays there (its faces stay as read). A corner shared by components moves once, for all of them;
 //! 4. each component is rebuilt as the merged hull of its moved corners (within `t`); a component whose rebuild fails
 //!    or loses faces is kept as read.
+//!
+//! When the planes of the whole hull's faces and the components' cannot all hold (the rounds end without agreeing:
+//! the whole hull merged within `t` sliver facets of a long part that are not one face), steps 1-3 run again without
+//! the whole hull's faces.
 //!
 //! Exactly planar faces and their corners are never moved, so a part whose faces are exactly planar (axis-aligned
 //! parts in any precision) reads back bit for bit. Cost: O(F log F + V) for F faces and V corners, plus one merged
@@ -43,6 +49,51 @@ const MAX_ROUNDS: usize = 200;
 /// The components with the corners of their creased faces moved onto their planes (module documentation); returns
 /// the components and the number of corners moved.
 pub(crate) fn flatten_faces(components: Vec<ConvexPolytope>, tolerance: f64) -> (Vec<ConvexPolytope>, usize) {
+    // with the whole hull's faces; when their planes and the components' cannot all hold (the hull merged within `t`
+    // facets that are not one face: a long part's hull has slivers folded by less than `t`), without them
+    let moves = match plan_moves(&components, tolerance, true) {
+        Some(m) if m.converged => Some(m),
+        _ => plan_moves(&components, tolerance, false),
+    };
+    let Some(Moves { ids, corners, moved_corner, .. }) = moves else {
+        return (components, 0);
+    };
+    let moved = moved_corner.iter().filter(|m| m.is_some()).count();
+    if moved == 0 {
+        return (components, 0);
+    }
+    let rebuilt = components
+        .into_iter()
+        .zip(&ids)
+        .map(|(comp, ids)| {
+            if ids.iter().all(|&v| moved_corner[v].is_none()) {
+                return comp;
+            }
+            let points: Vec<DVec3> = ids.iter().map(|&v| moved_corner[v].unwrap_or(corners[v])).collect();
+            match convex_hull_merged_within(&points, tolerance) {
+                Ok(h) if h.polytope.faces().len() == comp.faces().len() => h.polytope,
+                _ => comp,
+            }
+        })
+        .collect();
+    (rebuilt, moved)
+}
+
+/// Where the corners of the components go (by global corner): [`flatten_faces`]'s steps 1-3.
+struct Moves {
+    /// Per component, per vertex: its global corner.
+    ids: Vec<Vec<usize>>,
+    /// The global corners as read.
+    corners: Vec<DVec3>,
+    /// Per global corner: where it moves, if it moves.
+    moved_corner: Vec<Option<DVec3>>,
+    /// Whether every moved corner lies on its planes within `1e-13` of the coordinates.
+    converged: bool,
+}
+
+/// Steps 1-3 of the module documentation, with the whole hull's faces among the faces when `hull_faces`; `None` when
+/// no face is creased.
+fn plan_moves(components: &[ConvexPolytope], tolerance: f64, hull_faces: bool) -> Option<Moves> {
     // global corners by exact coordinates (components touching share them bit for bit)
     let mut id_of: HashMap<[u64; 3], usize> = HashMap::new();
     let mut corners: Vec<DVec3> = Vec::new();
@@ -70,6 +121,17 @@ pub(crate) fn flatten_faces(components: Vec<ConvexPolytope>, tolerance: f64) -> 
     for (c, comp) in components.iter().enumerate() {
         for f in comp.faces() {
             let corners_of: Vec<usize> = f.vertices.iter().map(|&v| ids[c][v]).collect();
+            faces.push(FaceRef { corners: corners_of, normal: f.plane.normal });
+        }
+    }
+    // the faces of the whole part's hull too (merged within the tolerance): a face across several components (a
+    // resting face on the tips of two flanges) is no component's face, and its corners are to lie in one plane as well
+    if hull_faces
+        && components.len() > 1
+        && let Ok(hull) = convex_hull_merged_within(&corners, tolerance)
+    {
+        for f in hull.polytope.faces() {
+            let corners_of: Vec<usize> = f.vertices.iter().map(|&v| hull.source[v]).collect();
             faces.push(FaceRef { corners: corners_of, normal: f.plane.normal });
         }
     }
@@ -143,7 +205,7 @@ pub(crate) fn flatten_faces(components: Vec<ConvexPolytope>, tolerance: f64) -> 
         creased.insert(r, !exact);
     }
     if !creased.values().any(|&c| c) {
-        return (components, 0);
+        return None;
     }
     // a class with a creased cluster: all its clusters move (their common normal is fitted anew)
     let mut class_creased: HashMap<usize, bool> = HashMap::new();
@@ -176,6 +238,7 @@ pub(crate) fn flatten_faces(components: Vec<ConvexPolytope>, tolerance: f64) -> 
     // around one edge) agree only after a few rounds
     let size = corners.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element())).max(1.0);
     let mut position = corners.clone();
+    let mut converged = false;
     let mut clusters_sorted: Vec<usize> = cluster_faces.keys().copied().collect();
     clusters_sorted.sort_unstable();
     for _round in 0..MAX_ROUNDS {
@@ -227,30 +290,13 @@ pub(crate) fn flatten_faces(components: Vec<ConvexPolytope>, tolerance: f64) -> 
         }
         tracing::trace!(round = _round, worst, inactive = active.iter().filter(|a| !**a).count(), "flattening");
         if worst <= 1e-13 * size {
+            converged = true;
             break;
         }
     }
     let moved_corner: Vec<Option<DVec3>> =
         (0..corners.len()).map(|v| (active[v] && position[v] != corners[v]).then_some(position[v])).collect();
-    let moved = moved_corner.iter().filter(|m| m.is_some()).count();
-    if moved == 0 {
-        return (components, 0);
-    }
-    let rebuilt = components
-        .into_iter()
-        .zip(&ids)
-        .map(|(comp, ids)| {
-            if ids.iter().all(|&v| moved_corner[v].is_none()) {
-                return comp;
-            }
-            let points: Vec<DVec3> = ids.iter().map(|&v| moved_corner[v].unwrap_or(corners[v])).collect();
-            match convex_hull_merged_within(&points, tolerance) {
-                Ok(h) if h.polytope.faces().len() == comp.faces().len() => h.polytope,
-                _ => comp,
-            }
-        })
-        .collect();
-    (rebuilt, moved)
+    Some(Moves { ids, corners, moved_corner, converged })
 }
 
 /// Three points of `pts` that are not collinear (exactly), if any.
