@@ -50,3 +50,32 @@ pub fn turned_zyx((a, b, c): (f64, f64, f64), v: [f64; 3]) -> [f64; 3] {
     };
     apply(rz, apply(ry, apply(rx, v)))
 }
+
+/// Writes the built-in example `name` turned by `Rz(0.3) Ry(0.7) Rx(1.1)` and moved by (123.25, -45.5, 7) into `dir`
+/// as `turned.json` (its convex pieces in `f64`) and `turned.stl` (binary: single precision), as `part info` and
+/// `part export` give them.
+pub fn write_turned_example(dir: &Path, name: &str) {
+    let o = run_in(dir, &["part", "info", &format!("example:{name}"), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let info: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("json");
+    let pieces: Vec<Vec<[f64; 3]>> = info["pieces"]
+        .as_array()
+        .expect("pieces")
+        .iter()
+        .map(|p| {
+            p["vertices"]
+                .as_array()
+                .expect("vertices")
+                .iter()
+                .map(|v| {
+                    let t = turned_zyx((0.3, 0.7, 1.1), [0, 1, 2].map(|k| v[k].as_f64().expect("coordinate")));
+                    [t[0] + 123.25, t[1] - 45.5, t[2] + 7.0]
+                })
+                .collect()
+        })
+        .collect();
+    let turned = serde_json::json!({ "name": "turned", "convex_pieces": pieces });
+    std::fs::write(dir.join("turned.json"), turned.to_string()).expect("write");
+    let o = run_in(dir, &["part", "export", "turned.json", "--stl", "turned.stl"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}

@@ -148,26 +148,7 @@ fn mesh_tolerance_reads_a_mesh_planar_only_to_single_precision() {
 #[test]
 fn a_part_turned_and_stored_in_single_precision_rests_as_in_double_precision() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let o = run_in(dir.path(), &["part", "info", "example:triangle", "--json"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let info: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("json");
-    let pieces: Vec<Vec<[f64; 3]>> = info["pieces"]
-        .as_array()
-        .expect("pieces")
-        .iter()
-        .map(|p| {
-            p["vertices"]
-                .as_array()
-                .expect("vertices")
-                .iter()
-                .map(|v| turned_zyx((0.3, 0.7, 1.1), [0, 1, 2].map(|k| v[k].as_f64().expect("coordinate"))))
-                .collect()
-        })
-        .collect();
-    let turned = serde_json::json!({ "name": "turned", "convex_pieces": pieces });
-    std::fs::write(dir.path().join("turned.json"), turned.to_string()).expect("write");
-    let o = run_in(dir.path(), &["part", "export", "turned.json", "--stl", "turned.stl"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    write_turned_example(dir.path(), "triangle");
     let margins = |file: &str| -> Vec<f64> {
         let o = run_in(dir.path(), &["part", "poses", file, "--json"]);
         assert!(o.status.success(), "{}", stderr(&o));

@@ -393,30 +393,7 @@ fn the_default_floor_has_room_beside_a_square_part() {
 #[test]
 fn a_part_turned_and_stored_in_single_precision_plans_and_checks() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let o = run_in(dir.path(), &["part", "info", "example:channel", "--json"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let info: Value = serde_json::from_str(&stdout(&o)).expect("json");
-    let pieces: Vec<Vec<[f64; 3]>> = info["pieces"]
-        .as_array()
-        .expect("pieces")
-        .iter()
-        .map(|p| {
-            p["vertices"]
-                .as_array()
-                .expect("vertices")
-                .iter()
-                .map(|v| {
-                    let v = [0, 1, 2].map(|k| v[k].as_f64().expect("coordinate"));
-                    let t = turned_zyx((0.3, 0.7, 1.1), v);
-                    [t[0] + 123.25, t[1] - 45.5, t[2] + 7.0]
-                })
-                .collect()
-        })
-        .collect();
-    let turned = serde_json::json!({ "name": "turned", "convex_pieces": pieces });
-    std::fs::write(dir.path().join("turned.json"), turned.to_string()).expect("write");
-    let o = run_in(dir.path(), &["part", "export", "turned.json", "--stl", "turned.stl"]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    write_turned_example(dir.path(), "channel");
     let o = run_in(dir.path(), &["plan", "turned.stl", "--count", "8", "--w", "0.5", "--out", "p"]);
     assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
     let plan = read_json(&dir.path().join("p/plan.json"));

@@ -59,6 +59,23 @@ pub struct Settled {
 /// enters through (`None` when `p` is already inside). The ray enters iff the open interval of `s` where every
 /// `n_k . q(s) < d_k - tol` is not empty; `s` itself is the exact touching value `max(0, max_k (n_k . p - d_k) /
 /// n_{k,z})` over the faces with `n_{k,z} > 0`, so the settled part touches and does not sink by the tolerance.
+/// The c-space obstacle of the moving part's component `mi` (turned by `rotation`) against the stack component `sc`,
+/// from the shared cache; a failure names the pair.
+fn stack_obstacle(
+    cache: &ObstacleCache,
+    mi: usize,
+    component: &stackplan_geom::ConvexPolytope,
+    rotation: DMat3,
+    sc: &crate::detect::StackComponent,
+) -> Result<std::sync::Arc<stackplan_cspace::Obstacle>, PlacementError> {
+    cache.get_or_build(mi, sc.part, sc.piece, component, rotation, &sc.world).map_err(|e| PlacementError::Obstacle {
+        moving_piece: mi,
+        fixed_part: sc.part,
+        fixed_piece: sc.piece,
+        reason: e.to_string(),
+    })
+}
+
 fn ray_entry(planes: impl Iterator<Item = (DVec3, f64)>, p: DVec3, tol: f64) -> Option<(f64, Option<usize>)> {
     // vertical component below which a face counts as vertical: its bound would lie beyond any stack
     const VERTICAL: f64 = 1e-12;
@@ -114,14 +131,7 @@ pub fn settle(
         .collect();
     let stop = |mi: usize, sc: &crate::detect::StackComponent| -> Result<Option<(f64, Contact)>, PlacementError> {
         let component = &part.components[mi];
-        let obstacle = cache.get_or_build(mi, sc.part, sc.piece, component, rotation, &sc.world).map_err(|e| {
-            PlacementError::Obstacle {
-                moving_piece: mi,
-                fixed_part: sc.part,
-                fixed_piece: sc.piece,
-                reason: e.to_string(),
-            }
-        })?;
+        let obstacle = stack_obstacle(cache, mi, component, rotation, sc)?;
         let planes = obstacle.planes().map(|pl| (pl.normal, pl.offset));
         let Some((s, face)) = ray_entry(planes, release, tol) else {
             return Ok(None);
@@ -227,14 +237,7 @@ pub fn lowest_release(
             continue;
         }
         for (mi, component) in part.components.iter().enumerate() {
-            let raw = cache.get_or_build(mi, sc.part, sc.piece, component, rotation, &sc.world).map_err(|e| {
-                PlacementError::Obstacle {
-                    moving_piece: mi,
-                    fixed_part: sc.part,
-                    fixed_piece: sc.piece,
-                    reason: e.to_string(),
-                }
-            })?;
+            let raw = stack_obstacle(cache, mi, component, rotation, sc)?;
             let derived = DerivedObstacle::from_obstacle(&raw, 0, mi, fi, clearance, true, insertion);
             if let Some(interval) = line_interval(&derived.planes, rest, tol) {
                 intervals.push(interval);

@@ -51,13 +51,16 @@ const MAX_ROUNDS: usize = 200;
 pub(crate) fn flatten_faces(components: Vec<ConvexPolytope>, tolerance: f64) -> (Vec<ConvexPolytope>, usize) {
     // with the whole hull's faces; when their planes and the components' cannot all hold (the hull merged within `t`
     // facets that are not one face: a long part's hull has slivers folded by less than `t`), without them
+    // (nothing creased with the whole hull's faces is nothing creased without them: no second attempt)
     let moves = match plan_moves(&components, tolerance, true) {
-        Some(m) if m.converged => Some(m),
-        _ => plan_moves(&components, tolerance, false),
+        None => return (components, 0),
+        Some(m) if m.converged => m,
+        Some(_) => match plan_moves(&components, tolerance, false) {
+            Some(m) => m,
+            None => return (components, 0),
+        },
     };
-    let Some(Moves { ids, corners, moved_corner, .. }) = moves else {
-        return (components, 0);
-    };
+    let Moves { ids, corners, moved_corner, .. } = moves;
     let moved = moved_corner.iter().filter(|m| m.is_some()).count();
     if moved == 0 {
         return (components, 0);
@@ -160,20 +163,10 @@ fn plan_moves(components: &[ConvexPolytope], tolerance: f64, hull_faces: bool) -
     let angle = 4.0 * tolerance / extent;
     let mut class_parent: Vec<usize> = (0..faces.len()).collect();
     let parallel = |f: &FaceRef, g: &FaceRef| f.normal.cross(g.normal).length() <= angle;
-    let pairs: Vec<(usize, usize)> = if faces.len() <= MAX_ALL_PAIRS {
-        (0..faces.len()).flat_map(|i| (i + 1..faces.len()).map(move |j| (i, j))).collect()
-    } else {
-        faces_at
-            .iter()
-            .flat_map(|around| {
-                around.iter().enumerate().flat_map(move |(a, &i)| around[a + 1..].iter().map(move |&j| (i, j)))
-            })
-            .collect()
-    };
-    for (i, j) in pairs {
+    let mut join = |i: usize, j: usize| {
         let (f, g) = (&faces[i], &faces[j]);
         if !parallel(f, g) {
-            continue;
+            return;
         }
         let (ci, cj) = (find(&mut class_parent, i), find(&mut class_parent, j));
         if ci != cj {
@@ -184,6 +177,22 @@ fn plan_moves(components: &[ConvexPolytope], tolerance: f64, hull_faces: bool) -
             let (ri, rj) = (find(&mut parent, i), find(&mut parent, j));
             if ri != rj {
                 parent[ri.max(rj)] = ri.min(rj);
+            }
+        }
+    };
+    // (the pairs are visited, never collected: 4096 faces make 8 million of them)
+    if faces.len() <= MAX_ALL_PAIRS {
+        for i in 0..faces.len() {
+            for j in i + 1..faces.len() {
+                join(i, j);
+            }
+        }
+    } else {
+        for around in &faces_at {
+            for (a, &i) in around.iter().enumerate() {
+                for &j in &around[a + 1..] {
+                    join(i, j);
+                }
             }
         }
     }
