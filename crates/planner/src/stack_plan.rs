@@ -278,7 +278,15 @@ fn clip_to_rectangle(poly: &[DVec2], lo: DVec2, hi: DVec2) -> Vec<DVec2> {
                 out.push(a);
             }
             if (da < 0.0) != (db < 0.0) && da != db {
-                out.push(a + (b - a) * (da / (da - db)));
+                // on the rectangle's side exactly (`d n` is `lo` or `hi`): interpolation leaves it an ulp off, and a
+                // footprint that only grew must contain the last one (the carried stage-1 frontier's test)
+                let mut cut = a + (b - a) * (da / (da - db));
+                if n.x != 0.0 {
+                    cut.x = d * n.x;
+                } else {
+                    cut.y = d * n.y;
+                }
+                out.push(cut);
             }
         }
     }
@@ -734,6 +742,38 @@ mod tests {
             .collect();
         let hull = convex_hull(&pts).expect("box").polytope;
         Part::from_components("block", vec![hull], 1.0, PartOrigin::ConvexPieces).expect("part")
+    }
+
+    /// The Complex plan's footprint at parts 9 and 10 (`w 0.9`): interpolated cuts left corners an ulp off the
+    /// rectangle (-270.99999999999994 beside -271), so the grown footprint did not contain the last one exactly and
+    /// the carried stage-1 frontier was dropped (6 800 nodes searched again from the roots).
+    #[test]
+    fn clipped_footprints_have_their_corners_on_the_rectangle_and_contain_the_smaller_ones() {
+        let floor = FloorVolume::rectangle(-501.5, -501.5, 501.5, 501.5, 1212.0).polygon;
+        let lo = DVec2::new(-271.0, -237.00000000000006);
+        let small = clip_to_rectangle(&floor, lo, DVec2::new(262.0, 274.00000000000006));
+        let grown = clip_to_rectangle(&floor, lo, DVec2::new(271.0, 274.00000000000006));
+        for (poly, hi) in [(&small, 262.0), (&grown, 271.0)] {
+            assert_eq!(poly.len(), 4);
+            for c in poly.iter() {
+                assert!(c.x == lo.x || c.x == hi, "{c:?}");
+                assert!(c.y == lo.y || c.y == 274.00000000000006, "{c:?}");
+            }
+        }
+        let sides = crate::request::polygon_side_planes(&grown);
+        assert!(small.iter().all(|&c| sides.iter().all(|&(n, d)| n.dot(c) <= d)), "{small:?} not inside {grown:?}");
+        // a floor that is no rectangle: the cuts lie on the rectangle's sides, its own corners stay
+        let hexagon: Vec<DVec2> = (0..6)
+            .map(|k| {
+                let a = std::f64::consts::PI / 3.0 * k as f64 + 0.1;
+                DVec2::new(500.0 * a.cos(), 500.0 * a.sin())
+            })
+            .collect();
+        let cut = clip_to_rectangle(&hexagon, DVec2::new(-301.3, -299.7), DVec2::new(299.9, 300.1));
+        for c in &cut {
+            let on_side = c.x == -301.3 || c.x == 299.9 || c.y == -299.7 || c.y == 300.1;
+            assert!(on_side || hexagon.contains(c), "{c:?}");
+        }
     }
 
     #[test]
