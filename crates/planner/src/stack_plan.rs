@@ -263,7 +263,7 @@ fn rows(m: DMat3) -> [[f64; 3]; 3] {
 }
 
 /// The floor polygon clipped to a rectangle (Sutherland-Hodgman; both convex, so the result is convex).
-fn clip_to_rectangle(poly: &[DVec2], lo: DVec2, hi: DVec2) -> Vec<DVec2> {
+pub(crate) fn clip_to_rectangle(poly: &[DVec2], lo: DVec2, hi: DVec2) -> Vec<DVec2> {
     let mut out = poly.to_vec();
     let edges: [(DVec2, f64); 4] = [(DVec2::X, hi.x), (DVec2::NEG_X, -lo.x), (DVec2::Y, hi.y), (DVec2::NEG_Y, -lo.y)];
     for (n, d) in edges {
