@@ -21,6 +21,13 @@
 //!   are computed per candidate;
 //! * one memo of rigid-body equilibrium answers ([`SolveCache`], exact keys) for the whole plan: the support-tree
 //!   edges the candidate does not load recur from candidate to candidate and from part to part;
+//! * the candidates found not stable on their supports (test 1), by part, rotation, position and tolerance (exact
+//!   bits): the planner meets the same free positions again part after part, and most are rejected so. Test 1 sees
+//!   only the candidate's contacts (with the floor, and with the placed parts whose boxes meet its box grown by the
+//!   tolerance: [`crate::contacts::contacts_of_part`]'s box test) and keeps only the contacts of the candidate, the
+//!   one movable part. So while no part placed since meets its grown box, the same candidate at the same tolerance
+//!   has the same contacts, the same equilibrium problem and the same verdict, and the memo answers it without
+//!   computing its contacts;
 //! * the grasp per part and rotation: the grasp of a part depends on its own material only, so a translated copy
 //!   has the same largest inscribed radius up to rounding (and the tolerance's last digits). A memoised radius
 //!   decides the verdict only when it is farther than [`GRASP_BAND`] (relative to the cup radius) from the cup
@@ -44,7 +51,7 @@ use crate::check::{CheckOptions, grasp_of};
 use crate::contacts::{ContactAnalysis, analyse_contacts, contacts_of_part};
 use crate::equilibrium::{EquilibriumOptions, SolveCache, Verdict, solve_equilibrium_with};
 use crate::insertion::{Obstruction, insertion_obstruction};
-use crate::world::{PlacedPart, WorldPart};
+use crate::world::{PlacedPart, WorldPart, aabb_overlap};
 use glam::DVec3;
 use stackplan_geom::Tolerance;
 use std::collections::HashMap;
@@ -122,8 +129,14 @@ pub struct GrowingStack<'a> {
     contacts: HashMap<u64, ContactAnalysis>,
     /// Largest grasp radius by part (address) and rotation (bits).
     grasps: HashMap<(usize, [u64; 9]), f64>,
+    /// Candidates found not stable on their supports, by part (address), rotation, position and tolerance (bits):
+    /// the number of parts placed then and the verdict (see the module documentation).
+    unstable: HashMap<UnstableKey, (usize, Verdict)>,
     cache: SolveCache,
 }
+
+/// A candidate's part (address), rotation and position (bits) and the tolerance (bits) it was tested at.
+type UnstableKey = (usize, [u64; 9], [u64; 3], u64);
 
 impl<'a> GrowingStack<'a> {
     /// An empty stack tested with `options` (friction, grasp, contact tolerance; clearance, margins and prefix
@@ -152,6 +165,7 @@ impl<'a> GrowingStack<'a> {
             bounds: None,
             contacts: HashMap::new(),
             grasps: HashMap::new(),
+            unstable: HashMap::new(),
             cache: SolveCache::new(),
         })
     }
@@ -168,15 +182,16 @@ impl<'a> GrowingStack<'a> {
     /// the policy's tolerance for the diagonal of the box of the placed parts and the candidate, rounded as
     /// [`ToleranceScale`] says. Errors: a bad pose.
     pub fn tolerance_for(&self, candidate: &PlacedPart<'_>) -> Result<f64, StabilityError> {
-        let new = WorldPart::new(candidate, self.world.len())?;
-        Ok(self.tolerance_with(&new))
+        let aabb = WorldPart::aabb_of(candidate, self.world.len())?;
+        Ok(self.tolerance_with(&aabb))
     }
 
-    fn tolerance_with(&self, new: &WorldPart) -> f64 {
+    /// The tolerance for the placed parts and a candidate with the box `aabb`.
+    fn tolerance_with(&self, aabb: &(DVec3, DVec3)) -> f64 {
         match self.options.contact_tolerance {
             Some(t) => t,
             None => {
-                let (lo, hi) = self.bounds_with(new);
+                let (lo, hi) = self.bounds_with(aabb);
                 let diagonal = (hi - lo).length();
                 let scale = match self.scale {
                     ToleranceScale::Exact => diagonal,
@@ -205,16 +220,16 @@ impl<'a> GrowingStack<'a> {
     /// Places a part on the stack (the caller's accepted candidate; it is not tested again).
     pub fn push(&mut self, part: PlacedPart<'a>) -> Result<(), StabilityError> {
         let world = WorldPart::new(&part, self.world.len())?;
-        self.bounds = Some(self.bounds_with(&world));
+        self.bounds = Some(self.bounds_with(&world.aabb));
         self.world.push(world);
         self.placed.push(part);
         self.contacts.clear();
         Ok(())
     }
 
-    fn bounds_with(&self, part: &WorldPart) -> (DVec3, DVec3) {
+    fn bounds_with(&self, aabb: &(DVec3, DVec3)) -> (DVec3, DVec3) {
         let (lo, hi) = self.bounds.unwrap_or((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)));
-        (lo.min(part.aabb.0), hi.max(part.aabb.1))
+        (lo.min(aabb.0), hi.max(aabb.1))
     }
 
     /// Whether `candidate` (at rest), released `release_drop` above its position, keeps the horizontal clearance
@@ -239,7 +254,7 @@ impl<'a> GrowingStack<'a> {
         let tol = match self.options.contact_tolerance {
             Some(t) => t,
             None => {
-                let (lo, hi) = self.bounds_with(&at_rest);
+                let (lo, hi) = self.bounds_with(&at_rest.aabb);
                 Tolerance::for_scale((hi - lo).length()).linear
             }
         };
@@ -256,8 +271,21 @@ impl<'a> GrowingStack<'a> {
         candidate: PlacedPart<'_>,
     ) -> Result<Result<Accepted, Rejection>, StabilityError> {
         let last = self.world.len();
+        // the candidate's box (its components are built only when the memo does not answer)
+        let aabb = WorldPart::aabb_of(&candidate, last)?;
+        let tol = self.tolerance_with(&aabb);
+        let key: UnstableKey = (
+            std::ptr::from_ref(candidate.part) as usize,
+            candidate.rotation.to_cols_array().map(f64::to_bits),
+            candidate.position.to_array().map(f64::to_bits),
+            tol.to_bits(),
+        );
+        if let Some((then, verdict)) = self.unstable.get(&key)
+            && self.world[*then..].iter().all(|p| !aabb_overlap(&p.aabb, &aabb, tol))
+        {
+            return Ok(Err(Rejection::NotStable(verdict.clone())));
+        }
         let new = WorldPart::new(&candidate, last)?;
-        let tol = self.tolerance_with(&new);
         let prefix = self.contacts.entry(tol.to_bits()).or_insert_with(|| analyse_contacts(&self.world, tol, |_| true));
         let (patches, interferences) = (prefix.patches.len(), prefix.interferences.len());
         self.world.push(new);
@@ -266,6 +294,9 @@ impl<'a> GrowingStack<'a> {
         prefix.patches.truncate(patches);
         prefix.interferences.truncate(interferences);
         self.world.pop();
+        if let Ok(Err(Rejection::NotStable(verdict))) = &outcome {
+            self.unstable.insert(key, (last, verdict.clone()));
+        }
         outcome
     }
 }

@@ -115,6 +115,26 @@ impl WorldPart {
         })
     }
 
+    /// The bounding box [`WorldPart::new`] gives `placed`, bit for bit (the same transformed vertices; a minimum
+    /// and a maximum do not round), without building its components; the same errors. O(vertices).
+    pub fn aabb_of(placed: &PlacedPart<'_>, index: usize) -> Result<(DVec3, DVec3), StabilityError> {
+        check_rotation(placed.rotation, index)?;
+        if !placed.position.is_finite() {
+            return Err(StabilityError::NonFinitePosition { part: index });
+        }
+        if placed.part.components.is_empty() {
+            return Err(StabilityError::EmptyPart { part: index });
+        }
+        Ok(placed.part.components.iter().flat_map(|c| c.vertices()).fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(lo, hi), v| {
+                // `ConvexPolytope::transformed`'s arithmetic
+                let w = placed.rotation * *v + placed.position;
+                (lo.min(w), hi.max(w))
+            },
+        ))
+    }
+
     /// Bounding-box diagonal.
     pub fn diagonal(&self) -> f64 {
         (self.aabb.1 - self.aabb.0).length()
@@ -146,4 +166,52 @@ pub fn aabb_overlap(a: &(DVec3, DVec3), b: &(DVec3, DVec3), margin: f64) -> bool
         && b.0.y <= a.1.y + margin
         && a.0.z <= b.1.z + margin
         && b.0.z <= a.1.z + margin
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::EulerRot;
+    use stackplan_geom::convex_hull;
+    use stackplan_geom::part::PartOrigin;
+
+    /// `aabb_of` is the box `WorldPart::new` builds, bit for bit, at turned poses far from the origin; and it fails
+    /// where `new` fails.
+    #[test]
+    fn the_box_without_the_components_is_the_world_parts_box() {
+        let corners = |lo: DVec3, hi: DVec3| -> Vec<DVec3> {
+            (0..8)
+                .map(|i| {
+                    DVec3::new(
+                        if i & 1 == 0 { lo.x } else { hi.x },
+                        if i & 2 == 0 { lo.y } else { hi.y },
+                        if i & 4 == 0 { lo.z } else { hi.z },
+                    )
+                })
+                .collect()
+        };
+        let pieces =
+            [(DVec3::ZERO, DVec3::new(60.0, 30.0, 2.0)), (DVec3::new(0.0, 0.0, 2.0), DVec3::new(2.0, 30.0, 40.0))];
+        let components =
+            pieces.iter().map(|(lo, hi)| convex_hull(&corners(*lo, *hi)).expect("hull").polytope).collect();
+        let part = Part::from_components("l", components, 1.0, PartOrigin::ConvexPieces).expect("part");
+        for k in 0..50 {
+            let t = k as f64;
+            let rotation = DMat3::from_euler(EulerRot::ZYX, 0.37 * t, 0.11 * t - 2.0, 0.05 * t);
+            let position = DVec3::new(1e5 * (t - 25.0).sin(), 13.7 * t, -0.3 * t);
+            let placed = PlacedPart { part: &part, rotation, position };
+            let boxed = WorldPart::aabb_of(&placed, k).expect("pose");
+            let built = WorldPart::new(&placed, k).expect("pose").aabb;
+            assert_eq!(boxed.0.to_array().map(f64::to_bits), built.0.to_array().map(f64::to_bits), "{k}");
+            assert_eq!(boxed.1.to_array().map(f64::to_bits), built.1.to_array().map(f64::to_bits), "{k}");
+        }
+        let bad = PlacedPart {
+            part: &part,
+            rotation: DMat3::from_diagonal(DVec3::new(1.0, 1.0, -1.0)),
+            position: DVec3::ZERO,
+        };
+        assert!(WorldPart::aabb_of(&bad, 3).is_err() && WorldPart::new(&bad, 3).is_err());
+        let nan = PlacedPart { part: &part, rotation: DMat3::IDENTITY, position: DVec3::new(f64::NAN, 0.0, 0.0) };
+        assert!(WorldPart::aabb_of(&nan, 3).is_err() && WorldPart::new(&nan, 3).is_err());
+    }
 }

@@ -188,6 +188,49 @@ fn the_grasp_memo_decides_like_the_grasp_at_each_pose() {
     assert_eq!(growing.check_candidate(moved).expect("candidate"), Err(Rejection::NotGraspable));
 }
 
+/// The memo of candidates found not stable on their supports: the same candidate is answered alike while no part
+/// placed since comes near it, and tested again once one does (here a plank put under its overhang, on which it then
+/// rests). Every answer is compared with a fresh stack's (no memo) and with `check_added_part`'s report; the parts
+/// placed lie inside the first box, so the tolerance does not change and only the box test decides.
+#[test]
+fn a_candidate_found_not_stable_is_tested_again_once_a_part_placed_since_comes_near_it() {
+    let plank = box_part("plank", DVec3::new(60.0, 30.0, 5.0));
+    let o = options(0.5, 10.0);
+    let base = at(&plank, DVec3::ZERO);
+    let corner = at(&plank, DVec3::new(200.0, 100.0, 0.0));
+    // on the base, its c.g. 10 mm beyond the base's edge: it tips over
+    let overhanging = at(&plank, DVec3::new(40.0, 0.0, 5.0));
+    // 20 mm beside the candidate: no contact with it
+    let beside = at(&plank, DVec3::new(0.0, 50.0, 0.0));
+    // under the overhang, 2 mm from the base: the candidate rests on both
+    let under = at(&plank, DVec3::new(62.0, 0.0, 0.0));
+    let mut growing = GrowingStack::new(&o).expect("options");
+    let mut stack = vec![base, corner];
+    for p in &stack {
+        growing.push(*p).expect("push");
+    }
+    let tol = growing.tolerance_for(&overhanging).expect("pose");
+    let first = growing.check_candidate(overhanging).expect("candidate");
+    assert!(matches!(first, Err(Rejection::NotStable(_))), "{first:?}");
+    for (added, stable) in [(beside, false), (under, true)] {
+        stack.push(added);
+        growing.push(added).expect("push");
+        assert_eq!(growing.tolerance_for(&overhanging).expect("pose").to_bits(), tol.to_bits());
+        let memoised = growing.check_candidate(overhanging).expect("candidate");
+        let mut fresh = GrowingStack::new(&o).expect("options");
+        for p in &stack {
+            fresh.push(*p).expect("push");
+        }
+        assert_eq!(memoised, fresh.check_candidate(overhanging).expect("candidate"));
+        let mut with = stack.clone();
+        with.push(overhanging);
+        let report =
+            check_added_part(&with, &CheckOptions { contact_tolerance: Some(tol), ..o.clone() }).expect("added");
+        assert_eq!(memoised.as_ref().err(), expected(&report).as_ref().err());
+        assert_eq!(memoised.is_ok(), stable, "{memoised:?}");
+    }
+}
+
 #[test]
 fn options_a_growing_stack_cannot_honour_are_errors() {
     let mut o = options(0.5, 10.0);
