@@ -42,4 +42,4 @@ pub use search::{
     Contact, NoPlacement, Placement, PlacementResult, PlacementSearch, PlacementStats, SearchCaches, place,
     place_with_cache, place_with_caches,
 };
-pub use stack_plan::{Plan, PlanError, PlanOptions, PlannedPart, plan_stack};
+pub use stack_plan::{DEFAULT_MAX_CANDIDATES, Plan, PlanError, PlanOptions, PlannedPart, plan_stack};
