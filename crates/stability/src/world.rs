@@ -172,29 +172,12 @@ pub fn aabb_overlap(a: &(DVec3, DVec3), b: &(DVec3, DVec3), margin: f64) -> bool
 mod tests {
     use super::*;
     use glam::EulerRot;
-    use stackplan_geom::convex_hull;
-    use stackplan_geom::part::PartOrigin;
 
     /// `aabb_of` is the box `WorldPart::new` builds, bit for bit, at turned poses far from the origin; and it fails
     /// where `new` fails.
     #[test]
     fn the_box_without_the_components_is_the_world_parts_box() {
-        let corners = |lo: DVec3, hi: DVec3| -> Vec<DVec3> {
-            (0..8)
-                .map(|i| {
-                    DVec3::new(
-                        if i & 1 == 0 { lo.x } else { hi.x },
-                        if i & 2 == 0 { lo.y } else { hi.y },
-                        if i & 4 == 0 { lo.z } else { hi.z },
-                    )
-                })
-                .collect()
-        };
-        let pieces =
-            [(DVec3::ZERO, DVec3::new(60.0, 30.0, 2.0)), (DVec3::new(0.0, 0.0, 2.0), DVec3::new(2.0, 30.0, 40.0))];
-        let components =
-            pieces.iter().map(|(lo, hi)| convex_hull(&corners(*lo, *hi)).expect("hull").polytope).collect();
-        let part = Part::from_components("l", components, 1.0, PartOrigin::ConvexPieces).expect("part");
+        let part = stackplan_geom::examples::l_corner_part();
         for k in 0..50 {
             let t = k as f64;
             let rotation = DMat3::from_euler(EulerRot::ZYX, 0.37 * t, 0.11 * t - 2.0, 0.05 * t);
