@@ -231,6 +231,34 @@ fn a_candidate_found_not_stable_is_tested_again_once_a_part_placed_since_comes_n
     }
 }
 
+/// The memos key a part by its geometry, not by its address: a part dropped and another one built in its place
+/// (with the allocator's reuse, usually at the same address), tested at the same pose and tolerance, is tested
+/// afresh. A 100 mm plank overhanging the base is not stable; a 40 mm one at the same pose is.
+#[test]
+fn the_memos_answer_only_for_the_part_they_were_made_for() {
+    let o = options(0.5, 10.0);
+    let base_part = box_part("base", DVec3::new(60.0, 30.0, 5.0));
+    let base = at(&base_part, DVec3::ZERO);
+    // both candidates' boxes with the base's have a diagonal that rounds up to 128 mm: the same tolerance
+    let mut growing = GrowingStack::new(&o).expect("options").with_tolerance_scale(ToleranceScale::PowerOfTwo);
+    growing.push(base).expect("push");
+    let mut fresh = GrowingStack::new(&o).expect("options").with_tolerance_scale(ToleranceScale::PowerOfTwo);
+    fresh.push(base).expect("push");
+    let pose = DVec3::new(20.0, 0.0, 5.0);
+    for round in 0..8 {
+        let long = Box::new(box_part("plank", DVec3::new(100.0, 30.0, 5.0)));
+        let tol = growing.tolerance_for(&at(&long, pose)).expect("pose");
+        let first = growing.check_candidate(at(&long, pose)).expect("candidate");
+        assert!(matches!(first, Err(Rejection::NotStable(_))), "round {round}: {first:?}");
+        drop(long);
+        let short = Box::new(box_part("plank", DVec3::new(40.0, 30.0, 5.0)));
+        assert_eq!(growing.tolerance_for(&at(&short, pose)).expect("pose").to_bits(), tol.to_bits());
+        let tested = growing.check_candidate(at(&short, pose)).expect("candidate");
+        assert_eq!(tested, fresh.check_candidate(at(&short, pose)).expect("candidate"), "round {round}");
+        assert!(tested.is_ok(), "round {round}: {tested:?}");
+    }
+}
+
 #[test]
 fn options_a_growing_stack_cannot_honour_are_errors() {
     let mut o = options(0.5, 10.0);
