@@ -139,8 +139,8 @@ pub struct GrowingStack<'a> {
 /// A candidate's part ([`part_fingerprint`]), rotation and position (bits) and the tolerance (bits) it was tested at.
 type UnstableKey = (u64, [u64; 9], [u64; 3], u64);
 
-/// A fingerprint of what the memoised answers of a part depend on: its components' vertices, its mass and its c.g.
-/// (the bits of each, mixed word by word). The memos key parts by it, not by their address: a part dropped and another
+/// A fingerprint of what the memoised answers of a part depend on: its components' vertices and faces, its mass and
+/// its c.g. (the bits of each, mixed word by word). The memos key parts by it, not by their address: a part dropped and another
 /// built at the same address during one stack's life would otherwise be answered for. O(vertices).
 fn part_fingerprint(part: &stackplan_geom::Part) -> u64 {
     let mut h = 0xcbf2_9ce4_8422_2325u64;
@@ -148,6 +148,11 @@ fn part_fingerprint(part: &stackplan_geom::Part) -> u64 {
     mix(part.components.len() as u64);
     for component in &part.components {
         mix(component.vertices().len() as u64);
+        // (the faces' partition of the boundary too: a face split in two offers the grasp smaller discs)
+        for face in component.faces() {
+            mix(face.vertices.len() as u64);
+            face.vertices.iter().for_each(|&v| mix(v as u64));
+        }
         for v in component.vertices() {
             v.to_array().map(f64::to_bits).into_iter().for_each(&mut mix);
         }
