@@ -668,7 +668,7 @@ fn scene_keys(stack: &[crate::request::StackPart<'_>]) -> Vec<SceneKey> {
             let fingerprint = match fingerprints.iter().find(|(p, _)| *p == at) {
                 Some(&(_, f)) => f,
                 None => {
-                    let f = part_fingerprint(s.part);
+                    let f = s.part.fingerprint();
                     fingerprints.push((at, f));
                     f
                 }
@@ -682,20 +682,6 @@ fn scene_keys(stack: &[crate::request::StackPart<'_>]) -> Vec<SceneKey> {
             (fingerprint, pose)
         })
         .collect()
-}
-
-/// A 64-bit hash of a part's component vertices (their bits, in order), which is all a scene takes from it.
-fn part_fingerprint(part: &stackplan_geom::Part) -> u64 {
-    use std::hash::{Hash, Hasher};
-    let mut hasher = std::collections::hash_map::DefaultHasher::new();
-    part.components.len().hash(&mut hasher);
-    for c in &part.components {
-        c.vertices().len().hash(&mut hasher);
-        for v in c.vertices() {
-            v.to_array().map(f64::to_bits).hash(&mut hasher);
-        }
-    }
-    hasher.finish()
 }
 
 /// What one partition of the orientations keeps from search to search ([`SearchCaches`]).
@@ -789,7 +775,7 @@ struct CacheSignature {
     horizontal: bool,
     extrapolate: bool,
     partitions: usize,
-    /// [`part_fingerprint`] of the part placed (the derived obstacles and structures are its components').
+    /// [`stackplan_geom::Part::fingerprint`] of the part placed (the derived obstacles and structures are its components').
     moving: u64,
     stack: Vec<SceneKey>,
 }
@@ -914,7 +900,7 @@ fn prepare<'r, 'a>(
         .collect();
     let keys = scene_keys(&request.stack);
     // the obstacle cache's keys name parts by index: refuse a cache built for another part or another stack
-    let moving = part_fingerprint(part);
+    let moving = part.fingerprint();
     let fixed: Vec<u64> = keys
         .iter()
         .map(|key| {

@@ -127,40 +127,17 @@ pub struct GrowingStack<'a> {
     bounds: Option<(DVec3, DVec3)>,
     /// Contacts among the placed parts, by the bits of the tolerance they were analysed with.
     contacts: HashMap<u64, ContactAnalysis>,
-    /// Largest grasp radius by part ([`part_fingerprint`]) and rotation (bits).
+    /// Largest grasp radius by part ([`stackplan_geom::Part::fingerprint`], not its address) and rotation (bits).
     grasps: HashMap<(u64, [u64; 9]), f64>,
-    /// Candidates found not stable on their supports, by part ([`part_fingerprint`]), rotation, position and
-    /// tolerance (bits):
-    /// the number of parts placed then and the verdict (see the module documentation).
+    /// Candidates found not stable on their supports, by [`UnstableKey`]: the number of parts placed then and the
+    /// verdict (see the module documentation).
     unstable: HashMap<UnstableKey, (usize, Verdict)>,
     cache: SolveCache,
 }
 
-/// A candidate's part ([`part_fingerprint`]), rotation and position (bits) and the tolerance (bits) it was tested at.
+/// A candidate's part ([`stackplan_geom::Part::fingerprint`]), rotation and position (bits) and the tolerance (bits)
+/// it was tested at.
 type UnstableKey = (u64, [u64; 9], [u64; 3], u64);
-
-/// A fingerprint of what the memoised answers of a part depend on: its components' vertices and faces, its mass and
-/// its c.g. (the bits of each, mixed word by word). The memos key parts by it, not by their address: a part dropped and another
-/// built at the same address during one stack's life would otherwise be answered for. O(vertices).
-fn part_fingerprint(part: &stackplan_geom::Part) -> u64 {
-    let mut h = 0xcbf2_9ce4_8422_2325u64;
-    let mut mix = |word: u64| h = (h ^ word).wrapping_mul(0x0000_0100_0000_01b3).rotate_left(29);
-    mix(part.components.len() as u64);
-    for component in &part.components {
-        mix(component.vertices().len() as u64);
-        // (the faces' partition of the boundary too: a face split in two offers the grasp smaller discs)
-        for face in component.faces() {
-            mix(face.vertices.len() as u64);
-            face.vertices.iter().for_each(|&v| mix(v as u64));
-        }
-        for v in component.vertices() {
-            v.to_array().map(f64::to_bits).into_iter().for_each(&mut mix);
-        }
-    }
-    mix(part.mass.mass.to_bits());
-    part.mass.center_of_gravity.to_array().map(f64::to_bits).into_iter().for_each(&mut mix);
-    h
-}
 
 impl<'a> GrowingStack<'a> {
     /// An empty stack tested with `options` (friction, grasp, contact tolerance; clearance, margins and prefix
@@ -298,8 +275,9 @@ impl<'a> GrowingStack<'a> {
         // the candidate's box (its components are built only when the memo does not answer)
         let aabb = WorldPart::aabb_of(&candidate, last)?;
         let tol = self.tolerance_with(&aabb);
+        let part = candidate.part.fingerprint();
         let key: UnstableKey = (
-            part_fingerprint(candidate.part),
+            part,
             candidate.rotation.to_cols_array().map(f64::to_bits),
             candidate.position.to_array().map(f64::to_bits),
             tol.to_bits(),
@@ -314,7 +292,8 @@ impl<'a> GrowingStack<'a> {
         let (patches, interferences) = (prefix.patches.len(), prefix.interferences.len());
         self.world.push(new);
         contacts_of_part(&self.world, last, tol, |_| true, prefix);
-        let outcome = test_last(&self.world, prefix, tol, &self.options, &self.cache, &mut self.grasps, candidate);
+        let outcome =
+            test_last(&self.world, prefix, tol, &self.options, &self.cache, &mut self.grasps, candidate, part);
         prefix.patches.truncate(patches);
         prefix.interferences.truncate(interferences);
         self.world.pop();
@@ -334,6 +313,7 @@ fn test_last(
     cache: &SolveCache,
     grasps: &mut HashMap<(u64, [u64; 9]), f64>,
     candidate: PlacedPart<'_>,
+    part: u64,
 ) -> Result<Result<Accepted, Rejection>, StabilityError> {
     let n = parts.len();
     let last = n - 1;
@@ -353,7 +333,7 @@ fn test_last(
     // the grasp: a memoised radius of the same rotation decides a clear verdict; else the grasp at this pose
     let mut exact: Option<(f64, bool)> = None;
     if options.grasp.pattern.is_empty() {
-        let key = (part_fingerprint(candidate.part), candidate.rotation.to_cols_array().map(f64::to_bits));
+        let key = (part, candidate.rotation.to_cols_array().map(f64::to_bits));
         let radius = match grasps.get(&key) {
             Some(r) => *r,
             None => {
