@@ -29,6 +29,7 @@ pub mod qp;
 pub mod reference;
 pub mod regress;
 pub mod request;
+mod round_end;
 pub mod search;
 pub mod settle;
 pub mod stack_plan;

@@ -80,7 +80,9 @@
 //! partition without a found placement whose next key pops before the best found one (of any partition, fixed at the
 //! round's start) searches on up to that key; the others, while one such partition runs, look ahead for their next
 //! placements (the caller often asks for more: the stacking planner rejects candidates; the work stays in the carried
-//! frontier either way). A partition that runs alone runs without rounds (nothing can change its bound). The bound is
+//! frontier either way). A partition that finishes its round first waits, spinning briefly, for the others
+//! (`round_end.rs`: the next round then finds both threads awake; timing only). A partition that runs alone runs
+//! without rounds (nothing can change its bound). The bound is
 //! exchanged only between rounds and every round's work is a function of the states at its start, so the states
 //! after each call, hence the carried frontiers, the later candidates and the plans, depend on `P` but never on the
 //! thread count or the timing (a shared atomic "best so far" would make them timing-dependent). `P = 1` is the
@@ -101,6 +103,7 @@ use crate::obstacles::{DerivedObstacle, PlaneOrigin};
 use crate::orientation::{Orientation, SeparableQuadratic, rotated_components};
 use crate::qp::{QpOptimum, Quadratic, minimise};
 use crate::request::{FloorVolume, PlacementError, PlacementRequest, polygon_side_planes};
+use crate::round_end::RoundEnd;
 use crate::symmetry::{is_uniform_full_turn, period_length, rotational_order};
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
@@ -1408,14 +1411,23 @@ fn advance_all<const D: usize>(
         }
         // a round: the needed partitions search for their next placement up to the best one, the others look
         // further ahead (placements the caller may ask for next; the work stays in the state either way)
+        // (a partition that finishes its round first waits, spinning, for the others: `RoundEnd`)
+        let round_end = RoundEnd::new(roles.len());
         let results: Vec<Result<(), PlacementError>> = searches
             .par_iter_mut()
             .zip(states.par_iter_mut())
             .zip(roles.par_iter())
-            .map(|((search, state), &role)| match role {
-                1 => search.step(state, 1, max_cost, bound, ROUND_POPS),
-                2 => search.step(state, LOOK_AHEAD - state.ahead.len(), max_cost, None, ROUND_POPS),
-                _ => Ok(()),
+            .enumerate()
+            .map(|(i, ((search, state), &role))| {
+                let want = match role {
+                    1 => 1,
+                    2 => LOOK_AHEAD - state.ahead.len(),
+                    _ => return Ok(()),
+                };
+                round_end.start(i);
+                let result = search.step(state, want, max_cost, (role == 1).then_some(bound).flatten(), ROUND_POPS);
+                round_end.finish(i);
+                result
             })
             .collect();
         for result in results {

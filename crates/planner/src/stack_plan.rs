@@ -309,10 +309,24 @@ pub fn plan_stack(part: &Part, options: &PlanOptions) -> Result<Plan, PlanError>
 }
 
 /// [`plan_stack`] calling `progress(parts placed, count)` after every part.
+///
+/// The plan runs on a thread of rayon's current pool (the calling thread when it is one): the searches' rounds
+/// ([`crate::search`]) are then parallel loops started from a worker, which hands the other partition to the other
+/// worker directly instead of queueing the whole loop from outside and sleeping until it ends (a wake-up per round;
+/// docs/benchmarks.md, session 35). The plan does not depend on it, nor on the number of threads.
 pub fn plan_stack_with_progress(
     part: &Part,
     options: &PlanOptions,
-    progress: &mut dyn FnMut(usize, usize),
+    progress: &mut (dyn FnMut(usize, usize) + Send),
+) -> Result<Plan, PlanError> {
+    rayon::scope(|_| plan_stack_here(part, options, progress))
+}
+
+/// [`plan_stack_with_progress`] on the calling thread.
+fn plan_stack_here(
+    part: &Part,
+    options: &PlanOptions,
+    progress: &mut (dyn FnMut(usize, usize) + Send),
 ) -> Result<Plan, PlanError> {
     if options.count == 0 {
         return Err(PlanError::BadOption("the number of parts must be at least 1".into()));

@@ -147,7 +147,11 @@ impl PlannerArgs {
 
 /// Runs the planner; `progress(parts placed)` after every part. Returns the plan and the seconds it took; an error
 /// when not even the first part could be placed.
-pub fn run_planner(part: &Part, options: &PlanOptions, progress: &mut dyn FnMut(usize)) -> anyhow::Result<(Plan, f64)> {
+pub fn run_planner(
+    part: &Part,
+    options: &PlanOptions,
+    progress: &mut (dyn FnMut(usize) + Send),
+) -> anyhow::Result<(Plan, f64)> {
     let started = std::time::Instant::now();
     let plan = plan_stack_with_progress(part, options, &mut |done, _| progress(done))?;
     let seconds = started.elapsed().as_secs_f64();
