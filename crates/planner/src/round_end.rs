@@ -15,13 +15,18 @@
 //! the loop's items one after the other) is not waited for. The spin is bounded by [`SPIN_LIMIT`] anyway. Nothing
 //! of the search's results depends on it: each round's work is fixed at its start.
 //!
-//! Cost: O(partitions) per check, at most [`SPIN_LIMIT`] of spinning per round.
+//! Cost: O(partitions) per check, at most [`SPIN_LIMIT`] of waiting per round: a few hundred spins, then
+//! `yield_now` (the thread stays awake but gives its core to a runnable thread, such as the partition it waits for
+//! when the machine has fewer free cores than rayon has threads).
 
 use std::sync::atomic::{AtomicU8, Ordering};
 use std::time::{Duration, Instant};
 
 /// The longest a finished partition spins for the others (then it returns to rayon's own idle loop).
 pub const SPIN_LIMIT: Duration = Duration::from_millis(2);
+
+/// Spins before the wait starts yielding.
+const PURE_SPINS: u32 = 256;
 
 const IDLE: u8 = 0;
 const RUNNING: u8 = 1;
@@ -58,7 +63,14 @@ impl RoundEnd {
             if !self.phases.iter().any(|p| p.load(Ordering::Acquire) == RUNNING) {
                 return true;
             }
-            std::hint::spin_loop();
+            // a short spin, then yields: with more threads than free cores (a loaded machine, `--threads` above the
+            // core count) the running partition may need this core, and a yield gives it; an idle core returns
+            // from the yield at once, still awake
+            if spins < PURE_SPINS {
+                std::hint::spin_loop();
+            } else {
+                std::thread::yield_now();
+            }
             spins = spins.wrapping_add(1);
             // the clock read costs more than a spin: every 64th
             if spins.is_multiple_of(64) && started.elapsed() >= SPIN_LIMIT {
