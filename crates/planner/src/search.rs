@@ -1425,7 +1425,8 @@ fn advance_all<const D: usize>(
                     _ => return Ok(()),
                 };
                 round_end.start(i);
-                let result = search.step(state, want, max_cost, (role == 1).then_some(bound).flatten(), ROUND_POPS);
+                let bound = if role == 1 { bound } else { None };
+                let result = search.step(state, want, max_cost, bound, ROUND_POPS);
                 round_end.finish(i);
                 result
             })

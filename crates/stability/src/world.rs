@@ -86,22 +86,29 @@ pub fn check_rotation(rotation: DMat3, part: usize) -> Result<(), StabilityError
     Ok(())
 }
 
+/// The errors of a placed part (index `index` in its stack) that [`WorldPart::new`] and [`WorldPart::aabb_of`]
+/// refuse: a rotation that is not one, a position that is not finite, a part without components.
+fn check_placed(placed: &PlacedPart<'_>, index: usize) -> Result<(), StabilityError> {
+    check_rotation(placed.rotation, index)?;
+    if !placed.position.is_finite() {
+        return Err(StabilityError::NonFinitePosition { part: index });
+    }
+    if placed.part.components.is_empty() {
+        return Err(StabilityError::EmptyPart { part: index });
+    }
+    Ok(())
+}
+
 impl WorldPart {
     /// Transforms the part `placed` (index `index` in its stack, used in errors).
     pub fn new(placed: &PlacedPart<'_>, index: usize) -> Result<Self, StabilityError> {
-        check_rotation(placed.rotation, index)?;
-        if !placed.position.is_finite() {
-            return Err(StabilityError::NonFinitePosition { part: index });
-        }
+        check_placed(placed, index)?;
         let components: Vec<WorldComponent> = placed
             .part
             .components
             .iter()
             .map(|c| WorldComponent::new(c.transformed(placed.rotation, placed.position)))
             .collect();
-        if components.is_empty() {
-            return Err(StabilityError::EmptyPart { part: index });
-        }
         let aabb =
             components.iter().fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), c| {
                 (lo.min(c.aabb.0), hi.max(c.aabb.1))
@@ -118,13 +125,7 @@ impl WorldPart {
     /// The bounding box [`WorldPart::new`] gives `placed`, bit for bit (the same transformed vertices; a minimum
     /// and a maximum do not round), without building its components; the same errors. O(vertices).
     pub fn aabb_of(placed: &PlacedPart<'_>, index: usize) -> Result<(DVec3, DVec3), StabilityError> {
-        check_rotation(placed.rotation, index)?;
-        if !placed.position.is_finite() {
-            return Err(StabilityError::NonFinitePosition { part: index });
-        }
-        if placed.part.components.is_empty() {
-            return Err(StabilityError::EmptyPart { part: index });
-        }
+        check_placed(placed, index)?;
         Ok(placed.part.components.iter().flat_map(|c| c.vertices()).fold(
             (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
             |(lo, hi), v| {
