@@ -9,6 +9,7 @@
 //! * [`accurate_normal`]: the normal of the plane through three points, accurate for slivers (the hull's face planes);
 //! * [`mass`]: volume, centre of gravity and inertia tensor;
 //! * [`part`]: rigid parts as unions of convex components, with boundary faces;
+//! * [`plate`]: the flat plates of sheet-metal parts, and when two plates' pieces may stand for their filled outlines;
 //! * [`pose`]: rigid poses (rotation and position) of placed parts;
 //! * [`io`]: file formats (part JSON, STL, OBJ, glTF export, stack files) with located errors.
 
@@ -19,6 +20,7 @@ pub mod hull;
 pub mod io;
 pub mod mass;
 pub mod part;
+pub mod plate;
 pub mod polygon;
 pub mod polytope;
 pub mod pose;

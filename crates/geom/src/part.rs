@@ -5,6 +5,7 @@
 //! boundary of the union, kept as planar polygons with holes in [`Part::boundary`].
 
 use crate::mass::{MassProperties, Moments};
+use crate::plate::Plate;
 use crate::polytope::{ConvexPolytope, Plane};
 use crate::tolerance::Tolerance;
 use glam::DVec3;
@@ -70,6 +71,11 @@ pub struct Part {
     pub density: f64,
     /// How the part was made.
     pub origin: PartOrigin,
+    /// Flat plates: the components that came from one sheet-metal face with a convex outline (empty for other
+    /// parts). A search may let the pieces of two parallel plates stand for their filled outlines where that is exact
+    /// ([`crate::plate::merges_exactly`]); nothing else depends on them.
+    #[serde(default)]
+    pub plates: Vec<Plate>,
 }
 
 /// The point a part's moments are summed about (see `mass`: about the origin, a part far from it loses digits of
@@ -116,7 +122,7 @@ impl Part {
         }
         let mass = total.properties_about(density, reference).ok_or(PartError::ZeroVolume(0))?;
         let boundary = boundary_faces(&components);
-        Ok(Self { name: name.into(), components, boundary, mass, density, origin })
+        Ok(Self { name: name.into(), components, boundary, mass, density, origin, plates: Vec::new() })
     }
 
     /// Axis-aligned bounding box of the part `(min, max)`.
@@ -149,6 +155,15 @@ impl Part {
                 mix(face.vertices.len() as u64);
                 face.vertices.iter().for_each(|&v| mix(v as u64));
             }
+        }
+        // the plates (which pieces stand for a filled outline in a search's cache)
+        mix(self.plates.len() as u64);
+        for plate in &self.plates {
+            mix(plate.pieces.len() as u64);
+            plate.pieces.iter().for_each(|&i| mix(i as u64));
+            plate.normal.to_array().map(f64::to_bits).into_iter().for_each(&mut mix);
+            mix(plate.outline_diameter.to_bits());
+            mix(plate.hole_diameter.to_bits());
         }
         mix(self.mass.mass.to_bits());
         self.mass.center_of_gravity.to_array().map(f64::to_bits).into_iter().for_each(&mut mix);

@@ -21,6 +21,7 @@
 
 use crate::convex_merge::merge_convex;
 use crate::part::{Part, PartError, PartOrigin};
+use crate::plate::Plate;
 use crate::polygon::{
     FacePlane, RingDefect, check_rings, drop_collinear, is_convex_ccw, ring_orientation, simplify_ring,
 };
@@ -303,11 +304,34 @@ impl SheetMetal {
     }
 
     /// Builds the rigid part: validation, decomposition, extrusion, mass properties and boundary faces.
+    /// Every face with a convex outline is a [`Plate`] of the part (its prisms' indices, normal, filled outline and
+    /// the diameters of its outline and largest hole).
     pub fn build_part(&self, name: &str, density: f64, decomposition: Decomposition) -> Result<Part, SheetMetalError> {
-        let components: Vec<ConvexPolytope> = self.decompose(decomposition)?.into_iter().flatten().collect();
-        let part =
+        self.check_thickness()?;
+        let mut components: Vec<ConvexPolytope> = Vec::new();
+        let mut plates: Vec<Plate> = Vec::new();
+        for face in 0..self.faces.len() {
+            let d = self.decompose_face(face, decomposition)?;
+            let prisms = extrude(face, &d, self.thickness)?;
+            let corners = |ring: &[usize]| ring.iter().map(|&i| d.points_on_plane[i]).collect::<Vec<DVec3>>();
+            let outline_2d: Vec<DVec2> = d.outline.iter().map(|&i| d.points[i]).collect();
+            if !prisms.is_empty() && is_convex_ccw(&outline_2d) {
+                let holes: Vec<Vec<DVec3>> = d.holes.iter().map(|h| corners(h)).collect();
+                let pieces = (components.len()..components.len() + prisms.len()).collect();
+                plates.extend(Plate::new(pieces, &prisms, d.plane.normal, &corners(&d.outline), &holes));
+            }
+            components.extend(prisms);
+        }
+        let mut part =
             Part::from_components(name, components, density, PartOrigin::SheetMetal { thickness: self.thickness })?;
-        tracing::debug!(name, components = part.components.len(), volume = part.mass.volume, "built sheet-metal part");
+        part.plates = plates;
+        tracing::debug!(
+            name,
+            components = part.components.len(),
+            plates = part.plates.len(),
+            volume = part.mass.volume,
+            "built sheet-metal part"
+        );
         Ok(part)
     }
 }
