@@ -207,7 +207,7 @@ pub struct PlanStats {
     /// Obstacles extrapolated within a constant-topology interval ([`crate::interval_obstacles`]).
     #[serde(default)]
     pub obstacles_extrapolated: u64,
-    /// Free-space cells whose QP no solver could solve, skipped ([`crate::search::SearchStats::cells_unsolved`]):
+    /// Free-space cells whose QP no solver could solve, skipped ([`crate::search::PlacementStats::cells_unsolved`]):
     /// when not 0, a part's position is the cheapest of the cells solved, not proven the cheapest of all.
     #[serde(default)]
     pub cells_unsolved: u64,

@@ -36,7 +36,7 @@
 //! ([`crate::tolerance`]); for single-precision coordinates, `16 x 2^-24 x` the largest coordinate magnitude, 16
 //! roundings to `f32`; and [`super::ReadOptions::mesh_tolerance`] when given, for files written with fewer digits
 //! still. Coordinates are single precision in binary STL (`f32`), and in a text file (ASCII STL, OBJ) when none is
-//! written with more than 9 significant digits, the most an `f32` needs to be written exactly ([`Precision`]):
+//! written with more than 9 significant digits, the most an `f32` needs to be written exactly (`Precision`):
 //! exporters write 6 to 9 (the STL specification says that ASCII STL is single precision too), while a file written
 //! with the shortest text of `f64` values, as the writers here do, has 15 to 17 for a part turned into place, and is
 //! then taken as written. The rounding of a face's corners moves them off its plane by at most one rounding each, and
