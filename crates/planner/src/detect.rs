@@ -53,12 +53,26 @@ pub struct StackScene {
     parts: usize,
     /// The components' boxes (`placed.aabb`) in one compact list, for the broad phase.
     boxes: Vec<(DVec3, DVec3)>,
+    /// Per stack part: the index of its first component in [`StackScene::components`].
+    pub part_first: Vec<usize>,
+    /// Per component: the plate of its part it belongs to ([`stackplan_geom::Part::plates`]), if any.
+    pub plate_of: Vec<Option<u32>>,
+    /// Per stack part, per plate: the filled plate in world coordinates.
+    pub plates_world: Vec<Vec<ConvexPolytope>>,
 }
 
 impl StackScene {
     /// Places every component. O(total size).
     pub fn new(parts: &[(&Part, Pose)]) -> Self {
-        let mut scene = Self { components: Vec::new(), top: 0.0, parts: 0, boxes: Vec::new() };
+        let mut scene = Self {
+            components: Vec::new(),
+            top: 0.0,
+            parts: 0,
+            boxes: Vec::new(),
+            part_first: Vec::new(),
+            plate_of: Vec::new(),
+            plates_world: Vec::new(),
+        };
         for &(part, pose) in parts {
             scene.push_part(part, pose);
         }
@@ -68,6 +82,18 @@ impl StackScene {
     /// Places one more stack part's components (stack part index [`StackScene::parts`] before the call): the scene
     /// of the longer list, as [`StackScene::new`] builds it. O(size of the part).
     pub fn push_part(&mut self, part: &Part, pose: Pose) {
+        self.part_first.push(self.components.len());
+        let mut plate_of = vec![None; part.components.len()];
+        for (k, plate) in part.plates.iter().enumerate() {
+            for &i in &plate.pieces {
+                if let Some(slot) = plate_of.get_mut(i) {
+                    *slot = Some(k as u32);
+                }
+            }
+        }
+        self.plate_of.extend(plate_of);
+        self.plates_world
+            .push(part.plates.iter().map(|p| p.filled.transformed(pose.rotation, pose.position)).collect());
         for (ci, c) in part.components.iter().enumerate() {
             let world = c.transformed(pose.rotation, pose.position);
             let turned = Arc::new(c.transformed(pose.rotation, DVec3::ZERO));

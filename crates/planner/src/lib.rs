@@ -10,6 +10,7 @@
 //! * [`detect`]: interference pairs at a configuration (broad phase + exact narrow phase, insertion sweeps);
 //! * [`interval_obstacles`]: obstacles constructed at interval starts and extrapolated inside (\[A\] IV-B);
 //! * [`obstacles`]: the pair obstacles cut out (plain, insertion, clearance) with face provenance;
+//! * `plates.rs` (private): one obstacle for two parallel sheet-metal plates where that is exact;
 //! * [`dary_heap`]: the 4-ary heap of the search's open nodes;
 //! * [`qp`]: the QP on a free-space cell with its active constraints;
 //! * [`search`]: the best-first search and its statistics (\[A\] Tables I-II);
@@ -25,6 +26,7 @@ pub mod detect;
 pub mod interval_obstacles;
 pub mod obstacles;
 pub mod orientation;
+mod plates;
 pub mod qp;
 pub mod reference;
 pub mod regress;

@@ -611,6 +611,8 @@ struct Search<'r, 'a> {
     rotated: HashMap<[u64; 9], RotatedComponents>,
     detect_scratch: DetectScratch,
     intervals: IntervalObstacles,
+    /// Per moving component, its plate when the request merges plates ([`crate::plates::moving_plates`]).
+    moving_plate_of: Arc<[Option<u32>]>,
     stats: PlacementStats,
     /// Rounds of the partitioned loop run (first partition only; for the debug log).
     rounds: u64,
@@ -777,6 +779,7 @@ struct CacheSignature {
     insertion: bool,
     horizontal: bool,
     extrapolate: bool,
+    merge_plates: bool,
     partitions: usize,
     /// [`stackplan_geom::Part::fingerprint`] of the part placed (the derived obstacles and structures are its components').
     moving: u64,
@@ -825,6 +828,7 @@ impl SearchCaches {
                 && old.insertion == next.insertion
                 && old.horizontal == next.horizontal
                 && old.extrapolate == next.extrapolate
+                && old.merge_plates == next.merge_plates
                 && old.partitions == next.partitions
                 && old.moving == next.moving
                 && old.stack.len() <= next.stack.len()
@@ -936,6 +940,7 @@ fn prepare<'r, 'a>(
         insertion: request.insertion,
         horizontal: request.horizontal_clearance,
         extrapolate: request.extrapolate,
+        merge_plates: request.merge_plates,
         partitions: request.partitions,
         moving,
         stack: keys,
@@ -944,6 +949,7 @@ fn prepare<'r, 'a>(
     let lanes = request.partitions;
     let mut searches = Vec::with_capacity(lanes);
     let caches_events = caches.events.clone();
+    let moving_plate_of: Arc<[Option<u32>]> = crate::plates::moving_plates(request).into();
     for (lane, lane_caches) in caches.lanes.iter_mut().enumerate() {
         // the pairs earlier searches built, by orientation (one pass over the shared derived obstacles); caches that
         // carry frontiers keep the obstacle table itself (carried cells name obstacles by id)
@@ -959,6 +965,7 @@ fn prepare<'r, 'a>(
             }
         }
         table.by_orientation.resize_with(n_orientations, KnownObstacles::default);
+        let moving_plate_of: Arc<[Option<u32>]> = Arc::clone(&moving_plate_of);
         searches.push(Search {
             request,
             lane,
@@ -982,6 +989,7 @@ fn prepare<'r, 'a>(
                 intervals.share_events(&caches_events);
                 intervals
             },
+            moving_plate_of: Arc::clone(&moving_plate_of),
             stats: stats.clone(),
             rounds: 0,
         });
@@ -1925,6 +1933,17 @@ impl Search<'_, '_> {
 
     /// The id of the derived obstacle of a pair at an orientation, building it on first use.
     fn obstacle_id(&mut self, orientation: usize, moving: usize, fixed: usize) -> Result<u32, PlacementError> {
+        // the pieces of two plates that merge share the filled plates' obstacle, named by their first pieces
+        let merged = crate::plates::merged_pair(
+            self.request,
+            &self.moving_plate_of,
+            &self.scene,
+            self.orientations[orientation].rotation,
+            moving,
+            fixed,
+            self.tol.linear,
+        );
+        let (moving, fixed) = merged.map_or((moving, fixed), |m| (m.moving, m.fixed));
         if let Some(id) = self.obstacle_ids.get(&(orientation, moving, fixed)) {
             return Ok(*id);
         }
@@ -1946,7 +1965,10 @@ impl Search<'_, '_> {
             fixed_piece: sc.piece,
             reason,
         };
-        let raw = if self.request.extrapolate {
+        let raw = if let Some(pair) = &merged {
+            crate::plates::merged_obstacle(self.request, &self.scene, self.cache, pair, o.rotation)
+                .map_err(|e| to_error(format!("the filled plates' obstacle: {e}")))?
+        } else if self.request.extrapolate {
             let rest_rotation = self.request.resting_rotations[o.rest];
             let (raw, route) = self
                 .intervals
@@ -1961,7 +1983,7 @@ impl Search<'_, '_> {
                 .get_or_build(moving, sc.part, sc.piece, &self.request.part.components[moving], o.rotation, &sc.world)
                 .map_err(|e| to_error(e.to_string()))?
         };
-        let built = Arc::new(DerivedObstacle::from_obstacle(
+        let mut built = DerivedObstacle::from_obstacle(
             &raw,
             o.index,
             moving,
@@ -1969,7 +1991,9 @@ impl Search<'_, '_> {
             self.request.clearance,
             self.request.horizontal_clearance,
             self.request.insertion,
-        ));
+        );
+        built.plates = merged.map(|m| (m.moving_plate, m.fixed_plate));
+        let built = Arc::new(built);
         self.derived.insert((orientation, moving, fixed), Arc::clone(&built));
         let id = self.obstacles.len() as u32;
         self.by_orientation[orientation].push(id, &built);
@@ -2181,6 +2205,32 @@ impl Search<'_, '_> {
                     } else {
                         ob.origins[face as usize].name()
                     };
+                    if let Some((moving_plate, fixed_plate)) = ob.plates {
+                        // the filled plates' face: the plates' pieces that touch
+                        let touching = crate::plates::touching_pieces(
+                            self.request,
+                            &self.scene,
+                            &o.components,
+                            moving_plate,
+                            sc.part,
+                            fixed_plate,
+                            p,
+                            self.request.clearance,
+                            self.tol.linear,
+                        );
+                        for (ours, theirs) in touching {
+                            let contact = Contact::Stack {
+                                our_component: ours,
+                                stack_part: sc.part,
+                                stack_component: self.scene.components[theirs].piece,
+                                face_kind: face_kind.to_string(),
+                            };
+                            if !contacts.contains(&contact) {
+                                contacts.push(contact);
+                            }
+                        }
+                        continue;
+                    }
                     Contact::Stack {
                         our_component: ob.moving,
                         stack_part: sc.part,

@@ -10,6 +10,7 @@ mod omega_2d;
 mod partitions;
 mod placement;
 mod plans_vs_parry;
+mod plates;
 mod regress;
 mod resumable;
 mod searched_elsewhere;
