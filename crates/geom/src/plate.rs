@@ -29,7 +29,14 @@
 //! search does not resolve anyway. Plates that are not parallel do not merge: a corner of one can always dip into a
 //! hole of the other without touching it (the pockets the search has to visit).
 //!
-//! Cost: O(pieces' vertices) per face to build, O(1) per test.
+//! **One side merged** ([`slices_clear_holes`]). The pieces of one plate against a single convex set `B` (a piece of
+//! another part, turned anyhow): the union of the pieces' obstacles against `B` is the filled plate's obstacle
+//! against `B` unless a slice of `B` by a slab parallel to the plate fits into a hole (the argument above with `B`'s
+//! slab slice in the place of the other outline: the part of `B` inside the filled plate lies in one hole, and its
+//! shadow on the plate reaches the outline unless the whole slice lies in the hole).
+//!
+//! Cost: O(pieces' vertices) per face to build, O(1) per [`merges_exactly`], O(vertices) per
+//! [`slices_clear_holes`].
 
 use crate::hull::convex_hull_merged;
 use crate::polytope::ConvexPolytope;
@@ -98,6 +105,51 @@ pub fn merges_exactly(a: &Plate, rotation_a: DMat3, b: &Plate, rotation_b: DMat3
     parallel && no_fit && reach.is_finite()
 }
 
+/// Whether no slice of the convex set with `vertices` by a slab parallel to a plate with unit normal `normal` (any
+/// thickness, anywhere along the normal) fits into a hole of diameter `hole_diameter`: then the obstacles of that set
+/// against each of the plate's pieces together make exactly its obstacle against the filled plate (a convex set that
+/// meets the filled plate but no piece meets it inside one hole, and its slab slice, which reaches the plate's
+/// outline unless it lies in the hole, must then fit into that hole; see the module documentation for the same
+/// argument). Sufficient test, by Brunn-Minkowski: the width of a convex set's sections along a fixed direction `u`
+/// is a concave function of the section's level, so every section is at least as wide along `u` as the narrower of
+/// the two extreme features along `normal` (the vertices within `tolerance` of the lowest and of the highest level);
+/// a slice contains a section, and a set that fits into the hole is at most as wide as its diameter. The directions
+/// tried are those between two vertices of one extreme feature. A feature that is a single vertex (a corner can dip
+/// into any hole) fails. O(v + f^2) for `v` vertices and `f` in the extreme features.
+pub fn slices_clear_holes(vertices: &[DVec3], normal: DVec3, hole_diameter: f64, tolerance: f64) -> bool {
+    let n = normal.normalize_or_zero();
+    if n == DVec3::ZERO || vertices.is_empty() || !hole_diameter.is_finite() {
+        return false;
+    }
+    let level = |v: &DVec3| n.dot(*v);
+    let lo = vertices.iter().map(level).fold(f64::INFINITY, f64::min);
+    let hi = vertices.iter().map(level).fold(f64::NEG_INFINITY, f64::max);
+    if !(lo.is_finite() && hi.is_finite()) {
+        return false;
+    }
+    let feature = |at: f64| -> Vec<DVec3> {
+        vertices.iter().filter(|v| (level(v) - at).abs() <= tolerance).map(|v| *v - n * level(v)).collect()
+    };
+    let (bottom, top) = (feature(lo), feature(hi));
+    let width = |points: &[DVec3], u: DVec3| {
+        let (a, b) =
+            points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(u.dot(*p)), b.max(u.dot(*p))));
+        b - a
+    };
+    let needed = hole_diameter + tolerance;
+    for points in [&bottom, &top] {
+        for (i, p) in points.iter().enumerate() {
+            for q in &points[i + 1..] {
+                let u = (*q - *p).normalize_or_zero();
+                if u != DVec3::ZERO && width(&bottom, u) > needed && width(&top, u) > needed {
+                    return true;
+                }
+            }
+        }
+    }
+    false
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -138,6 +190,27 @@ mod tests {
         let part = sheet.build_part("l", 1.0, Decomposition::ConvexMerge).expect("part");
         assert!(part.components.len() >= 2);
         assert!(part.plates.is_empty(), "the hull of an L is not the L");
+    }
+
+    #[test]
+    fn slices_of_a_long_bar_clear_a_small_hole_but_its_end_does_not() {
+        let bar = ConvexPolytope::cuboid(DVec3::new(0.0, 0.0, 0.0), DVec3::new(200.0, 2.0, 150.0)).expect("bar");
+        // a vertical wall 200 long against a horizontal plate: every horizontal slice is 200 x 2
+        assert!(slices_clear_holes(bar.vertices(), DVec3::Z, 50.0, 1e-6));
+        // against a plate parallel to its end (normal x): the slices are 2 x 150, wider than a 100 mm hole only along z
+        assert!(slices_clear_holes(bar.vertices(), DVec3::X, 100.0, 1e-6));
+        assert!(!slices_clear_holes(bar.vertices(), DVec3::X, 160.0, 1e-6));
+        // turned so that a vertical edge leads (normal between x and y): a slice near it is thin
+        let turned = DMat3::from_rotation_z(0.3);
+        let vertices: Vec<DVec3> = bar.vertices().iter().map(|v| turned * *v).collect();
+        assert!(slices_clear_holes(&vertices, DVec3::Z, 50.0, 1e-6));
+        // against a wall across it a vertical edge leads: its slices are thin but 150 tall
+        let across = DVec3::new(1.0, 1.0, 0.0).normalize();
+        assert!(slices_clear_holes(&vertices, across, 100.0, 1e-6));
+        assert!(!slices_clear_holes(&vertices, across, 160.0, 1e-6));
+        // a corner leading (a tilted bar) never clears
+        let tilted: Vec<DVec3> = bar.vertices().iter().map(|v| DMat3::from_rotation_x(0.2) * turned * *v).collect();
+        assert!(!slices_clear_holes(&tilted, DVec3::Z, 1.0, 1e-6));
     }
 
     #[test]
