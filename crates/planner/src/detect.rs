@@ -59,6 +59,8 @@ pub struct StackScene {
     pub plate_of: Vec<Option<u32>>,
     /// Per stack part, per plate: the filled plate in world coordinates.
     pub plates_world: Vec<Vec<ConvexPolytope>>,
+    /// Per stack part: the number of plates of the parts before it (a plate's index in the whole stack).
+    pub plate_first: Vec<usize>,
 }
 
 impl StackScene {
@@ -72,6 +74,7 @@ impl StackScene {
             part_first: Vec::new(),
             plate_of: Vec::new(),
             plates_world: Vec::new(),
+            plate_first: Vec::new(),
         };
         for &(part, pose) in parts {
             scene.push_part(part, pose);
@@ -83,6 +86,7 @@ impl StackScene {
     /// of the longer list, as [`StackScene::new`] builds it. O(size of the part).
     pub fn push_part(&mut self, part: &Part, pose: Pose) {
         self.part_first.push(self.components.len());
+        self.plate_first.push(self.plates_world.iter().map(Vec::len).sum());
         let mut plate_of = vec![None; part.components.len()];
         for (k, plate) in part.plates.iter().enumerate() {
             for &i in &plate.pieces {

@@ -63,10 +63,12 @@ pub struct DerivedObstacle {
     pub planes: Vec<Plane>,
     /// Provenance of each plane.
     pub origins: Vec<PlaneOrigin>,
-    /// `Some((moving plate, fixed plate))`: the obstacle of two parallel plates' filled outlines, standing for the
-    /// obstacles of all their pieces' pairs (the planner's `plates.rs`; `moving` and `fixed` then name the plates' first
-    /// pieces); `None`: the pair's own obstacle.
-    pub plates: Option<(usize, usize)>,
+    /// The moving part's plate whose filled outline stands for its pieces in this obstacle (the planner's
+    /// `plates.rs`; `moving` then names the plate's first piece), or `None`.
+    pub moving_plate: Option<usize>,
+    /// The stack part's plate whose filled outline stands for its pieces (`fixed` then names its first piece), or
+    /// `None`.
+    pub fixed_plate: Option<usize>,
     /// With insertion: the planes of the pair's c-space obstacle `C` that face down, which the insertion obstacle
     /// drops (grown like the others). A position on the insertion obstacle's boundary that violates one of them
     /// lies below `C`, on its downward sweep: the part does not touch the stack component there. Empty otherwise.
@@ -138,7 +140,7 @@ impl DerivedObstacle {
                 };
             }
         }
-        Self { orientation, moving, fixed, planes, origins, below, plates: None }
+        Self { orientation, moving, fixed, planes, origins, below, moving_plate: None, fixed_plate: None }
     }
 
     /// The region of positions at which the part, at `orientation`, lies inside the convex polygon `polygon`
@@ -160,7 +162,8 @@ impl DerivedObstacle {
             planes,
             origins,
             below: Vec::new(),
-            plates: None,
+            moving_plate: None,
+            fixed_plate: None,
         }
     }
 

@@ -122,10 +122,12 @@ pub struct PlacementRequest<'a> {
     /// Extrapolate obstacles within their constant-topology intervals instead of constructing each one
     /// ([`crate::interval_obstacles`], \[A\] IV-B). Off: every obstacle is constructed (the reference route).
     pub extrapolate: bool,
-    /// Let the pieces of two parallel plates of sheet-metal parts stand for their filled outlines where that is
-    /// exact ([`stackplan_geom::plate::merges_exactly`]; the planner's `plates.rs`): one obstacle instead of one per pair of
-    /// pieces, the same free positions. A contact with such an obstacle lists the plates' pieces that touch. Default
-    /// on; off: every pair of pieces has its own obstacle (the reference route).
+    /// Let the pieces of a sheet-metal plate stand for its filled outline where that is exact (two parallel plates,
+    /// [`stackplan_geom::plate::merges_exactly`]; a plate against a component none of whose slices fits into its
+    /// holes, [`stackplan_geom::plate::slices_clear_holes`]; the planner's `plates.rs`): one obstacle instead of one
+    /// per pair of pieces, the same free positions (with a clearance, grown by other planes near corners). A contact
+    /// with such an obstacle lists the pieces that touch. Default on; off: every pair of pieces has its own obstacle
+    /// (the reference route).
     pub merge_plates: bool,
     /// Largest number of search nodes popped before giving up with [`PlacementError::NodeBudget`] (per partition
     /// of the orientations: each partition counts its own pops).

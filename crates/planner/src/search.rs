@@ -611,8 +611,10 @@ struct Search<'r, 'a> {
     rotated: HashMap<[u64; 9], RotatedComponents>,
     detect_scratch: DetectScratch,
     intervals: IntervalObstacles,
-    /// Per moving component, its plate when the request merges plates ([`crate::plates::moving_plates`]).
+    /// Per moving component, its plate when the request merges plates (`plates.rs`).
     moving_plate_of: Arc<[Option<u32>]>,
+    /// Per (orientation, moving, stack component) asked for: the merged obstacle that stands for it, if any.
+    merge_memo: HashMap<(usize, usize, usize), Option<crate::plates::MergedPair>>,
     stats: PlacementStats,
     /// Rounds of the partitioned loop run (first partition only; for the debug log).
     rounds: u64,
@@ -990,6 +992,7 @@ fn prepare<'r, 'a>(
                 intervals
             },
             moving_plate_of: Arc::clone(&moving_plate_of),
+            merge_memo: HashMap::new(),
             stats: stats.clone(),
             rounds: 0,
         });
@@ -1933,30 +1936,49 @@ impl Search<'_, '_> {
 
     /// The id of the derived obstacle of a pair at an orientation, building it on first use.
     fn obstacle_id(&mut self, orientation: usize, moving: usize, fixed: usize) -> Result<u32, PlacementError> {
-        // the pieces of two plates that merge share the filled plates' obstacle, named by their first pieces
-        let merged = crate::plates::merged_pair(
-            self.request,
-            &self.moving_plate_of,
-            &self.scene,
-            self.orientations[orientation].rotation,
-            moving,
-            fixed,
-            self.tol.linear,
-        );
-        let (moving, fixed) = merged.map_or((moving, fixed), |m| (m.moving, m.fixed));
-        if let Some(id) = self.obstacle_ids.get(&(orientation, moving, fixed)) {
+        // a pair whose pieces merge into a plate takes the merged obstacle (`plates.rs`), under its own key
+        let merged = if self.moving_plate_of.is_empty() {
+            None
+        } else {
+            match self.merge_memo.get(&(orientation, moving, fixed)) {
+                Some(m) => *m,
+                None => {
+                    let m = crate::plates::merged_pair(
+                        self.request,
+                        &self.moving_plate_of,
+                        &self.scene,
+                        self.orientations[orientation].rotation,
+                        moving,
+                        fixed,
+                        self.tol.linear,
+                    );
+                    self.merge_memo.insert((orientation, moving, fixed), m);
+                    m
+                }
+            }
+        };
+        let key = merged.map_or((moving, fixed), |m| m.key);
+        if let Some(id) = self.obstacle_ids.get(&(orientation, key.0, key.1)) {
             return Ok(*id);
         }
         let t = Instant::now();
-        if let Some(shared) = self.derived.get(&(orientation, moving, fixed)) {
+        if let Some(shared) = self.derived.get(&(orientation, key.0, key.1)) {
             let id = self.obstacles.len() as u32;
             self.obstacles.push(Arc::clone(shared));
-            self.obstacle_ids.insert((orientation, moving, fixed), id);
+            self.obstacle_ids.insert((orientation, key.0, key.1), id);
             self.by_orientation[orientation].push(id, shared);
             self.stats.pairs_evaluated += 1;
             self.stats.time_obstacles_ms += ms(t);
             return Ok(id);
         }
+        if moving >= crate::plates::VIRTUAL || fixed >= crate::plates::VIRTUAL {
+            // a merged obstacle's key names no pair: it is known from the shared tables or not at all
+            return Err(PlacementError::FreeSpace {
+                orientation,
+                reason: format!("no merged obstacle under the key ({moving}, {fixed})"),
+            });
+        }
+        let (moving, fixed) = merged.map_or((moving, fixed), |m| (m.moving, m.fixed));
         let o = &self.orientations[orientation];
         let sc = &self.scene.components[fixed];
         let to_error = |reason| PlacementError::Obstacle {
@@ -1967,7 +1989,7 @@ impl Search<'_, '_> {
         };
         let raw = if let Some(pair) = &merged {
             crate::plates::merged_obstacle(self.request, &self.scene, self.cache, pair, o.rotation)
-                .map_err(|e| to_error(format!("the filled plates' obstacle: {e}")))?
+                .map_err(|e| to_error(format!("the merged plates' obstacle: {e}")))?
         } else if self.request.extrapolate {
             let rest_rotation = self.request.resting_rotations[o.rest];
             let (raw, route) = self
@@ -1992,13 +2014,14 @@ impl Search<'_, '_> {
             self.request.horizontal_clearance,
             self.request.insertion,
         );
-        built.plates = merged.map(|m| (m.moving_plate, m.fixed_plate));
+        built.moving_plate = merged.and_then(|m| m.moving_plate);
+        built.fixed_plate = merged.and_then(|m| m.fixed_plate);
         let built = Arc::new(built);
-        self.derived.insert((orientation, moving, fixed), Arc::clone(&built));
+        self.derived.insert((orientation, key.0, key.1), Arc::clone(&built));
         let id = self.obstacles.len() as u32;
         self.by_orientation[orientation].push(id, &built);
         self.obstacles.push(built);
-        self.obstacle_ids.insert((orientation, moving, fixed), id);
+        self.obstacle_ids.insert((orientation, key.0, key.1), id);
 
         self.stats.pairs_evaluated += 1;
         self.stats.time_obstacles_ms += ms(t);
@@ -2205,15 +2228,16 @@ impl Search<'_, '_> {
                     } else {
                         ob.origins[face as usize].name()
                     };
-                    if let Some((moving_plate, fixed_plate)) = ob.plates {
-                        // the filled plates' face: the plates' pieces that touch
+                    if ob.moving_plate.is_some() || ob.fixed_plate.is_some() {
+                        // a merged obstacle's face: the pieces of its sides that touch
                         let touching = crate::plates::touching_pieces(
                             self.request,
                             &self.scene,
                             &o.components,
-                            moving_plate,
-                            sc.part,
-                            fixed_plate,
+                            ob.moving_plate,
+                            ob.moving,
+                            ob.fixed_plate,
+                            ob.fixed,
                             p,
                             self.request.clearance,
                             self.tol.linear,

@@ -99,6 +99,46 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 32, ..ProptestConfig::default() })]
+
+    #[test]
+    fn a_plate_against_a_piece_whose_slices_clear_its_holes_is_the_union_of_its_pieces(
+        moving in plate_strategy(),
+        size in (20.0f64..120.0, 1.0f64..20.0, 5.0f64..80.0),
+        tilt in (0.0f64..6.3, prop_oneof![Just(0.0), Just(std::f64::consts::FRAC_PI_2), 0.0f64..1.6], 0.0f64..6.3),
+        seed in 0u64..1_000_000,
+    ) {
+        // a box turned anyhow against the plate: where no slice of it by a slab parallel to the plate fits into a
+        // hole, the filled plate's obstacle against it is the union of the pieces' (and otherwise it is not tested)
+        let b = ConvexPolytope::cuboid(DVec3::ZERO, DVec3::new(size.0, size.1, size.2)).expect("box");
+        let turn = DMat3::from_rotation_z(tilt.0) * DMat3::from_rotation_x(tilt.1) * DMat3::from_rotation_z(tilt.2);
+        let fixed = b.transformed(turn, DVec3::new(60.0, 40.0, 0.0));
+        let plate = &moving.plates[0];
+        let clear = stackplan_geom::plate::slices_clear_holes(fixed.vertices(), plate.normal, plate.hole_diameter, 1e-6);
+        let filled = obstacle(&plate.filled, DMat3::IDENTITY, &fixed).expect("filled obstacle");
+        let pairs: Vec<_> =
+            moving.components.iter().map(|m| obstacle(m, DMat3::IDENTITY, &fixed).expect("pair obstacle")).collect();
+        let (lo, hi) = filled.polytope().aabb();
+        let mut state = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+        let mut next = || {
+            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..400 {
+            let p = lo + (hi - lo) * DVec3::new(next(), next(), next());
+            let in_filled = depth(filled.planes(), p);
+            let in_pieces = pairs.iter().map(|o| depth(o.planes(), p)).fold(f64::NEG_INFINITY, f64::max);
+            if in_pieces > 1e-7 {
+                prop_assert!(in_filled > -1e-7, "a pair's obstacle reaches outside the filled one at {p}");
+            }
+            if clear && in_filled > 1e-3 {
+                prop_assert!(in_pieces > -1e-7, "pocket at {p}: {in_filled} inside the filled plate, {in_pieces} outside every pair");
+            }
+        }
+    }
+}
+
 #[test]
 fn a_plate_that_fits_into_a_hole_leaves_a_pocket_and_is_not_merged() {
     // a 40 x 30 plate with a 10 x 10 hole above a 200 x 140 plate with a 60 x 50 hole: the small plate fits into the
