@@ -194,7 +194,8 @@ pub struct PlacementStats {
     pub total_pairs: u64,
     /// m_part x m_stack x orientations searched.
     pub total_pairs_searched: u64,
-    /// Distinct (orientation, component pair) whose obstacle was built or extrapolated.
+    /// Distinct (orientation, component pair) whose obstacle was built or extrapolated (an obstacle that stands for
+    /// the pairs of a merged plate's pieces, [`PlacementRequest::merge_plates`], counts once).
     pub pairs_evaluated: u64,
     /// Obstacles constructed from scratch (Gauss-map overlay).
     pub obstacles_constructed: u64,
