@@ -125,6 +125,19 @@ impl Part {
         Ok(Self { name: name.into(), components, boundary, mass, density, origin, plates: Vec::new() })
     }
 
+    /// For each component, the index of the plate it belongs to ([`Part::plates`]), if any. O(components).
+    pub fn plate_of_components(&self) -> Vec<Option<u32>> {
+        let mut of = vec![None; self.components.len()];
+        for (k, plate) in self.plates.iter().enumerate() {
+            for &i in &plate.pieces {
+                if let Some(slot) = of.get_mut(i) {
+                    *slot = Some(k as u32);
+                }
+            }
+        }
+        of
+    }
+
     /// Axis-aligned bounding box of the part `(min, max)`.
     pub fn aabb(&self) -> (DVec3, DVec3) {
         let mut lo = DVec3::splat(f64::INFINITY);

@@ -87,15 +87,7 @@ impl StackScene {
     pub fn push_part(&mut self, part: &Part, pose: Pose) {
         self.part_first.push(self.components.len());
         self.plate_first.push(self.plates_world.iter().map(Vec::len).sum());
-        let mut plate_of = vec![None; part.components.len()];
-        for (k, plate) in part.plates.iter().enumerate() {
-            for &i in &plate.pieces {
-                if let Some(slot) = plate_of.get_mut(i) {
-                    *slot = Some(k as u32);
-                }
-            }
-        }
-        self.plate_of.extend(plate_of);
+        self.plate_of.extend(part.plate_of_components());
         self.plates_world
             .push(part.plates.iter().map(|p| p.filled.transformed(pose.rotation, pose.position)).collect());
         for (ci, c) in part.components.iter().enumerate() {

@@ -65,15 +65,7 @@ pub(crate) fn moving_plates(request: &PlacementRequest<'_>) -> Vec<Option<u32>> 
     if !request.merge_plates || request.part.plates.is_empty() {
         return Vec::new();
     }
-    let mut of = vec![None; request.part.components.len()];
-    for (k, plate) in request.part.plates.iter().enumerate() {
-        for &i in &plate.pieces {
-            if let Some(slot) = of.get_mut(i) {
-                *slot = Some(k as u32);
-            }
-        }
-    }
-    of
+    request.part.plate_of_components()
 }
 
 /// The merged obstacle that stands for moving component `moving` (turned by `rotation`) against stack component
