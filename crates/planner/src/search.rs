@@ -968,7 +968,6 @@ fn prepare<'r, 'a>(
             }
         }
         table.by_orientation.resize_with(n_orientations, KnownObstacles::default);
-        let moving_plate_of: Arc<[Option<u32>]> = Arc::clone(&moving_plate_of);
         searches.push(Search {
             request,
             lane,
@@ -1935,7 +1934,9 @@ impl Search<'_, '_> {
         Ok((placements, limited))
     }
 
-    /// The id of the derived obstacle of a pair at an orientation, building it on first use.
+    /// The id of the derived obstacle of a pair at an orientation, building it on first use: the pair's own, or the
+    /// merged one that stands for it (`plates.rs`; the pair may also be a merged obstacle's key from the shared
+    /// tables).
     fn obstacle_id(&mut self, orientation: usize, moving: usize, fixed: usize) -> Result<u32, PlacementError> {
         // a pair whose pieces merge into a plate takes the merged obstacle (`plates.rs`), under its own key
         let merged = if self.moving_plate_of.is_empty() {
