@@ -27,8 +27,8 @@
 //! near corners of the pairs' obstacles; the stacking planner checks every candidate's clearance exactly. A contact
 //! with a merged obstacle is reported per pair of pieces that touch ([`touching_pieces`]).
 //!
-//! Cost: O(1) per pair for rule 1 (table look-ups), O(vertices of the component) for rules 2-3, memoised per
-//! (orientation, pair) by the search; the contacts O(pieces x pieces) box tests and a separating-axis test per
+//! Cost: O(1) per pair for rule 1 (table look-ups), O(vertices of the component) for rules 2-3, once per
+//! (orientation, pair): the search keeps the pair's key as an alias of the merged obstacle's; the contacts O(pieces x pieces) box tests and a separating-axis test per
 //! overlapping box, only at a found placement.
 
 use crate::detect::StackScene;

@@ -614,8 +614,6 @@ struct Search<'r, 'a> {
     intervals: IntervalObstacles,
     /// Per moving component, its plate when the request merges plates (`plates.rs`).
     moving_plate_of: Arc<[Option<u32>]>,
-    /// Per (orientation, moving, stack component) asked for: the merged obstacle that stands for it, if any.
-    merge_memo: HashMap<(usize, usize, usize), Option<crate::plates::MergedPair>>,
     stats: PlacementStats,
     /// Rounds of the partitioned loop run (first partition only; for the debug log).
     rounds: u64,
@@ -992,7 +990,6 @@ fn prepare<'r, 'a>(
                 intervals
             },
             moving_plate_of: Arc::clone(&moving_plate_of),
-            merge_memo: HashMap::new(),
             stats: stats.clone(),
             rounds: 0,
         });
@@ -1938,36 +1935,36 @@ impl Search<'_, '_> {
     /// merged one that stands for it (`plates.rs`; the pair may also be a merged obstacle's key from the shared
     /// tables).
     fn obstacle_id(&mut self, orientation: usize, moving: usize, fixed: usize) -> Result<u32, PlacementError> {
-        // a pair whose pieces merge into a plate takes the merged obstacle (`plates.rs`), under its own key
+        if let Some(id) = self.obstacle_ids.get(&(orientation, moving, fixed)) {
+            return Ok(*id);
+        }
+        // a pair whose pieces merge into a plate takes the merged obstacle (`plates.rs`) under the merged key, and
+        // the pair's own key becomes an alias of it (the rule depends only on the orientation and the stack, which
+        // every search sharing these tables has in common)
         let merged = if self.moving_plate_of.is_empty() {
             None
         } else {
-            match self.merge_memo.get(&(orientation, moving, fixed)) {
-                Some(m) => *m,
-                None => {
-                    let m = crate::plates::merged_pair(
-                        self.request,
-                        &self.moving_plate_of,
-                        &self.scene,
-                        self.orientations[orientation].rotation,
-                        moving,
-                        fixed,
-                        self.tol.linear,
-                    );
-                    self.merge_memo.insert((orientation, moving, fixed), m);
-                    m
-                }
-            }
+            crate::plates::merged_pair(
+                self.request,
+                &self.moving_plate_of,
+                &self.scene,
+                self.orientations[orientation].rotation,
+                moving,
+                fixed,
+                self.tol.linear,
+            )
         };
         let key = merged.map_or((moving, fixed), |m| m.key);
-        if let Some(id) = self.obstacle_ids.get(&(orientation, key.0, key.1)) {
-            return Ok(*id);
+        if let Some(&id) = self.obstacle_ids.get(&(orientation, key.0, key.1)) {
+            self.obstacle_ids.insert((orientation, moving, fixed), id);
+            return Ok(id);
         }
         let t = Instant::now();
         if let Some(shared) = self.derived.get(&(orientation, key.0, key.1)) {
             let id = self.obstacles.len() as u32;
             self.obstacles.push(Arc::clone(shared));
             self.obstacle_ids.insert((orientation, key.0, key.1), id);
+            self.obstacle_ids.insert((orientation, moving, fixed), id);
             self.by_orientation[orientation].push(id, shared);
             self.stats.pairs_evaluated += 1;
             self.stats.time_obstacles_ms += ms(t);
@@ -1980,6 +1977,7 @@ impl Search<'_, '_> {
                 reason: format!("no merged obstacle under the key ({moving}, {fixed})"),
             });
         }
+        let asked = (moving, fixed);
         let (moving, fixed) = merged.map_or((moving, fixed), |m| (m.moving, m.fixed));
         let o = &self.orientations[orientation];
         let sc = &self.scene.components[fixed];
@@ -2024,6 +2022,7 @@ impl Search<'_, '_> {
         self.by_orientation[orientation].push(id, &built);
         self.obstacles.push(built);
         self.obstacle_ids.insert((orientation, key.0, key.1), id);
+        self.obstacle_ids.insert((orientation, asked.0, asked.1), id);
 
         self.stats.pairs_evaluated += 1;
         self.stats.time_obstacles_ms += ms(t);
