@@ -72,8 +72,8 @@ pub struct Part {
     /// How the part was made.
     pub origin: PartOrigin,
     /// Flat plates: the components that came from one sheet-metal face with a convex outline (empty for other
-    /// parts). A search may let the pieces of two parallel plates stand for their filled outlines where that is exact
-    /// ([`crate::plate::merges_exactly`]); nothing else depends on them.
+    /// parts). A search may let a plate's pieces stand for its filled outline where that is exact
+    /// ([`crate::plate::merges_exactly`], [`crate::plate::slices_clear_holes`]); nothing else depends on them.
     #[serde(default)]
     pub plates: Vec<Plate>,
 }
@@ -125,10 +125,14 @@ impl Part {
         Ok(Self { name: name.into(), components, boundary, mass, density, origin, plates: Vec::new() })
     }
 
-    /// For each component, the index of the plate it belongs to ([`Part::plates`]), if any. O(components).
+    /// For each component, the index of the plate it belongs to ([`Part::plates`]), if any. A plate without pieces
+    /// or naming a component the part does not have is left out (a part built by hand). O(components + pieces).
     pub fn plate_of_components(&self) -> Vec<Option<u32>> {
         let mut of = vec![None; self.components.len()];
         for (k, plate) in self.plates.iter().enumerate() {
+            if plate.pieces.is_empty() || plate.pieces.iter().any(|&i| i >= self.components.len()) {
+                continue;
+            }
             for &i in &plate.pieces {
                 if let Some(slot) = of.get_mut(i) {
                     *slot = Some(k as u32);

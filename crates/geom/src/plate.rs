@@ -182,6 +182,19 @@ mod tests {
     }
 
     #[test]
+    fn a_plate_naming_a_missing_piece_is_left_out() {
+        use crate::sheet_metal::Decomposition;
+        let mut part = crate::examples::complex().build_part("complex", 1.0, Decomposition::ConvexMerge).expect("part");
+        let before = part.plate_of_components();
+        let mut bogus = part.plates[1].clone();
+        bogus.pieces = vec![0, part.components.len()];
+        part.plates.push(bogus.clone());
+        bogus.pieces.clear();
+        part.plates.push(bogus);
+        assert_eq!(part.plate_of_components(), before);
+    }
+
+    #[test]
     fn a_concave_face_is_no_plate() {
         use crate::sheet_metal::{Decomposition, SheetFace, SheetMetal};
         let l = [(0.0, 0.0), (100.0, 0.0), (100.0, 30.0), (30.0, 30.0), (30.0, 100.0), (0.0, 100.0)];

@@ -294,11 +294,20 @@ impl SheetMetal {
     /// The convex prisms of every face, grouped by face: each convex polygon extruded by `thickness / 2` to both
     /// sides of the face plane. Every prism passes [`ConvexPolytope::validate`].
     pub fn decompose(&self, decomposition: Decomposition) -> Result<Vec<Vec<ConvexPolytope>>, SheetMetalError> {
+        Ok(self.decompose_with_faces(decomposition)?.into_iter().map(|(_, prisms)| prisms).collect())
+    }
+
+    /// [`SheetMetal::decompose`] with each face's decomposition beside its prisms.
+    fn decompose_with_faces(
+        &self,
+        decomposition: Decomposition,
+    ) -> Result<Vec<(FaceDecomposition, Vec<ConvexPolytope>)>, SheetMetalError> {
         self.check_thickness()?;
         (0..self.faces.len())
             .map(|face| {
                 let d = self.decompose_face(face, decomposition)?;
-                extrude(face, &d, self.thickness)
+                let prisms = extrude(face, &d, self.thickness)?;
+                Ok((d, prisms))
             })
             .collect()
     }
@@ -307,12 +316,9 @@ impl SheetMetal {
     /// Every face with a convex outline is a [`Plate`] of the part (its prisms' indices, normal, filled outline and
     /// the diameters of its outline and largest hole).
     pub fn build_part(&self, name: &str, density: f64, decomposition: Decomposition) -> Result<Part, SheetMetalError> {
-        self.check_thickness()?;
         let mut components: Vec<ConvexPolytope> = Vec::new();
         let mut plates: Vec<Plate> = Vec::new();
-        for face in 0..self.faces.len() {
-            let d = self.decompose_face(face, decomposition)?;
-            let prisms = extrude(face, &d, self.thickness)?;
+        for (d, prisms) in self.decompose_with_faces(decomposition)? {
             let corners = |ring: &[usize]| ring.iter().map(|&i| d.points_on_plane[i]).collect::<Vec<DVec3>>();
             let outline_2d: Vec<DVec2> = d.outline.iter().map(|&i| d.points[i]).collect();
             if !prisms.is_empty() && is_convex_ccw(&outline_2d) {
