@@ -11,9 +11,11 @@
 //! * [`part`]: rigid parts as unions of convex components, with boundary faces;
 //! * [`plate`]: the flat plates of sheet-metal parts, and when two plates' pieces may stand for their filled outlines;
 //! * [`pose`]: rigid poses (rotation and position) of placed parts;
+//! * [`cad`]: parts from CAD (STEP, single-shell meshes) recognised as sheet metal;
 //! * [`io`]: file formats (part JSON, STL, OBJ, glTF export, stack files) with located errors.
 
 pub mod accurate_normal;
+pub mod cad;
 pub mod convex_merge;
 pub mod examples;
 pub mod hull;
