@@ -316,9 +316,22 @@ impl SheetMetal {
     /// Every face with a convex outline is a [`Plate`] of the part (its prisms' indices, normal, filled outline and
     /// the diameters of its outline and largest hole).
     pub fn build_part(&self, name: &str, density: f64, decomposition: Decomposition) -> Result<Part, SheetMetalError> {
+        Ok(self.build_part_counted(name, density, decomposition)?.0)
+    }
+
+    /// [`SheetMetal::build_part`], with the number of prisms of each face (the part's components are the faces'
+    /// prisms in face order).
+    pub fn build_part_counted(
+        &self,
+        name: &str,
+        density: f64,
+        decomposition: Decomposition,
+    ) -> Result<(Part, Vec<usize>), SheetMetalError> {
         let mut components: Vec<ConvexPolytope> = Vec::new();
         let mut plates: Vec<Plate> = Vec::new();
+        let mut counts: Vec<usize> = Vec::with_capacity(self.faces.len());
         for (d, prisms) in self.decompose_with_faces(decomposition)? {
+            counts.push(prisms.len());
             let corners = |ring: &[usize]| ring.iter().map(|&i| d.points_on_plane[i]).collect::<Vec<DVec3>>();
             let outline_2d: Vec<DVec2> = d.outline.iter().map(|&i| d.points[i]).collect();
             if !prisms.is_empty() && is_convex_ccw(&outline_2d) {
@@ -338,7 +351,7 @@ impl SheetMetal {
             volume = part.mass.volume,
             "built sheet-metal part"
         );
-        Ok(part)
+        Ok((part, counts))
     }
 }
 

@@ -1,0 +1,205 @@
+//! A sheet-metal bend and its conservative convex decomposition.
+//!
+//! A bend is the region between two coaxial circular cylinders of radii `r` (inner) and `R = r + t` (outer, `t` the
+//! sheet thickness), over an angle `phi` about the axis and an interval of the axis: an annular sector extruded along
+//! the axis. It is not convex, so it is cut at `n` equal angles `Delta = phi / n` into segments, and each segment is
+//! replaced by the convex prism bounded by
+//! - the two radial planes of the cut (shared exactly with the neighbouring segments, and with the flat plates at the
+//!   two ends: the tangent lines of a bend lie on its first and last radial planes);
+//! - the chord of the inner arc (the chord lies nearer the axis than the arc: the segment contains the inner arc);
+//! - the two tangents of the outer arc at the cut angles, which meet at radius `R / cos(Delta / 2)` (they lie outside
+//!   the arc: the segment contains the outer arc);
+//! - the two planes that end the axial interval.
+//!
+//! So the union of the segments contains the bend, and a segment stands outside it by at most
+//! `max(R (1 / cos(Delta / 2) - 1), r (1 - cos(Delta / 2)))` ([`Bend::deviation`]); [`Bend::segments_within`] picks
+//! the fewest segments that keep this below a tolerance. The segments of one bend share their radial faces, so their
+//! interiors are disjoint. This is the "outer arc by tangent segments, inner arc by chords" rule of a conservative
+//! decomposition: interference-free for the pieces implies interference-free for the steel.
+//!
+//! Cost: O(n) per bend.
+
+use crate::polytope::{ConvexPolytope, PolytopeError};
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+/// One bend: an annular sector of two coaxial cylinders, extruded along their axis.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Bend {
+    /// A point of the axis; the axial interval is measured from it.
+    pub center: DVec3,
+    /// Unit direction of the axis; angles turn counter-clockwise about it.
+    pub axis: DVec3,
+    /// Inner radius `r` (mm), > 0.
+    pub inner_radius: f64,
+    /// Outer radius `R` (mm), > `r`.
+    pub outer_radius: f64,
+    /// Unit vector perpendicular to the axis at angle 0 (the start of the bend).
+    pub start: DVec3,
+    /// Swept angle `phi` (radians), in `(0, 2 pi)`.
+    pub angle: f64,
+    /// The axial interval `[lo, hi]` (mm along `axis` from `center`).
+    pub axial: [f64; 2],
+}
+
+impl Bend {
+    /// The unit radial direction at angle `a`.
+    pub fn radial(&self, a: f64) -> DVec3 {
+        let w = self.axis.cross(self.start);
+        self.start * a.cos() + w * a.sin()
+    }
+
+    /// The largest distance by which the `n`-segment decomposition stands outside the bend (mm).
+    pub fn deviation(&self, n: usize) -> f64 {
+        let half = self.angle / (2.0 * n.max(1) as f64);
+        let outer = self.outer_radius * (1.0 / half.cos() - 1.0);
+        let inner = self.inner_radius * (1.0 - half.cos());
+        outer.max(inner)
+    }
+
+    /// The fewest segments whose [`Bend::deviation`] is at most `tolerance` (mm, > 0), and at least one per 60
+    /// degrees (so that a tangent corner never runs far out even for a coarse tolerance). At most 10 000.
+    pub fn segments_within(&self, tolerance: f64) -> usize {
+        let min_by_angle = (self.angle / std::f64::consts::FRAC_PI_3).ceil().max(1.0) as usize;
+        let mut n = min_by_angle;
+        // the deviation falls monotonically with n; a doubling search then a bisection
+        if self.deviation(n) <= tolerance {
+            return n;
+        }
+        let mut hi = n;
+        while self.deviation(hi) > tolerance && hi < 10_000 {
+            n = hi;
+            hi = (hi * 2).min(10_000);
+        }
+        if self.deviation(hi) > tolerance {
+            return hi;
+        }
+        let mut lo = n; // deviation(lo) > tolerance >= deviation(hi)
+        while hi - lo > 1 {
+            let mid = (lo + hi) / 2;
+            if self.deviation(mid) <= tolerance { hi = mid } else { lo = mid }
+        }
+        hi
+    }
+
+    /// The exact volume of the bend: `phi (R^2 - r^2) / 2` times the axial length (mm^3).
+    pub fn volume(&self) -> f64 {
+        self.angle * (self.outer_radius.powi(2) - self.inner_radius.powi(2)) / 2.0 * (self.axial[1] - self.axial[0])
+    }
+
+    /// The `n` convex segments (see the module documentation), in order of angle.
+    pub fn segments(&self, n: usize) -> Result<Vec<ConvexPolytope>, PolytopeError> {
+        let n = n.max(1);
+        let delta = self.angle / n as f64;
+        let corner_radius = self.outer_radius / (delta / 2.0).cos();
+        let (z0, z1) = (self.axis * self.axial[0], self.axis * self.axial[1]);
+        (0..n)
+            .map(|k| {
+                let (a0, a1) = (delta * k as f64, delta * (k + 1) as f64);
+                // counter-clockwise about the axis: outer arc forwards, inner chord backwards
+                let ring = [
+                    self.radial(a0) * self.outer_radius,
+                    self.radial(a0 + delta / 2.0) * corner_radius,
+                    self.radial(a1) * self.outer_radius,
+                    self.radial(a1) * self.inner_radius,
+                    self.radial(a0) * self.inner_radius,
+                ];
+                let m = ring.len();
+                let mut vertices: Vec<DVec3> = ring.iter().map(|q| self.center + *q + z0).collect();
+                vertices.extend(ring.iter().map(|q| self.center + *q + z1));
+                let mut faces: Vec<Vec<usize>> = Vec::with_capacity(m + 2);
+                faces.push((m..2 * m).collect());
+                faces.push((0..m).rev().collect());
+                for i in 0..m {
+                    let j = (i + 1) % m;
+                    faces.push(vec![i, j, m + j, m + i]);
+                }
+                let piece = ConvexPolytope::new(vertices, faces)?;
+                piece.validate()?;
+                Ok(piece)
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::{FRAC_PI_2, PI};
+
+    fn quarter() -> Bend {
+        Bend {
+            center: DVec3::new(1.0, 2.0, 3.0),
+            axis: DVec3::Z,
+            inner_radius: 3.0,
+            outer_radius: 5.0,
+            start: DVec3::X,
+            angle: FRAC_PI_2,
+            axial: [-10.0, 30.0],
+        }
+    }
+
+    fn inside(pieces: &[ConvexPolytope], p: DVec3) -> bool {
+        pieces.iter().any(|c| c.planes().all(|pl| pl.signed_distance(p) <= 1e-9))
+    }
+
+    #[test]
+    fn segments_contain_the_bend_and_stay_within_the_deviation() {
+        let bend = quarter();
+        for tolerance in [0.5, 0.1, 0.01] {
+            let n = bend.segments_within(tolerance);
+            assert!(bend.deviation(n) <= tolerance);
+            assert!(n == 1 || bend.deviation(n - 1) > tolerance || n == 2, "n = {n} is not the fewest");
+            let pieces = bend.segments(n).expect("segments");
+            assert_eq!(pieces.len(), n);
+            // points of the true bend (on both arcs, in between, at the axial ends) lie in the union
+            for i in 0..=200 {
+                let a = bend.angle * i as f64 / 200.0;
+                for s in [0.0, 0.3, 1.0] {
+                    let rho = bend.inner_radius + s * (bend.outer_radius - bend.inner_radius);
+                    for z in [bend.axial[0], 0.0, bend.axial[1]] {
+                        let p = bend.center + bend.radial(a) * rho + bend.axis * z;
+                        assert!(inside(&pieces, p), "tolerance {tolerance}: {p} outside the segments");
+                    }
+                }
+            }
+            // every vertex lies within the deviation of the bend's annular sector
+            for c in &pieces {
+                for v in c.vertices() {
+                    let d = *v - bend.center;
+                    let rho = (d - bend.axis * d.dot(bend.axis)).length();
+                    assert!(rho >= bend.inner_radius * (1.0 - 1e-12) - tolerance);
+                    assert!(rho <= bend.outer_radius + tolerance + 1e-12);
+                }
+            }
+            // volume: at least the bend's, and within the deviation times the surface
+            let volume: f64 = pieces.iter().map(ConvexPolytope::volume).sum();
+            assert!(volume >= bend.volume() * (1.0 - 1e-12));
+            let surface = bend.angle * (bend.inner_radius + bend.outer_radius) * (bend.axial[1] - bend.axial[0]);
+            assert!(volume - bend.volume() <= tolerance * surface);
+        }
+    }
+
+    #[test]
+    fn neighbouring_segments_share_their_cut_exactly_and_do_not_overlap() {
+        let bend = Bend { angle: PI * 0.75, ..quarter() };
+        let pieces = bend.segments(5).expect("segments");
+        let volume: f64 = pieces.iter().map(ConvexPolytope::volume).sum();
+        // a point just past a cut lies in one segment only
+        for k in 1..5 {
+            let a = bend.angle * k as f64 / 5.0;
+            let p = bend.center + bend.radial(a + 1e-6) * 4.0;
+            let count = pieces.iter().filter(|c| c.planes().all(|pl| pl.signed_distance(p) < -1e-9)).count();
+            assert_eq!(count, 1, "cut {k}");
+        }
+        assert!(volume > bend.volume());
+    }
+
+    #[test]
+    fn segment_count_follows_the_tolerance() {
+        let bend = quarter();
+        assert!(bend.segments_within(0.01) > bend.segments_within(0.1));
+        assert_eq!(bend.segments_within(1e3), 2, "at least one segment per 60 degrees");
+        assert_eq!(Bend { angle: 0.1, ..bend }.segments_within(1.0), 1);
+    }
+}

@@ -1,0 +1,1060 @@
+//! Sheet-metal recognition: the thickness, plates and bends of a solid given by its planar and cylindrical faces
+//! ([`Brep`]), and the conservative convex pieces of the part.
+//!
+//! A bent sheet of constant thickness `t` is bounded by
+//! - **skins**: pairs of opposite planar faces `t` apart (outward normals opposite, the material between them), whose
+//!   projections overlap. The two skins of a plate have the same outline, since a cut edge is square to the sheet;
+//! - **bends**: pairs of coaxial cylinders, the inner (normal towards the axis) of radius `r` and the outer of radius
+//!   `r + t`;
+//! - **cut edges**: the narrow faces of width `t` around the sheet (rims, the walls of holes, the sides of bends).
+//!
+//! Recognition:
+//! 1. Each planar face's **partner** is the nearest opposite face behind it whose projection overlaps its own. The
+//!    thickness is the distance of the partner pair with the largest common area (the main plate); each bend's
+//!    radii must differ by it, and a face whose partner is nearer or farther than it while it is not a cut edge makes
+//!    the solid no sheet ("faces #12 and #40 are parallel but 7.1 mm apart; the sheet is 3.13 mm").
+//! 2. **Plates**: the partner pairs at the thickness form groups (a side may be split into several faces); the side of
+//!    larger area gives the plate's faces, whose loops, moved onto the mid-plane, are the outline and holes of a
+//!    [`SheetFace`]. A circular arc of a loop becomes a polygon that never cuts into the material: where the
+//!    material lies on the arc's centre side (a rounded corner) the polygon is made of tangents; where it lies on the
+//!    far side (a hole, a notch) of chords. The plates are then split into convex prisms as every sheet-metal face is
+//!    ([`SheetMetal::build_part`]: exact, holes included).
+//! 3. **Bends**: cylinders of one axis and radius are merged; an inner and an outer cylinder on one axis with radii
+//!    `t` apart whose angle ranges overlap make a bend ([`Bend`]), its angle and axial interval the range of both
+//!    cylinders' boundary points. A tessellated bend (from a mesh) has chords inside its inner arc, so its inner
+//!    radius for the pieces is the least distance of its boundary edges from the axis: the pieces contain the mesh,
+//!    not only the true cylinder. Each bend becomes [`Bend::segments`] within the bend tolerance.
+//! 4. **Check**: every boundary point of the solid (arcs sampled every 5 degrees) must lie in the union of the pieces
+//!    within the length tolerance; the first that does not names its face and how far outside it is.
+//!
+//! The solid's volume is the source's when it knows it (the enclosed volume of a mesh); for a B-rep it is the exact
+//! volume of the recognised sheet (each plate's area with its true arcs times the thickness, plus the bends' annular
+//! sectors), which the check above ties to the faces.
+//!
+//! Cost: O(F^2) face pairs for the partners (F faces, with cheap normal and box rejections first) plus one point in
+//! polygon test per sample; O(P x C) for the check (P boundary points, C pieces, with box rejection); the plates'
+//! decomposition as in [`crate::sheet_metal`].
+
+use super::bend::Bend;
+use super::{Brep, BrepFace, FaceSource, Segment, Surface};
+use crate::part::{Part, PartError, PartOrigin};
+use crate::plate::Plate;
+use crate::polygon::{PointInRing, point_in_ring};
+use crate::polytope::{ConvexPolytope, PolytopeError};
+use crate::sheet_metal::{Decomposition, SheetFace, SheetMetal, SheetMetalError};
+use glam::{DVec2, DVec3};
+use serde::{Deserialize, Serialize};
+
+/// The default bend tolerance (mm): how far a piece may stand outside the solid at a bend or a rounded outline.
+/// 0.1 mm keeps the pieces' volume within a few hundredths of a percent of the solid's for the bends of common
+/// sheets (radius up to ten times the thickness), with 5-7 segments for a 90 degree bend of radius 3-14 mm.
+pub const DEFAULT_BEND_TOLERANCE: f64 = 0.1;
+
+/// Options of the recognition.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RecogniseOptions {
+    /// The largest distance (mm, > 0) by which a piece may stand outside the solid at a bend or an arc of an outline.
+    pub bend_tolerance: f64,
+    /// How plates with holes or concave outlines are split into convex polygons.
+    pub decomposition: Decomposition,
+    /// The length tolerance (mm) of the geometric tests: opposite faces one thickness apart, coaxial cylinders, the
+    /// containment check. The caller sets it from the source's precision (a mesh's single-precision coordinates).
+    pub tolerance: f64,
+    /// The part's density.
+    pub density: f64,
+}
+
+impl Default for RecogniseOptions {
+    fn default() -> Self {
+        Self {
+            bend_tolerance: DEFAULT_BEND_TOLERANCE,
+            decomposition: Decomposition::default(),
+            tolerance: 1e-6,
+            density: 1.0,
+        }
+    }
+}
+
+/// A recognised plate.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RecognisedPlate {
+    /// The faces of the side that gives the outline.
+    pub faces: Vec<FaceSource>,
+    /// The faces of the other side.
+    pub other_side: Vec<FaceSource>,
+    /// Unit normal of the mid-plane (the outward normal of `faces`).
+    pub normal: DVec3,
+    /// Area of the mid-surface (mm^2), exact (arcs as arcs).
+    pub area: f64,
+    /// Number of holes.
+    pub holes: usize,
+    /// Number of circular arcs in the outline and holes.
+    pub arcs: usize,
+    /// The part's components that make the plate (indices into [`Part::components`]).
+    pub pieces: Vec<usize>,
+}
+
+/// A recognised bend.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RecognisedBend {
+    /// The geometry: axis, radii, angle, axial interval. `inner_radius` is the fitted or exact radius of the inner
+    /// cylinder.
+    pub bend: Bend,
+    /// The inner cylinder's faces.
+    pub inner_faces: Vec<FaceSource>,
+    /// The outer cylinder's faces.
+    pub outer_faces: Vec<FaceSource>,
+    /// The part's components that make the bend (indices into [`Part::components`]).
+    pub pieces: Vec<usize>,
+}
+
+/// A solid recognised as sheet metal, with its part.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SheetPart {
+    /// The sheet thickness (mm).
+    pub thickness: f64,
+    /// The plates.
+    pub plates: Vec<RecognisedPlate>,
+    /// The bends.
+    pub bends: Vec<RecognisedBend>,
+    /// The solid's volume (mm^3): see the module documentation.
+    pub solid_volume: f64,
+    /// The pieces' volume (mm^3), at least the solid's.
+    pub pieces_volume: f64,
+    /// The largest distance by which a piece stands outside the solid (mm), by construction.
+    pub max_deviation: f64,
+    /// The part: plates' prisms first, then the bends' segments.
+    pub part: Part,
+}
+
+/// Why a solid is not recognised as sheet metal. Every message names the faces.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RecogniseError {
+    /// No pair of opposite planar faces with the material between them.
+    #[error("no two opposite planar faces enclose material: this is no sheet (--decompose reads any solid approximately)")]
+    NoPlates,
+    /// A bend's radii do not differ by the thickness.
+    #[error(
+        "the bend of {inner} (radius {inner_radius:.4} mm) and {outer} (radius {outer_radius:.4} mm) is {bend:.4} mm \
+         thick, but the sheet is {thickness:.4} mm (--decompose reads any solid approximately)"
+    )]
+    BendThickness {
+        /// Inner cylinder face.
+        inner: FaceSource,
+        /// Outer cylinder face.
+        outer: FaceSource,
+        /// Inner radius (mm).
+        inner_radius: f64,
+        /// Outer radius (mm).
+        outer_radius: f64,
+        /// Their difference (mm).
+        bend: f64,
+        /// The sheet's thickness (mm).
+        thickness: f64,
+    },
+    /// Two opposite faces are not one thickness apart, and the solid is not covered by the recognised sheet there.
+    #[error(
+        "{a} and {b} are parallel but {distance:.4} mm apart; the sheet is {thickness:.4} mm: this is no sheet of \
+         constant thickness (--decompose reads any solid approximately)"
+    )]
+    NotConstantThickness {
+        /// One face.
+        a: FaceSource,
+        /// The other.
+        b: FaceSource,
+        /// Their distance (mm).
+        distance: f64,
+        /// The sheet's thickness (mm).
+        thickness: f64,
+    },
+    /// A point of the solid's boundary lies outside every piece.
+    #[error(
+        "{face} reaches ({:.4}, {:.4}, {:.4}), {distance:.4} mm outside every recognised plate and bend of the \
+         {thickness:.4} mm sheet (--decompose reads any solid approximately)",
+        point.x, point.y, point.z
+    )]
+    Outside {
+        /// The face.
+        face: FaceSource,
+        /// The point.
+        point: DVec3,
+        /// Its distance outside the nearest piece (mm, a lower bound).
+        distance: f64,
+        /// The sheet's thickness (mm).
+        thickness: f64,
+    },
+    /// The plates do not make a valid sheet-metal model (a self-intersecting outline, a hole touching the outline).
+    #[error("the plate of {face}: {source}")]
+    Plate {
+        /// The plate's (first) face.
+        face: FaceSource,
+        /// The model's reason.
+        source: SheetMetalError,
+    },
+    /// A bend's segments are not valid polytopes (a bend thinner than the kernel's tolerance).
+    #[error("the bend of {inner}: {source}")]
+    Bend {
+        /// The inner cylinder's face.
+        inner: FaceSource,
+        /// The reason.
+        source: PolytopeError,
+    },
+    /// The pieces do not make a part.
+    #[error(transparent)]
+    Part(#[from] PartError),
+    /// A bad option.
+    #[error("the bend tolerance must be positive and finite, got {0}")]
+    BadTolerance(f64),
+}
+
+/// One planar face, prepared: its frame and its loops as 2-D polygons (arcs sampled) for overlap tests.
+struct PlanarFace<'a> {
+    index: usize,
+    face: &'a BrepFace,
+    point: DVec3,
+    normal: DVec3,
+    u: DVec3,
+    v: DVec3,
+    /// Loops in the face's frame (outer first).
+    rings: Vec<Vec<DVec2>>,
+    /// Exact area (arcs as arcs), mm^2.
+    area: f64,
+    lo: DVec3,
+    hi: DVec3,
+}
+
+/// Cylinders of one axis line, radius and side.
+struct Cylinder {
+    point: DVec3,
+    axis: DVec3,
+    radius: f64,
+    convex: bool,
+    faces: Vec<usize>,
+    points: Vec<DVec3>,
+    /// The least distance from the axis of the faces' boundary edges (mm).
+    least: f64,
+    /// The largest distance from the axis of the faces' boundary points (mm).
+    most: f64,
+}
+
+/// Sampling step on arcs for tests (radians): 5 degrees.
+const ARC_STEP: f64 = std::f64::consts::PI / 36.0;
+
+/// Recognises `brep` as sheet metal and builds its conservative part. See the module documentation.
+pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<SheetPart, RecogniseError> {
+    if !(options.bend_tolerance > 0.0 && options.bend_tolerance.is_finite()) {
+        return Err(RecogniseError::BadTolerance(options.bend_tolerance));
+    }
+    let tol = options.tolerance.max(1e-12);
+    let planes: Vec<PlanarFace<'_>> = brep
+        .faces
+        .iter()
+        .enumerate()
+        .filter_map(|(index, face)| match face.surface {
+            Surface::Plane { point, normal } => planar_face(index, face, point, normal),
+            Surface::Cylinder { .. } => None,
+        })
+        .collect();
+    // 1. partners and thickness
+    let partners: Vec<Option<(usize, f64)>> = (0..planes.len()).map(|i| partner(&planes, i, tol)).collect();
+    let thickness = partners
+        .iter()
+        .enumerate()
+        .filter_map(|(i, p)| p.map(|(j, d)| (planes[i].area.min(planes[j].area), d)))
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, d)| d)
+        .ok_or(RecogniseError::NoPlates)?;
+    let sheet_tol = tol.max(thickness * 1e-6);
+    let at_thickness = |d: f64| (d - thickness).abs() <= 2.0 * sheet_tol;
+    // 2. plates: groups of partner pairs at the thickness
+    let mut parent: Vec<usize> = (0..planes.len()).collect();
+    for (i, p) in partners.iter().enumerate() {
+        if let Some((j, d)) = *p
+            && at_thickness(d)
+        {
+            let (a, b) = (find(&mut parent, i), find(&mut parent, j));
+            parent[a] = b;
+        }
+    }
+    let mut groups: std::collections::BTreeMap<usize, Vec<usize>> = std::collections::BTreeMap::new();
+    for i in 0..planes.len() {
+        let paired = partners[i].is_some_and(|(_, d)| at_thickness(d))
+            || partners.iter().any(|p| p.is_some_and(|(j, d)| j == i && at_thickness(d)));
+        if paired {
+            let root = find(&mut parent, i);
+            groups.entry(root).or_default().push(i);
+        }
+    }
+    let mut sheet = SheetMetal { thickness, faces: Vec::new() };
+    let mut plate_records: Vec<RecognisedPlate> = Vec::new();
+    let mut max_deviation: f64 = 0.0;
+    let mut exact_volume = 0.0;
+    for members in groups.values() {
+        // the two sides: by the sign of the normal against the first member's
+        let n0 = planes[members[0]].normal;
+        let (side_a, side_b): (Vec<usize>, Vec<usize>) = members.iter().partition(|&&i| planes[i].normal.dot(n0) > 0.0);
+        let area = |s: &[usize]| s.iter().map(|&i| planes[i].area).sum::<f64>();
+        let (front, back) = if area(&side_a) >= area(&side_b) { (side_a, side_b) } else { (side_b, side_a) };
+        for &i in &front {
+            let f = &planes[i];
+            // the mid-plane: half the distance to the partner (or to the face whose partner this is)
+            let d = partners[i]
+                .filter(|&(_, d)| at_thickness(d))
+                .map(|(_, d)| d)
+                .or_else(|| {
+                    partners.iter().find_map(|p| p.filter(|&(j, d)| j == i && at_thickness(d)).map(|(_, d)| d))
+                })
+                .unwrap_or(thickness);
+            let shift = -f.normal * (d / 2.0);
+            let (rings, deviation, arcs) = conservative_rings(f, options.bend_tolerance);
+            max_deviation = max_deviation.max(deviation);
+            let lift = |ring: &Vec<DVec3>| -> Vec<DVec3> {
+                ring.iter().map(|p| *p - f.normal * (*p - f.point).dot(f.normal) + shift).collect()
+            };
+            let mut rings3: Vec<Vec<DVec3>> = rings.iter().map(lift).collect();
+            let outline = rings3.remove(0);
+            plate_records.push(RecognisedPlate {
+                faces: vec![f.face.source.clone()],
+                other_side: back.iter().map(|&j| planes[j].face.source.clone()).collect(),
+                normal: f.normal,
+                area: f.area,
+                holes: rings3.len(),
+                arcs,
+                pieces: Vec::new(),
+            });
+            exact_volume += f.area * thickness;
+            sheet.faces.push(SheetFace { outline, holes: rings3 });
+        }
+    }
+    if sheet.faces.is_empty() {
+        return Err(RecogniseError::NoPlates);
+    }
+    // 3. bends
+    let cylinders = merge_cylinders(brep, tol);
+    let mut bends: Vec<RecognisedBend> = Vec::new();
+    let mut used = vec![false; cylinders.len()];
+    let mut piece_radii: Vec<(f64, f64)> = Vec::new();
+    for (i, inner) in cylinders.iter().enumerate() {
+        if inner.convex {
+            continue;
+        }
+        let outer = cylinders
+            .iter()
+            .enumerate()
+            .filter(|(j, c)| {
+                !used[*j] && c.convex && c.radius > inner.radius && coaxial(inner, c, tol) && angles_overlap(inner, c)
+            })
+            .min_by(|a, b| a.1.radius.total_cmp(&b.1.radius));
+        let Some((j, outer)) = outer else { continue };
+        let bend_thickness = outer.radius - inner.radius;
+        let (axial, _, _) = ranges(inner, outer);
+        if axial[1] - axial[0] <= thickness + sheet_tol && !at_thickness(bend_thickness) {
+            // a hole concentric with a rounded corner of a plate: cut edges, not a bend
+            continue;
+        }
+        if !at_thickness(bend_thickness) {
+            return Err(RecogniseError::BendThickness {
+                inner: brep.faces[inner.faces[0]].source.clone(),
+                outer: brep.faces[outer.faces[0]].source.clone(),
+                inner_radius: inner.radius,
+                outer_radius: outer.radius,
+                bend: bend_thickness,
+                thickness,
+            });
+        }
+        used[i] = true;
+        used[j] = true;
+        let (axial, start, angle) = ranges(inner, outer);
+        let bend = Bend {
+            center: inner.point,
+            axis: inner.axis,
+            inner_radius: inner.radius,
+            outer_radius: outer.radius,
+            start,
+            angle,
+            axial,
+        };
+        exact_volume += bend.volume();
+        bends.push(RecognisedBend {
+            bend,
+            inner_faces: inner.faces.iter().map(|&f| brep.faces[f].source.clone()).collect(),
+            outer_faces: outer.faces.iter().map(|&f| brep.faces[f].source.clone()).collect(),
+            pieces: Vec::new(),
+        });
+        // the pieces' radii: the chords of a tessellated inner arc lie inside it
+        piece_radii.push((inner.radius.min(inner.least), outer.radius.max(outer.most)));
+    }
+    // 4. pieces
+    let (base, counts) = sheet
+        .build_part_counted(name, options.density, options.decomposition)
+        .map_err(|source| plate_error(source, &plate_records))?;
+    let plates: Vec<Plate> = base.plates;
+    let mut components = base.components;
+    let mut next = 0;
+    for (record, count) in plate_records.iter_mut().zip(counts) {
+        record.pieces = (next..next + count).collect();
+        next += count;
+    }
+    for (b, &(r, big_r)) in bends.iter_mut().zip(&piece_radii) {
+        let cover = Bend { inner_radius: r, outer_radius: big_r, ..b.bend };
+        let n = cover.segments_within(options.bend_tolerance);
+        let pieces = cover.segments(n).map_err(|source| RecogniseError::Bend {
+            inner: b.inner_faces.first().cloned().unwrap_or(FaceSource::Step { entity: 0 }),
+            source,
+        })?;
+        // how far the segments stand outside the true (or fitted) cylinders
+        let half = cover.angle / (2.0 * n as f64);
+        let outward = (big_r / half.cos() - b.bend.outer_radius).max(b.bend.inner_radius - r * half.cos());
+        max_deviation = max_deviation.max(outward);
+        b.pieces = (components.len()..components.len() + pieces.len()).collect();
+        components.extend(pieces);
+    }
+    // 5. the check: every boundary point inside the pieces
+    check_cover(brep, &components, tol.max(1e-9 * diagonal(&components)), thickness, &partners, &planes)?;
+    let solid_volume = brep.volume.unwrap_or(exact_volume);
+    let mut part = Part::from_components(
+        name,
+        components,
+        options.density,
+        PartOrigin::SheetMetal { thickness },
+    )?;
+    part.plates = plates;
+    let pieces_volume = part.mass.volume;
+    tracing::debug!(
+        name,
+        thickness,
+        plates = plate_records.len(),
+        bends = bends.len(),
+        pieces = part.components.len(),
+        solid_volume,
+        pieces_volume,
+        max_deviation,
+        "recognised sheet metal"
+    );
+    Ok(SheetPart { thickness, plates: plate_records, bends, solid_volume, pieces_volume, max_deviation, part })
+}
+
+fn plate_error(source: SheetMetalError, plates: &[RecognisedPlate]) -> RecogniseError {
+    let face = match &source {
+        SheetMetalError::NonFinite { face, .. }
+        | SheetMetalError::TooFewVertices { face, .. }
+        | SheetMetalError::ZeroArea { face, .. }
+        | SheetMetalError::NonPlanar { face, .. }
+        | SheetMetalError::SelfIntersecting { face, .. }
+        | SheetMetalError::HoleNotInside { face, .. }
+        | SheetMetalError::HolesOverlap { face, .. }
+        | SheetMetalError::Triangulation { face, .. }
+        | SheetMetalError::Prism { face, .. } => Some(*face),
+        _ => None,
+    };
+    let face = face
+        .and_then(|f| plates.get(f))
+        .and_then(|p| p.faces.first().cloned())
+        .unwrap_or(FaceSource::Step { entity: 0 });
+    RecogniseError::Plate { face, source }
+}
+
+fn diagonal(components: &[ConvexPolytope]) -> f64 {
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for c in components {
+        let (a, b) = c.aabb();
+        lo = lo.min(a);
+        hi = hi.max(b);
+    }
+    (hi - lo).length()
+}
+
+fn find(parent: &mut [usize], mut x: usize) -> usize {
+    while parent[x] != x {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    x
+}
+
+/// A planar face's frame, 2-D rings (arcs sampled) and exact area; `None` for a face without a usable loop.
+fn planar_face(index: usize, face: &BrepFace, point: DVec3, normal: DVec3) -> Option<PlanarFace<'_>> {
+    let normal = normal.normalize_or_zero();
+    if normal == DVec3::ZERO || face.loops.is_empty() {
+        return None;
+    }
+    let u = normal.any_orthonormal_vector();
+    let v = normal.cross(u);
+    let to2 = |p: DVec3| DVec2::new((p - point).dot(u), (p - point).dot(v));
+    let rings: Vec<Vec<DVec2>> = face
+        .loops
+        .iter()
+        .map(|lp| {
+            let mut ring = Vec::new();
+            for s in lp {
+                let n = (s.sweep() / ARC_STEP).ceil().max(1.0) as usize;
+                let pts = s.points(n);
+                ring.extend(pts[..pts.len() - 1].iter().map(|p| to2(*p)));
+            }
+            ring
+        })
+        .filter(|r| r.len() >= 3)
+        .collect();
+    if rings.is_empty() {
+        return None;
+    }
+    // outline minus holes, whatever the loops' orientation
+    let areas: Vec<f64> = face.loops.iter().map(|lp| loop_area(lp, normal).abs()).collect();
+    let largest = areas.iter().copied().fold(0.0, f64::max);
+    let area = 2.0 * largest - areas.iter().sum::<f64>();
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for lp in &face.loops {
+        for s in lp {
+            for p in s.points((s.sweep() / ARC_STEP).ceil().max(1.0) as usize) {
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+    }
+    Some(PlanarFace { index, face, point, normal, u, v, rings, area, lo, hi })
+}
+
+/// The signed area of a loop about `normal` (mm^2), exact: the polygon of the segments' end points plus, for each
+/// arc, its circular segment, signed by the arc's turn about the normal.
+fn loop_area(lp: &[Segment], normal: DVec3) -> f64 {
+    let mut twice = 0.0;
+    let origin = lp.first().map(Segment::start).unwrap_or(DVec3::ZERO);
+    let mut arcs = 0.0;
+    for s in lp {
+        let (a, b) = (s.start() - origin, s.end() - origin);
+        twice += a.cross(b).dot(normal);
+        if let Segment::Arc { axis, radius, .. } = *s {
+            let phi = s.sweep();
+            arcs += axis.dot(normal).signum() * radius * radius / 2.0 * (phi - phi.sin());
+        }
+    }
+    twice / 2.0 + arcs
+}
+
+/// Whether the projections of two faces overlap: sample points inside `a` (a grid over its box) inside `b`.
+fn overlaps(a: &PlanarFace<'_>, b: &PlanarFace<'_>) -> bool {
+    // b's rings in a's frame
+    let to_a = |q: DVec2| {
+        let p = b.point + b.u * q.x + b.v * q.y;
+        DVec2::new((p - a.point).dot(a.u), (p - a.point).dot(a.v))
+    };
+    let b_rings: Vec<Vec<DVec2>> = b.rings.iter().map(|r| r.iter().map(|q| to_a(*q)).collect()).collect();
+    let inside = |rings: &[Vec<DVec2>], p: DVec2| {
+        rings.iter().filter(|r| point_in_ring(p, r) == PointInRing::Inside).count() % 2 == 1
+    };
+    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    for q in &a.rings[0] {
+        lo = lo.min(*q);
+        hi = hi.max(*q);
+    }
+    const GRID: usize = 24;
+    for i in 0..GRID {
+        for j in 0..GRID {
+            let p = lo + (hi - lo) * DVec2::new((i as f64 + 0.5) / GRID as f64, (j as f64 + 0.5) / GRID as f64);
+            if inside(&a.rings, p) && inside(&b_rings, p) {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+/// The nearest opposite face behind face `i` whose projection overlaps it, and its distance.
+fn partner(planes: &[PlanarFace<'_>], i: usize, tol: f64) -> Option<(usize, f64)> {
+    let a = &planes[i];
+    let mut best: Option<(usize, f64)> = None;
+    for (j, b) in planes.iter().enumerate() {
+        if j == i || a.normal.dot(b.normal) > -1.0 + 1e-6 {
+            continue;
+        }
+        let d = -(b.point - a.point).dot(a.normal);
+        if d <= tol || best.is_some_and(|(_, e)| e <= d) {
+            continue;
+        }
+        // boxes must overlap in the plane directions (cheap rejection)
+        let slack = DVec3::splat(d + tol);
+        if (0..3).any(|k| a.lo[k] > b.hi[k] + slack[k] || b.lo[k] > a.hi[k] + slack[k]) {
+            continue;
+        }
+        if overlaps(a, b) || overlaps(b, a) {
+            best = Some((j, d));
+        }
+    }
+    best
+}
+
+/// The loops of a planar face as polygons that never cut into the material (see the module documentation), outer
+/// first, with the largest deviation from the true loops and the number of arcs.
+fn conservative_rings(f: &PlanarFace<'_>, tolerance: f64) -> (Vec<Vec<DVec3>>, f64, usize) {
+    let n = f.normal;
+    // orient: the outer (largest) loop counter-clockwise about the normal, the others clockwise
+    let areas: Vec<f64> = f.face.loops.iter().map(|lp| loop_area(lp, n)).collect();
+    let outer = (0..areas.len()).max_by(|&a, &b| areas[a].abs().total_cmp(&areas[b].abs())).unwrap_or(0);
+    let mut order = vec![outer];
+    order.extend((0..areas.len()).filter(|&k| k != outer));
+    let mut deviation: f64 = 0.0;
+    let mut arcs = 0;
+    let mut out = Vec::new();
+    for k in order {
+        let lp = &f.face.loops[k];
+        let want_ccw = k == outer;
+        let reverse = (areas[k] > 0.0) != want_ccw;
+        let segments: Vec<Segment> =
+            if reverse { lp.iter().rev().map(Segment::reversed).collect() } else { lp.clone() };
+        let mut ring: Vec<DVec3> = Vec::new();
+        for s in &segments {
+            match *s {
+                Segment::Line { start, .. } => ring.push(start),
+                Segment::Arc { center, axis, radius, start, end } => {
+                    arcs += 1;
+                    let phi = s.sweep();
+                    // with the face on the left, the material lies on the centre side iff the arc turns
+                    // counter-clockwise about the outward normal
+                    let tangents = axis.dot(n) > 0.0;
+                    let steps = arc_steps(radius, phi, tolerance, tangents);
+                    let delta = phi / steps as f64;
+                    let (u0, w) = (start - center, axis.cross(start - center));
+                    let at = |a: f64, r: f64| center + (u0 * a.cos() + w * a.sin()) * (r / radius);
+                    if tangents {
+                        deviation = deviation.max(radius * (1.0 / (delta / 2.0).cos() - 1.0));
+                        if start != end {
+                            ring.push(start);
+                        }
+                        let corner = radius / (delta / 2.0).cos();
+                        ring.extend((0..steps).map(|i| at(delta * (i as f64 + 0.5), corner)));
+                    } else {
+                        deviation = deviation.max(radius * (1.0 - (delta / 2.0).cos()));
+                        ring.extend((0..steps).map(|i| at(delta * i as f64, radius)));
+                    }
+                    let _ = end;
+                }
+            }
+        }
+        out.push(ring);
+    }
+    (out, deviation, arcs)
+}
+
+/// Steps for an arc of radius `r` and sweep `phi` within `tolerance`: tangents deviate by `r (1/cos(d/2) - 1)`,
+/// chords by `r (1 - cos(d/2))`; at least one step per 60 degrees, at most 4096.
+fn arc_steps(r: f64, phi: f64, tolerance: f64, tangents: bool) -> usize {
+    let c = if tangents { r / (r + tolerance) } else { 1.0 - (tolerance / r).min(1.0) };
+    let delta = 2.0 * c.clamp(-1.0, 1.0).acos();
+    let by_tolerance = if delta > 0.0 { (phi / delta).ceil() } else { 4096.0 };
+    let by_angle = (phi / std::f64::consts::FRAC_PI_3).ceil();
+    (by_tolerance.max(by_angle).max(1.0) as usize).min(4096)
+}
+
+/// Cylindrical faces merged by axis line, radius and side.
+fn merge_cylinders(brep: &Brep, tol: f64) -> Vec<Cylinder> {
+    let mut out: Vec<Cylinder> = Vec::new();
+    for (index, face) in brep.faces.iter().enumerate() {
+        let Surface::Cylinder { point, axis, radius, convex } = face.surface else { continue };
+        let axis = axis.normalize_or_zero();
+        if axis == DVec3::ZERO || !(radius > 0.0) {
+            continue;
+        }
+        let points = face.boundary_points(ARC_STEP);
+        let distance = |p: DVec3| {
+            let d = p - point;
+            (d - axis * d.dot(axis)).length()
+        };
+        // the least distance of a boundary edge from the axis (chords of a tessellated inner arc)
+        let mut least = radius;
+        let mut most: f64 = radius;
+        for lp in &face.loops {
+            for s in lp {
+                match *s {
+                    Segment::Line { start, end } => {
+                        least = least.min(segment_axis_distance(start, end, point, axis));
+                        most = most.max(distance(start)).max(distance(end));
+                    }
+                    Segment::Arc { .. } => {
+                        for p in s.points((s.sweep() / ARC_STEP).ceil().max(1.0) as usize) {
+                            least = least.min(distance(p));
+                            most = most.max(distance(p));
+                        }
+                    }
+                }
+            }
+        }
+        let candidate = Cylinder { point, axis, radius, convex, faces: vec![index], points, least, most };
+        match out.iter_mut().find(|c| c.convex == convex && (c.radius - radius).abs() <= tol && coaxial(c, &candidate, tol))
+        {
+            Some(c) => {
+                c.faces.push(index);
+                c.points.extend(candidate.points);
+                c.least = c.least.min(least);
+                c.most = c.most.max(most);
+            }
+            None => out.push(candidate),
+        }
+    }
+    out
+}
+
+/// The least distance from the axis line of the segment `a b` (measured perpendicular to the axis).
+fn segment_axis_distance(a: DVec3, b: DVec3, point: DVec3, axis: DVec3) -> f64 {
+    let flat = |p: DVec3| {
+        let d = p - point;
+        d - axis * d.dot(axis)
+    };
+    let (p, q) = (flat(a), flat(b));
+    let e = q - p;
+    let len2 = e.length_squared();
+    let s = if len2 > 0.0 { (-p.dot(e) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    (p + e * s).length()
+}
+
+/// Whether two cylinders share their axis line (within `tol` over their extent).
+fn coaxial(a: &Cylinder, b: &Cylinder, tol: f64) -> bool {
+    let cross = a.axis.cross(b.axis).length();
+    let extent = a.points.iter().chain(&b.points).map(|p| (*p - a.point).length()).fold(a.radius, f64::max);
+    if cross * extent > tol.max(1e-9 * extent) * 10.0 {
+        return false;
+    }
+    let d = b.point - a.point;
+    (d - a.axis * d.dot(a.axis)).length() <= 10.0 * tol.max(1e-9 * extent)
+}
+
+/// The angles of points about a cylinder's axis, measured from `start`.
+fn angle_of(axis: DVec3, start: DVec3, center: DVec3, p: DVec3) -> f64 {
+    let d = p - center;
+    let w = axis.cross(start);
+    let a = d.dot(w).atan2(d.dot(start));
+    if a < 0.0 { a + std::f64::consts::TAU } else { a }
+}
+
+/// The smallest angular interval containing the points' angles: `(start direction, angle)`.
+fn angle_range(axis: DVec3, center: DVec3, points: &[DVec3]) -> (DVec3, f64) {
+    let reference = points
+        .iter()
+        .map(|p| {
+            let d = *p - center;
+            d - axis * d.dot(axis)
+        })
+        .find(|d| d.length() > 0.0)
+        .map(|d| d.normalize())
+        .unwrap_or_else(|| axis.any_orthonormal_vector());
+    let mut angles: Vec<f64> = points.iter().map(|p| angle_of(axis, reference, center, *p)).collect();
+    angles.sort_by(f64::total_cmp);
+    if angles.is_empty() {
+        return (reference, 0.0);
+    }
+    // the largest gap (cyclically) is outside the range
+    let mut gap = angles[0] + std::f64::consts::TAU - angles[angles.len() - 1];
+    let mut start_angle = angles[0];
+    for k in 1..angles.len() {
+        let g = angles[k] - angles[k - 1];
+        if g > gap {
+            gap = g;
+            start_angle = angles[k];
+        }
+    }
+    let w = axis.cross(reference);
+    let start = reference * start_angle.cos() + w * start_angle.sin();
+    (start, std::f64::consts::TAU - gap)
+}
+
+/// Whether the angle ranges of two coaxial cylinders overlap.
+fn angles_overlap(a: &Cylinder, b: &Cylinder) -> bool {
+    let (start, angle) = angle_range(a.axis, a.point, &a.points);
+    let (start_b, angle_b) = angle_range(a.axis, a.point, &b.points);
+    let sb = angle_of(a.axis, start, a.point, a.point + start_b);
+    let eb = sb + angle_b;
+    // b's interval [sb, eb] against a's [0, angle], cyclically
+    let tau = std::f64::consts::TAU;
+    let hit = |lo: f64, hi: f64| lo < angle - 1e-9 && hi > 1e-9;
+    hit(sb, eb) || hit(sb - tau, eb - tau)
+}
+
+/// A bend's axial interval (about the inner cylinder's axis point), start direction and angle from both cylinders.
+fn ranges(inner: &Cylinder, outer: &Cylinder) -> ([f64; 2], DVec3, f64) {
+    let points: Vec<DVec3> = inner.points.iter().chain(&outer.points).copied().collect();
+    let (lo, hi) = points
+        .iter()
+        .map(|p| (*p - inner.point).dot(inner.axis))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), z| (lo.min(z), hi.max(z)));
+    let (start, angle) = angle_range(inner.axis, inner.point, &points);
+    ([lo, hi], start, angle)
+}
+
+/// Checks that every boundary point of the solid lies in the union of the pieces (within `tol`).
+fn check_cover(
+    brep: &Brep,
+    components: &[ConvexPolytope],
+    tol: f64,
+    thickness: f64,
+    partners: &[Option<(usize, f64)>],
+    planes: &[PlanarFace<'_>],
+) -> Result<(), RecogniseError> {
+    let boxes: Vec<(DVec3, DVec3)> = components.iter().map(ConvexPolytope::aabb).collect();
+    for face in &brep.faces {
+        for p in face.boundary_points(ARC_STEP) {
+            let mut best = f64::INFINITY;
+            for (c, (lo, hi)) in components.iter().zip(&boxes) {
+                if (0..3).any(|k| p[k] < lo[k] - tol || p[k] > hi[k] + tol) {
+                    let outside = (*lo - p).max(p - *hi).max(DVec3::ZERO).length();
+                    best = best.min(outside.max(tol * 2.0));
+                    continue;
+                }
+                let d = c.planes().map(|pl| pl.signed_distance(p)).fold(f64::NEG_INFINITY, f64::max);
+                best = best.min(d);
+                if best <= tol {
+                    break;
+                }
+            }
+            if best > tol {
+                // a planar face with an opposite face at another distance: say so
+                let index = brep.faces.iter().position(|f| std::ptr::eq(f, face)).unwrap_or(0);
+                if let Some(pf) = planes.iter().position(|q| q.index == index)
+                    && let Some((j, d)) = partners[pf]
+                    && (d - thickness).abs() > 2.0 * tol.max(thickness * 1e-6)
+                {
+                    return Err(RecogniseError::NotConstantThickness {
+                        a: face.source.clone(),
+                        b: planes[j].face.source.clone(),
+                        distance: d,
+                        thickness,
+                    });
+                }
+                return Err(RecogniseError::Outside { face: face.source.clone(), point: p, distance: best, thickness });
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::{FRAC_PI_2, PI};
+
+    const T: f64 = 2.0;
+    const R: f64 = 3.0;
+    const W: f64 = 40.0;
+    const L1: f64 = 50.0;
+    const L2: f64 = 30.0;
+
+    fn line(a: [f64; 3], b: [f64; 3]) -> Segment {
+        Segment::Line { start: DVec3::from_array(a), end: DVec3::from_array(b) }
+    }
+
+    fn polygon(points: &[[f64; 3]]) -> Vec<Segment> {
+        (0..points.len()).map(|i| line(points[i], points[(i + 1) % points.len()])).collect()
+    }
+
+    fn plane(points: &[[f64; 3]], normal: [f64; 3], k: u64) -> BrepFace {
+        BrepFace {
+            source: FaceSource::Step { entity: k },
+            surface: Surface::Plane { point: DVec3::from_array(points[0]), normal: DVec3::from_array(normal) },
+            loops: vec![polygon(points)],
+        }
+    }
+
+    /// An L profile in the x-z plane extruded along y over `[0, W]`: plate A (z in [0, T], x in [-L1, 0]), a 90
+    /// degree bend about the axis through (0, y, T + R), plate B (x in [R, R + T], up to z = T + R + L2). With
+    /// `hole`, plate A has a round hole of radius 5 at (-25, 20).
+    fn l_profile(hole: bool) -> Brep {
+        let (t, r, big) = (T, R, R + T);
+        let c = |y: f64| DVec3::new(0.0, y, t + r);
+        let top = t + r + L2;
+        let profile = |y: f64| -> Vec<Segment> {
+            vec![
+                line([-L1, y, 0.0], [0.0, y, 0.0]),
+                Segment::Arc {
+                    center: c(y),
+                    axis: -DVec3::Y,
+                    radius: big,
+                    start: DVec3::new(0.0, y, 0.0),
+                    end: DVec3::new(big, y, t + r),
+                },
+                line([big, y, t + r], [big, y, top]),
+                line([big, y, top], [r, y, top]),
+                line([r, y, top], [r, y, t + r]),
+                Segment::Arc {
+                    center: c(y),
+                    axis: DVec3::Y,
+                    radius: r,
+                    start: DVec3::new(r, y, t + r),
+                    end: DVec3::new(0.0, y, t),
+                },
+                line([0.0, y, t], [-L1, y, t]),
+                line([-L1, y, t], [-L1, y, 0.0]),
+            ]
+        };
+        let circle = |z: f64| Segment::Arc {
+            center: DVec3::new(-25.0, 20.0, z),
+            axis: DVec3::Z,
+            radius: 5.0,
+            start: DVec3::new(-20.0, 20.0, z),
+            end: DVec3::new(-20.0, 20.0, z),
+        };
+        let mut a_bottom = plane(&[[-L1, 0.0, 0.0], [-L1, W, 0.0], [0.0, W, 0.0], [0.0, 0.0, 0.0]], [0.0, 0.0, -1.0], 1);
+        let mut a_top = plane(&[[-L1, 0.0, t], [0.0, 0.0, t], [0.0, W, t], [-L1, W, t]], [0.0, 0.0, 1.0], 2);
+        if hole {
+            a_bottom.loops.push(vec![circle(0.0)]);
+            a_top.loops.push(vec![circle(t)]);
+        }
+        let mut faces = vec![
+            a_bottom,
+            a_top,
+            plane(&[[-L1, 0.0, 0.0], [-L1, 0.0, t], [-L1, W, t], [-L1, W, 0.0]], [-1.0, 0.0, 0.0], 3),
+            plane(&[[r, 0.0, t + r], [r, 0.0, top], [r, W, top], [r, W, t + r]], [-1.0, 0.0, 0.0], 4),
+            plane(&[[big, 0.0, t + r], [big, W, t + r], [big, W, top], [big, 0.0, top]], [1.0, 0.0, 0.0], 5),
+            plane(&[[r, 0.0, top], [big, 0.0, top], [big, W, top], [r, W, top]], [0.0, 0.0, 1.0], 6),
+            BrepFace {
+                source: FaceSource::Step { entity: 7 },
+                surface: Surface::Plane { point: DVec3::new(0.0, 0.0, 0.0), normal: -DVec3::Y },
+                loops: vec![profile(0.0)],
+            },
+            BrepFace {
+                source: FaceSource::Step { entity: 8 },
+                surface: Surface::Plane { point: DVec3::new(0.0, W, 0.0), normal: DVec3::Y },
+                loops: vec![profile(W)],
+            },
+            BrepFace {
+                source: FaceSource::Step { entity: 9 },
+                surface: Surface::Cylinder { point: c(0.0), axis: DVec3::Y, radius: r, convex: false },
+                loops: vec![vec![
+                    line([0.0, 0.0, t], [0.0, W, t]),
+                    Segment::Arc {
+                        center: c(W),
+                        axis: -DVec3::Y,
+                        radius: r,
+                        start: DVec3::new(0.0, W, t),
+                        end: DVec3::new(r, W, t + r),
+                    },
+                    line([r, W, t + r], [r, 0.0, t + r]),
+                    Segment::Arc {
+                        center: c(0.0),
+                        axis: DVec3::Y,
+                        radius: r,
+                        start: DVec3::new(r, 0.0, t + r),
+                        end: DVec3::new(0.0, 0.0, t),
+                    },
+                ]],
+            },
+            BrepFace {
+                source: FaceSource::Step { entity: 10 },
+                surface: Surface::Cylinder { point: c(0.0), axis: DVec3::Y, radius: big, convex: true },
+                loops: vec![vec![
+                    line([0.0, 0.0, 0.0], [0.0, W, 0.0]),
+                    Segment::Arc {
+                        center: c(W),
+                        axis: -DVec3::Y,
+                        radius: big,
+                        start: DVec3::new(0.0, W, 0.0),
+                        end: DVec3::new(big, W, t + r),
+                    },
+                    line([big, W, t + r], [big, 0.0, t + r]),
+                    Segment::Arc {
+                        center: c(0.0),
+                        axis: DVec3::Y,
+                        radius: big,
+                        start: DVec3::new(big, 0.0, t + r),
+                        end: DVec3::new(0.0, 0.0, 0.0),
+                    },
+                ]],
+            },
+        ];
+        if hole {
+            faces.push(BrepFace {
+                source: FaceSource::Step { entity: 11 },
+                surface: Surface::Cylinder {
+                    point: DVec3::new(-25.0, 20.0, 0.0),
+                    axis: DVec3::Z,
+                    radius: 5.0,
+                    convex: false,
+                },
+                loops: vec![vec![circle(0.0)], vec![circle(t)]],
+            });
+        }
+        Brep { faces, volume: None }
+    }
+
+    fn exact_volume(hole: bool) -> f64 {
+        let bend = FRAC_PI_2 / 2.0 * ((R + T).powi(2) - R * R) * W;
+        let hole = if hole { PI * 25.0 * T } else { 0.0 };
+        (L1 + L2) * T * W + bend - hole
+    }
+
+    /// Whether `p` lies in the true solid.
+    fn in_solid(p: DVec3, hole: bool) -> bool {
+        if !(0.0..=W).contains(&p.y) {
+            return false;
+        }
+        if hole && (p.x + 25.0).powi(2) + (p.y - 20.0).powi(2) < 25.0 {
+            return false;
+        }
+        let plate_a = (-L1..=0.0).contains(&p.x) && (0.0..=T).contains(&p.z);
+        let plate_b = (R..=R + T).contains(&p.x) && (T + R..=T + R + L2).contains(&p.z);
+        let (dx, dz) = (p.x, p.z - (T + R));
+        let rho = (dx * dx + dz * dz).sqrt();
+        let bend = dx >= 0.0 && dz <= 0.0 && (R..=R + T).contains(&rho);
+        plate_a || plate_b || bend
+    }
+
+    #[test]
+    fn an_l_profile_gives_two_plates_one_bend_and_pieces_that_contain_it() {
+        for hole in [false, true] {
+            let sheet = recognise(&l_profile(hole), "l", &RecogniseOptions::default()).expect("recognised");
+            assert!((sheet.thickness - T).abs() < 1e-12);
+            assert_eq!(sheet.plates.len(), 2);
+            assert_eq!(sheet.plates.iter().map(|p| p.holes).sum::<usize>(), usize::from(hole));
+            assert_eq!(sheet.bends.len(), 1);
+            let b = &sheet.bends[0];
+            assert!((b.bend.inner_radius - R).abs() < 1e-12 && (b.bend.outer_radius - R - T).abs() < 1e-12);
+            assert!((b.bend.angle - FRAC_PI_2).abs() < 1e-9, "angle {}", b.bend.angle);
+            assert!((b.bend.axial[1] - b.bend.axial[0] - W).abs() < 1e-9);
+            let exact = exact_volume(hole);
+            assert!((sheet.solid_volume - exact).abs() < 1e-6 * exact, "{} vs {exact}", sheet.solid_volume);
+            assert!(sheet.pieces_volume >= exact * (1.0 - 1e-12));
+            assert!(sheet.pieces_volume <= exact * 1.01, "{} vs {exact}", sheet.pieces_volume);
+            assert!(sheet.max_deviation <= DEFAULT_BEND_TOLERANCE + 1e-12 && sheet.max_deviation > 0.0);
+            // every sampled point of the solid lies in a piece
+            let comps = &sheet.part.components;
+            let mut inside = 0;
+            for i in 0..40 {
+                for j in 0..12 {
+                    for k in 0..40 {
+                        let p = DVec3::new(
+                            -L1 + (L1 + R + T) * (i as f64 + 0.37) / 40.0,
+                            W * (j as f64 + 0.41) / 12.0,
+                            (T + R + L2) * (k as f64 + 0.29) / 40.0,
+                        );
+                        if in_solid(p, hole) {
+                            inside += 1;
+                            assert!(
+                                comps.iter().any(|c| c.planes().all(|pl| pl.signed_distance(p) <= 1e-9)),
+                                "{p} outside the pieces"
+                            );
+                        }
+                    }
+                }
+            }
+            assert!(inside > 500);
+        }
+    }
+
+    #[test]
+    fn a_block_is_no_sheet_and_the_error_names_the_faces() {
+        // the L profile with plate B twice as thick on one side: its skins are 4 mm apart
+        let mut brep = l_profile(false);
+        for f in &mut brep.faces {
+            if f.source == (FaceSource::Step { entity: 5 }) {
+                for s in &mut f.loops[0] {
+                    if let Segment::Line { start, end } = s {
+                        start.x += 2.0;
+                        end.x += 2.0;
+                    }
+                }
+                f.surface = Surface::Plane { point: DVec3::new(R + T + 2.0, 0.0, T + R), normal: DVec3::X };
+            }
+        }
+        let err = recognise(&brep, "l", &RecogniseOptions::default()).expect_err("not a sheet");
+        let text = err.to_string();
+        assert!(text.contains("--decompose"), "{text}");
+        assert!(text.contains('#'), "{text}");
+    }
+}
