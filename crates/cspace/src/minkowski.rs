@@ -30,9 +30,9 @@
 //! the threshold of merged face normals, so that a rotation about a face normal by less than it merges the faces and
 //! their edges alike). Every other decision of the merge is the sign of `(v x w) . u` for two edge directions that
 //! are not parallel, which rounding cannot flip; a face plus an edge (most merged faces of sheet metal rotated about
-//! `z`) takes a one-pass form of the same rule (`face_plus_segment`). (Until session 13 this was a labelled 2-D hull
-//! of the `|F| |G|` rounded sum points with duplicates and corners within a *length* tolerance removed; on every
-//! input away from the tolerance band both give the same faces, see `docs/benchmarks.md`, cspace section.)
+//! `z`) takes a one-pass form of the same rule (`face_plus_segment`). A labelled 2-D hull of the `|F| |G|` rounded sum
+//! points, with duplicates and corners within a *length* tolerance removed, gives the same faces on every input away
+//! from the tolerance band, but within it its length rule can contradict the angle rule of the unmerged side faces.
 //!
 //! Why a tolerance and not exact predicates: the input to this step is a *rotated* polytope whose coordinates are
 //! already rounded (`cos(pi / 2)` is not 0 in `f64`), so exact parallelism of a rotated face with a fixed one cannot be
