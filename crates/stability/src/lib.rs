@@ -14,7 +14,7 @@
 //! * [`growing`]: a stack that grows one part at a time and the verdict on a candidate for its next part (the
 //!   planner's per-candidate test).
 //!
-//! Helpers: [`sat`] (separating-axis test with sweeps), [`polygon2d`] (planar hulls and clipping), [`world`]
+//! Building blocks: [`sat`] (separating-axis test with sweeps), [`polygon2d`] (planar hulls and clipping), [`world`]
 //! (placed parts in world coordinates). Lengths in millimetres, angles in radians, forces in mass units times g.
 
 pub mod addition;
