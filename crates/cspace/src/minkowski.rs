@@ -89,9 +89,9 @@ pub enum Feature {
 /// What generated a face of the obstacle. Indices refer to the moving polytope `A` (vertices, edges, faces of `A` in
 /// its own coordinates) and the fixed polytope `B`.
 ///
-/// The first three kinds are the generic ones (\[A\] App. B; DESIGN.md section 3). The last three are the merged faces
-/// of degenerate configurations (parallel faces, a face parallel to an edge): they are exactly one face of the sum and
-/// name both generating features.
+/// The first three kinds are the generic ones (\[A\] App. B; `docs/algorithms.md`, "C-space obstacle of a convex
+/// pair"). The last three are the merged faces of degenerate configurations (parallel faces, a face parallel to an
+/// edge): they are exactly one face of the sum and name both generating features.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum FaceKind {

@@ -1,5 +1,5 @@
-//! Best-first search over (orientation, free-space cell) nodes: the placement of one part (\[A\] V-A..C, DESIGN.md
-//! section 6).
+//! Best-first search over (orientation, free-space cell) nodes: the placement of one part (\[A\] V-A..C;
+//! `docs/algorithms.md`, "Placement search").
 //!
 //! A node is an orientation `theta_k`, a convex cell `K` of positions (an H-polytope, \[A\] VI-A-1) and the optimum
 //! `p*` of the cost over `K` (`f(p*)` is the key). The roots are `(theta_k, Omega(theta_k))`. Loop:

@@ -1,5 +1,5 @@
 //! Settling a released part: the vertical drop from the position the search found, where the robot releases the
-//! part, to where it comes to rest (\[A\] VII-B; DESIGN.md section 7).
+//! part, to where it comes to rest (\[A\] VII-B; `docs/algorithms.md`, "Stability, grasp and insertion").
 //!
 //! **Why.** With the seed's clearance for robot positioning error ("the parts are separated in the plane by at least
 //! 5 mm", \[A\] VII-B, grown as in eq. 10-11) an obstacle face of unit normal `n` moves out by `delta |n_xy|`. A

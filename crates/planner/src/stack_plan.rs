@@ -1,4 +1,5 @@
-//! The stacking planner for n identical parts (\[A\] section II-B, "generate and test"; DESIGN.md sections 6-7).
+//! The stacking planner for n identical parts (\[A\] section II-B, "generate and test"; `docs/algorithms.md`,
+//! "Placement search" and "Stability, grasp and insertion").
 //!
 //! Parts are added one at a time; the parts already placed never move. For each new part:
 //!

@@ -1,6 +1,7 @@
 //! # stackplan-stability
 //!
-//! Conditions (ii)-(iv) of a stacking configuration (Ayyadevara et al. 2002, \[A\] II-B; DESIGN.md section 7):
+//! Conditions (ii)-(iv) of a stacking configuration (Ayyadevara et al. 2002, \[A\] II-B; `docs/algorithms.md`,
+//! "Stability, grasp and insertion"):
 //!
 //! * [`resting_poses`](mod@resting_poses): the faces of a part's convex hull it rests on stably, with rotation
 //!   (phi, psi), margin and c.g. height — the planner's candidate orientations;
