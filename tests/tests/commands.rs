@@ -113,7 +113,7 @@ fn interference_reports_penetrating_touching_and_free() {
 }
 
 /// The audit's reproducers: pairs a few tolerances apart (tolerance 3.0e-7 mm) are `separated` at their distance
-/// (parry's GJK, used before, answered 0 for the first two and left the third out, above the clearance).
+/// (parry's GJK answers 0 for the first two and leaves the third out, above the clearance).
 #[test]
 fn interference_gives_the_distance_of_pairs_a_few_tolerances_apart() {
     let cases: [(&[&str], (u64, u64), f64); 4] = [
@@ -177,9 +177,9 @@ fn non_finite_numbers_are_errors_naming_the_option() {
 }
 
 /// Angles in degrees are reduced modulo 360 exactly before they turn a part: `T` and `T + 360 k` give the same
-/// obstacles, interference pairs and extrapolation bit for bit, for k up to 2^40 (before, 1e17 degrees turned a part
-/// by 4.4 degrees too much and 1e20 by 118); the window of `intervals` moves by whole turns; the rotation bounds of
-/// `contacts` are at most a turn.
+/// obstacles, interference pairs and extrapolation bit for bit, for k up to 2^40 (a plain conversion to radians turns
+/// a part by 4.4 degrees too much at 1e17 degrees and by 118 at 1e20); the window of `intervals` moves by whole turns;
+/// the rotation bounds of `contacts` are at most a turn.
 #[test]
 fn angles_are_reduced_modulo_a_turn() {
     let turns = 360.0 * 2f64.powi(40);
@@ -247,8 +247,8 @@ fn angles_are_reduced_modulo_a_turn() {
 }
 
 /// `intervals` partitions the turn exactly: each `end_deg` is bit for bit the next `start_deg`, and the last one less
-/// 360 the first (before, 3 of the 21 joins of Block against L-corner and 15 of the 558 of Triangle against Channel
-/// were a few ulps apart, and no last end less 360 was the first start).
+/// 360 the first (with each end computed on its own, 3 of the 21 joins of Block against L-corner and 15 of the 558 of
+/// Triangle against Channel are a few ulps apart).
 #[test]
 fn intervals_share_their_boundaries() {
     for parts in [["example:block", "example:l-corner"], ["example:triangle", "example:channel"]] {

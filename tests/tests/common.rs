@@ -1,4 +1,4 @@
-//! Helpers shared by the end-to-end tests.
+//! Functions shared by the end-to-end tests.
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};

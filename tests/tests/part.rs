@@ -78,7 +78,8 @@ fn export_writes_readable_files() {
     let obj = info("c.obj");
     assert!((obj - original).abs() <= 1e-6 * original, "{obj} vs {original}");
     // a sheet-metal part rotated into place, whose faces are planar only to rounding, reads back from OBJ and STL too
-    // (before session 30: "not convex: the polygon at line 11 does not lie in a face plane of the shell's convex hull")
+    // (written with the components' own faces it would not: "not convex: the polygon at line 11 does not lie in a
+    // face plane of the shell's convex hull")
     let o = run_in(dir.path(), &["part", "export", "example:triangle", "--obj", "t.obj", "--stl", "t.stl"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let original = info("example:triangle");

@@ -386,10 +386,10 @@ fn the_default_floor_has_room_beside_a_square_part() {
 }
 
 /// A Channel turned into place by a general rotation and stored as binary STL (single precision: its faces planar
-/// only to about 1e-5 mm) plans a complete stack that `check` passes. Before session 33 the file did not read (its
-/// touching pieces linked into one shell); read with its faces merged but not flattened, the plan ended with an error
-/// ("LP for Chebyshev centre failed"). The reader now flattens the faces, and a cell no solver can solve is skipped
-/// and counted (`stats.cells_unsolved`), never the end of a plan.
+/// only to about 1e-5 mm) plans a complete stack that `check` passes. It needs the reader's shell linking within the
+/// length tolerance (else its touching pieces link into one shell) and its flattened faces (read with its faces
+/// merged but not flattened, the plan ends with an error, "LP for Chebyshev centre failed"), and a cell no solver can
+/// solve is skipped and counted (`stats.cells_unsolved`), never the end of a plan.
 #[test]
 fn a_part_turned_and_stored_in_single_precision_plans_and_checks() {
     let dir = tempfile::tempdir().expect("tempdir");

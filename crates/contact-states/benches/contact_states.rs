@@ -33,7 +33,7 @@ fn bench(c: &mut Criterion) {
     let a = fixed.pieces[0].clone();
     let b: ConvexPiece = moving.pieces[0].transformed(&Pose::from_config(&[3.0, 4.0, 10.0, 0.1, -0.05, 0.12]));
     c.bench_function("growth_distance_box_pair", |bench| bench.iter(|| growth_distance(black_box(&a), black_box(&b))));
-    // the same pair through the general vertex enumeration (the parallelepiped form removed): the previous solver
+    // the same pair through the general vertex enumeration (the parallelepiped form removed), for the ratio
     let (ga, gb) =
         (ConvexPiece { parallelepiped: None, ..a.clone() }, ConvexPiece { parallelepiped: None, ..b.clone() });
     c.bench_function("growth_distance_box_pair_vertex_enumeration", |bench| {

@@ -4,8 +4,8 @@
 //! (eq. 4), non-penetration (eq. 5) and the box (eq. 7), and the upper one eq. 10 (`min -t_k`). \[P\] solves the
 //! penalised forms eq. 11-12 with a GA; the penalty leaves a slack (the minimiser of `t_k + lambda f` sits where the
 //! decrease of `t_k` balances the growth of `lambda f`), and a GA/compass search on a thin manifold stops short of
-//! the true extreme (the earlier version of this module did: the face-down cube test could only assert that a vertex
-//! contact lifts the centre, not the analytic maximum). Here every extremal is searched *on* the state's manifold
+//! the true extreme (with it the face-down cube test could only assert that a vertex contact lifts the centre, not
+//! the analytic maximum). Here every extremal is searched *on* the state's manifold
 //! ([`crate::manifold::Manifolds::extremal`]): a local search whose moves (along the tangent space of the state's
 //! active constraints, or of one variable) are restored onto the closure by projection, accepting only points that
 //! satisfy eq. 8 to the strict tolerance. The 12 searches run one after the other from the best configuration known

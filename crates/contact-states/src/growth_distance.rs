@@ -2,7 +2,7 @@
 //! separation and penetration*, IEEE T-RA 12(6), 1996), the non-penetration measure of \[P\] II-B, eq. 5.
 //!
 //! Both polytopes are scaled about interior seed points `p` (of A) and `q` (of B) by a common factor `sigma` until
-//! they just touch. As a linear program in `(x, sigma)` (\[P\]; DESIGN.md section 8):
+//! they just touch. As a linear program in `(x, sigma)` (\[P\]; `docs/algorithms.md`, "Contact states"):
 //!
 //! `min sigma  s.t.  a_i . (x - p) <= sigma (b_i - a_i . p)  (faces of A),  a_j . (x - q) <= sigma (b_j - a_j . q)  (B)`.
 //!

@@ -8,9 +8,9 @@
 //! One ACSG is generated (GA population 30, 20 generations, polish 800, 6 witness attempts, extremal budget 150 for
 //! test time; about 25 s in the test profile on the loaded 2-core machine) and checked:
 //! * regression: the number of feasible states per level is printed with the Table I-style extremal table, not
-//!   asserted (thin states come and go with the last bits; the crate README records the current counts: seed 2004
-//!   gives [0, 27, 87, 91, 35, 11], 251 states, in session 30, against the seed's 63 for its own geometry, which has
-//!   one wall where the `l-corner` fixture has two);
+//!   asserted (thin states come and go with the last bits; the crate README records the current counts, 252 states
+//!   at seed 2004, against the seed's 63 for its own geometry, which has one wall where the `l-corner` fixture has
+//!   two);
 //! * every reported state is verified **independently** at its witness (`common::independent_check`: parry3d-f64
 //!   element distances, plane checks, c-space interference; the state's PCs hold, nothing penetrates, and exactly
 //!   the state's PPCs are in contact), and its extremals lie in the closure of the state;

@@ -1,10 +1,9 @@
 //! The Euclidean distance of two disjoint convex polytopes given by their vertices, by closest features: accurate to
 //! rounding (about `1e-16` times the coordinates' magnitude) at every distance, down to a fraction of the tolerance.
 //!
-//! Why not GJK: parry3d-f64's GJK, which `interference` used before, ends its iteration on a relative improvement
-//! threshold and takes a tiny simplex as an intersection; a few tolerances from touching it answered `0` (Triangle
-//! parts 5e-7 mm apart) or a distance above the clearance (1e-5 mm apart at 17.3 degrees), so separated pairs were
-//! reported at gap 0 or not at all.
+//! Why not GJK: parry3d-f64's GJK ends its iteration on a relative improvement threshold and takes a tiny simplex as
+//! an intersection; a few tolerances from touching it answers `0` (Triangle parts 5e-7 mm apart) or a distance above
+//! the clearance (1e-5 mm apart at 17.3 degrees), so separated pairs would be reported at gap 0 or not at all.
 //!
 //! The method: the closest points `x` of `A` and `y` of `B` of two disjoint convex polytopes lie on their boundaries,
 //! and the set of closest pairs `(x, y)` is convex; an extreme pair of it has `x` at a vertex of `A` and `y` in a

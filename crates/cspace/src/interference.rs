@@ -22,8 +22,8 @@
 //!   from the flag's conditions, and the cross products are not even formed.
 //! * **Clearance** `delta > 0`: pairs whose Euclidean distance is below `delta` are reported too. The SAT gap is only a
 //!   lower bound on the distance of separated polytopes, so candidates with `tol < gap < delta` get their exact
-//!   distance by closest features ([`pair_distance`], [`crate::distance`]; parry3d-f64's GJK, used before, answered 0
-//!   or more than the clearance a few tolerances from touching).
+//!   distance by closest features ([`pair_distance`], [`crate::distance`]; parry3d-f64's GJK answers 0 or more than
+//!   the clearance a few tolerances from touching).
 
 use glam::{DMat3, DVec3};
 use parry3d_f64::bounding_volume::Aabb;
@@ -350,9 +350,9 @@ pub fn pair_distance(a: &PlacedConvex, b: &PlacedConvex) -> Option<f64> {
     crate::distance::convex_distance(&a.vertices, &b.vertices)
 }
 
-/// [`pair_distance`] under its former name: it was parry3d-f64's GJK, which answered 0, or more than the clearance,
-/// for pairs a few tolerances apart ([`crate::distance`]). The planner's narrow phase (`stackplan-planner`'s
-/// `detect`) calls it by this name, and must agree with [`classify_pair`] bit for bit.
+/// [`pair_distance`] under another name (not GJK, which answers 0, or more than the clearance, for pairs a few
+/// tolerances apart: [`crate::distance`]). The planner's narrow phase (`stackplan-planner`'s `detect`) calls it by
+/// this name, and must agree with [`classify_pair`] bit for bit.
 pub fn gjk_distance(a: &PlacedConvex, b: &PlacedConvex) -> Option<f64> {
     pair_distance(a, b)
 }

@@ -30,9 +30,9 @@
 //! the threshold of merged face normals, so that a rotation about a face normal by less than it merges the faces and
 //! their edges alike). Every other decision of the merge is the sign of `(v x w) . u` for two edge directions that
 //! are not parallel, which rounding cannot flip; a face plus an edge (most merged faces of sheet metal rotated about
-//! `z`) takes a one-pass form of the same rule (`face_plus_segment`). (Until session 13 this was a labelled 2-D hull
-//! of the `|F| |G|` rounded sum points with duplicates and corners within a *length* tolerance removed; on every
-//! input away from the tolerance band both give the same faces, see `docs/benchmarks.md`, cspace section.)
+//! `z`) takes a one-pass form of the same rule (`face_plus_segment`). A labelled 2-D hull of the `|F| |G|` rounded sum
+//! points, with duplicates and corners within a *length* tolerance removed, gives the same faces on every input away
+//! from the tolerance band, but within it its length rule can contradict the angle rule of the unmerged side faces.
 //!
 //! Why a tolerance and not exact predicates: the input to this step is a *rotated* polytope whose coordinates are
 //! already rounded (`cos(pi / 2)` is not 0 in `f64`), so exact parallelism of a rotated face with a fixed one cannot be
@@ -89,9 +89,9 @@ pub enum Feature {
 /// What generated a face of the obstacle. Indices refer to the moving polytope `A` (vertices, edges, faces of `A` in
 /// its own coordinates) and the fixed polytope `B`.
 ///
-/// The first three kinds are the generic ones (\[A\] App. B; DESIGN.md section 3). The last three are the merged faces
-/// of degenerate configurations (parallel faces, a face parallel to an edge): they are exactly one face of the sum and
-/// name both generating features.
+/// The first three kinds are the generic ones (\[A\] App. B; `docs/algorithms.md`, "C-space obstacle of a convex
+/// pair"). The last three are the merged faces of degenerate configurations (parallel faces, a face parallel to an
+/// edge): they are exactly one face of the sum and name both generating features.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum FaceKind {

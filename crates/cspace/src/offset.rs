@@ -5,12 +5,13 @@
 //!   or at a vertex the offset planes meet farther out than `delta` (by a factor `1 / cos(phi / 2)` at an edge whose
 //!   faces' normals make an angle `phi`), so it contains the exact offset `C (+) Ball(delta)` and is slightly
 //!   conservative there; over every face it is exact. O(F).
-//! * **Insertion obstacle** (\[A\] condition 4, DESIGN.md section 3): the part reaches `p` by translating straight down
-//!   from far above; it is blocked iff `p + t z` is in the interior of `C` for some `t >= 0`, i.e. iff `p` is in the
-//!   interior of `C (+) {-t z : t >= 0}`. Its support function is `h(u) = h_C(u)` for `u_z >= 0` and `+inf` for
-//!   `u_z < 0`, so its facets are: the faces of `C` with `n_z > 0` (the top), the vertical faces of `C` (`n_z = 0`), and
-//!   one vertical face per *silhouette edge* of `C` (an edge between a face with `n_z > 0` and one with `n_z < 0`) with
-//!   the horizontal normal orthogonal to the edge (oriented away from `C`). Faces with `n_z < 0` disappear. O(E).
+//! * **Insertion obstacle** (\[A\] condition 4; `docs/algorithms.md`, "C-space obstacle of a convex pair"): the part
+//!   reaches `p` by translating straight down from far above; it is blocked iff `p + t z` is in the interior of `C`
+//!   for some `t >= 0`, i.e. iff `p` is in the interior of `C (+) {-t z : t >= 0}`. Its support function is
+//!   `h(u) = h_C(u)` for `u_z >= 0` and `+inf` for `u_z < 0`, so its facets are: the faces of `C` with `n_z > 0` (the
+//!   top), the vertical faces of `C` (`n_z = 0`), and one vertical face per *silhouette edge* of `C` (an edge between
+//!   a face with `n_z > 0` and one with `n_z < 0`) with the horizontal normal orthogonal to the edge (oriented away
+//!   from `C`). Faces with `n_z < 0` disappear. O(E).
 //! * **Slice** at `p_z = z` (\[A\] VII-A, the `{px, py}` c-space): the convex polygon `C ∩ {p_z = z}`, from the
 //!   crossings of the edges of `C` with the plane and the vertices on it, in counter-clockwise order seen from above.
 //!   O(E log E).

@@ -23,7 +23,7 @@
 //! and every face's offset (the largest `n . v` over its corners in cycle order, the general assembly's arithmetic),
 //! and files every half-edge under the vertex that names it for `prism_assembly::edge_table` (geom's table).
 //!
-//! Checked on the way (else `None`, and the caller derives the cycles and assembles them as before, with the same
+//! Checked on the way (else `None`, and the caller derives the cycles and assembles them directly, with the same
 //! result): the poles and levels (`z_prism::poles`), every side face supported by a vertical edge, every chain
 //! closing with `k` steps that cover each side face once per pole, each A step's support ending at the chain's `j`,
 //! every side face a quadrilateral, tame (`z_prism::tame_side`, on the corners `derived_cycles` tests), and each of
@@ -72,7 +72,7 @@ const NONE: u32 = u32::MAX;
 
 /// The obstacle of a tame z-prism pair (`specs` from `z_prism::face_specs` with the poles merged pairwise and every
 /// side normal supported with margin), bit for bit the general route's, or `None` when the pair is not the structure
-/// of the module documentation (then the caller derives the cycles as before). `prism` holds the classes from
+/// of the module documentation (then the caller derives the cycles and assembles them). `prism` holds the classes from
 /// `z_prism::vertical_arcs`; its levels are overwritten.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn obstacle(

@@ -30,7 +30,7 @@
 //! What is saved: both sign tables (`EA FB + EB FA` products), the arc-crossing pass, the circles of the horizontal
 //! arcs and most of the support tests' arithmetic.
 //!
-//! **Derived cycles** (session 16): for a *tame* pair ([`derived_cycles`]: two poles per summand, merged pairwise, no
+//! **Derived cycles**: for a *tame* pair ([`derived_cycles`]: two poles per summand, merged pairwise, no
 //! side face merged, every side face a quadrilateral, edge lengths far from under- and overflow, unit side normals
 //! orthogonal to their horizontal edges, every side normal at least [`MARGIN`] inside the arc holding it) the obstacle
 //! is the extrusion `(b (+) (-R a)) x [b_lo - a_hi, b_hi - a_lo]` of the 2-D Minkowski sum of the cross-sections, and
@@ -449,7 +449,7 @@ pub(crate) fn ends([v0, v1]: [usize; 2], levels: &[u8]) -> Option<[usize; 2]> {
 /// The vertex-pair cycles of every face of the obstacle of a *tame* z-prism pair, in the order of `specs` (from
 /// [`face_specs`]), without the general assembly's polygon merges (`minkowski::face_plus_segment`,
 /// `minkowski::planar_merge`), into `cycles` / `starts`; `false` (buffers garbage) when the pair is not one this
-/// handles, and the caller assembles as before.
+/// handles, and the caller runs the general assembly.
 ///
 /// Handled: each summand has exactly two poles, a top (`+z`) and a bottom one, every vertex on one of them, every
 /// side face a quadrilateral; each pole of `B` is merged with the same pole of `-RA` and no side face is merged
@@ -730,8 +730,8 @@ mod tests {
         rotations.push(DMat3::from_cols(-DVec3::X, -DVec3::Y, DVec3::Z));
         rotations.push(DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7));
         // the z-prisms among them (not the x-extruded one; not the tiny box, whose vertical edges' squared lengths
-        // underflow; the 7-gon is one since the hull computes its face planes accurately: its top normal's x was a
-        // rounded 3e-17 before)
+        // underflow; the 7-gon is one because the hull computes its face planes accurately: a plainly computed top
+        // normal has a rounded x of 3e-17)
         let z_prisms = shapes
             .iter()
             .filter(|s| {

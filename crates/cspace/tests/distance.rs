@@ -85,8 +85,8 @@ proptest! {
 
     /// A pair pushed out of touching by `delta` (from a few tolerances to a fifth of the pair's size) is `Separated`
     /// with `gap = delta` (to rounding), at least the separating-axis gap, and listed by the scene with that gap
-    /// when `delta` is below the clearance. parry3d-f64's GJK, used before, answered 0 or more than the clearance
-    /// for a few per cent of such pairs below 1e-5 mm.
+    /// when `delta` is below the clearance. parry3d-f64's GJK answers 0 or more than the clearance for a few per
+    /// cent of such pairs below 1e-5 mm.
     #[test]
     fn separated_pairs_report_the_distance_they_were_moved_apart(
         (a, b) in any_pair(),

@@ -315,10 +315,10 @@ proptest! {
 
 /// The audit's case: the Triangle part's inclined pieces against themselves, turned by 1e-9 to 1e-5 rad about `z`
 /// from the critical orientations 0 and 90 degrees, where their faces and edges are nearly parallel: every obstacle's
-/// planes support its difference points within the tolerance. Until the hull computed its face planes accurately,
-/// the pieces' own planes were off by up to 1e-7 rad (fitted to points planar only to rounding), and the obstacle of
-/// pair (2, 2) at 1e-7 degree had a difference point 8.4e-4 mm (over 2000 tolerances) above an edge-edge face: `place`
-/// could report a position penetrating by that much as touching.
+/// planes support its difference points within the tolerance. Planes fitted to the pieces' points (planar only to
+/// rounding) are off by up to 1e-7 rad instead of the hull's accurate ones, and then the obstacle of pair (2, 2) at
+/// 1e-7 degree has a difference point 8.4e-4 mm (over 2000 tolerances) above an edge-edge face: `place` would report
+/// a position penetrating by that much as touching.
 #[test]
 fn triangle_pieces_just_off_critical_orientations() {
     let part = stackplan_geom::examples::part_by_name("triangle", stackplan_geom::Decomposition::default())

@@ -2,16 +2,16 @@
 //! 6, 16, 32 and 64 inequalities, and time per obstacle subtraction.
 //!
 //! `exact` is `minimize` (strictly convex costs take the closed-form path of `active_set`), `general` is
-//! `qp::minimize_general` (the general active-set method alone: the solver before the closed-form path, for a
-//! before/after ratio in the same run), `clarabel` the interior-point cross-check. The on-CPU part also times
+//! `qp::minimize_general` (the general active-set method alone, what the closed-form path saves measured in the same
+//! run), `clarabel` the interior-point cross-check. The on-CPU part also times
 //! w = 1 (singular Hessian: `minimize` runs the general method with the lowest-z tie-break).
 //!
 //! Run: `cargo bench -p stackplan-freespace --bench qp -- --warm-up-time 1 --measurement-time 3`.
 //!
 //! Each benchmark runs twice: with criterion's wall clock (`*_wall`) and with the thread's on-CPU time
 //! (`*_cpu`, from `/proc/thread-self/schedstat`, nanosecond resolution), because the benchmark machine is shared
-//! (2 cores, load average above 15 while other helpers compile): wall-clock medians are inflated by time spent
-//! waiting for a core, CPU time is not.
+//! (2 cores, often busy with other builds): wall-clock medians are inflated by time spent waiting for a core, CPU
+//! time is not.
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use stackplan_freespace::qp::minimize_general;

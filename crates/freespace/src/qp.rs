@@ -934,7 +934,7 @@ mod tests {
         }
         // the apex: the upper y side and the tilted lower one meet at z = 12.4036..., x at the cost's centre
         assert!((s.point[2] - 12.40361385829693).abs() < 1e-6 && (s.point[0] - c[0]).abs() < 1e-9, "{:?}", s.point);
-        // cheaper than the points the solvers stopped at before (on the cell's top, z = 26.03)
+        // cheaper than the points where the active set and clarabel stop on this cell (on its top, z = 26.03)
         let top = [c[0], 7.211700647994338, 26.025579816179977];
         assert!(s.cost < cost.evaluate(&top));
     }

@@ -3,11 +3,11 @@
 //! Sheet-metal components are boxes and thin prisms, and the c-space obstacles of their pairs are prisms too: almost
 //! every face is a triangle or a quadrilateral. A `Vec<usize>` per face costs one heap allocation to build, one to
 //! clone and one to free for each of them; a c-space obstacle of two hexagonal prisms has 12 quadrilateral sides, and
-//! those allocations were a tenth of its construction time (issue #3's benchmark, `docs/benchmarks.md`). A
+//! those allocations would be a tenth of its construction time (`cargo bench -p stackplan-cspace --bench obstacle`). A
 //! [`VertexCycle`] keeps up to [`VertexCycle::INLINE`] indices inside the face and spills longer cycles to the heap.
 //!
 //! It reads like a `[usize]` (it dereferences to one) and prints, compares, serialises and deserialises exactly like
-//! the `Vec<usize>` it replaces (a JSON array of indices), so files and `Debug` output are unchanged. The inline
+//! a `Vec<usize>` (a JSON array of indices), so files and `Debug` output are those of a plain list. The inline
 //! storage is an implementation detail: `smallvec` does not appear in the public API.
 
 use serde::{Deserialize, Serialize};

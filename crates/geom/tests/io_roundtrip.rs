@@ -138,9 +138,10 @@ fn face_counts(part: &Part) -> (usize, usize) {
 /// Every built-in example, in both decompositions, written in every format reads back: the same vertices per
 /// component (binary STL: rounded to `f32`) and the faces of their hull, rounding creases merged. The sheet-metal
 /// examples are rotated into place, so some of their faces are coplanar only to rounding (Triangle's quadrilaterals
-/// are 5e-11 out of plane): before session 30 their OBJ and STL files failed the reader's exact convexity check ("the
-/// polygon at line 11 does not lie in a face plane of the shell's convex hull"), and until session 32 they read back
-/// split into their exact facets; now each reads back as the one face it was built as.
+/// are 5e-11 out of plane): written with the components' own faces their OBJ and STL files fail the reader's exact
+/// convexity check ("the polygon at line 11 does not lie in a face plane of the shell's convex hull"), and without the
+/// merge of rounding creases they read back split into their exact facets; each reads back as the one face it was
+/// built as.
 #[test]
 fn every_example_reads_back_from_every_format() {
     let opts = ReadOptions::default();
@@ -228,9 +229,9 @@ fn turned(part: &Part, rotation: DMat3) -> Part {
 /// Components touching along a face that is planar only to rounding: each component's exact hull splits the face
 /// along another diagonal (the fold seen from the other side), so the STL holds the shared face twice, triangulated
 /// differently. The shell splitter must still separate the components (the other component's triangle is on the
-/// same half-plane within the length tolerance), and each shell passes the convexity check. Before session 33, 48 of
-/// 114 turned parts of an audit failed to read back from STL ("the polygon at byte 84 does not lie in a face plane of
-/// the shell's convex hull": two touching components linked into one shell), the built-in Triangle, Complex and
+/// same half-plane within the length tolerance), and each shell passes the convexity check. Linked by the exact test
+/// alone, two touching components become one shell and 48 of 114 turned parts fail to read back from STL ("the
+/// polygon at byte 84 does not lie in a face plane of the shell's convex hull"), the built-in Triangle, Complex and
 /// L-corner among them.
 #[test]
 fn turned_parts_with_touching_components_round_trip_through_stl() {

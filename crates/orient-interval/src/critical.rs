@@ -1,9 +1,10 @@
 //! Critical orientations: the angles of rotation about world `z` at which the structure of the c-space obstacle
 //! `C(A, B) = B (+) (-R(theta) A)` of a convex pair changes.
 //!
-//! Paper: Ayyadevara et al. 2002 (\[A\]) section IV-A (manuscript 4.1), eq. 4-5, and Appendix C, eq. 13-16; DESIGN.md
-//! section 4. The vertices move as `P_ij(theta) = V_j^B - R(theta) V_i^A` (eq. 4). Every event function below is
-//! `alpha cos(theta) + beta sin(theta) + gamma` ([`Trig`]) and is solved in closed form.
+//! Paper: Ayyadevara et al. 2002 (\[A\]) section IV-A (manuscript 4.1), eq. 4-5, and Appendix C, eq. 13-16;
+//! `docs/algorithms.md`, "Critical orientations and extrapolation". The vertices move as `P_ij(theta) = V_j^B -
+//! R(theta) V_i^A` (eq. 4). Every event function below is `alpha cos(theta) + beta sin(theta) + gamma` ([`Trig`]) and
+//! is solved in closed form.
 //!
 //! # Event kinds
 //!

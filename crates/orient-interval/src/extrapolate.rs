@@ -1,11 +1,12 @@
 //! Extrapolation of a c-space obstacle within its constant-structure interval.
 //!
-//! Paper: Ayyadevara et al. 2002 (\[A\]) section IV-B (manuscript 4.2) and eq. 4; DESIGN.md section 4. While the
-//! structure (faces, edges, vertex provenance `[i, j]`, face kinds) stays constant, the obstacle at a new angle is
-//! obtained by moving every vertex to `V_j^B - R(theta) V_i^A` (eq. 4) and recomputing each face plane from its
-//! generating features ([`NormalRecipe`]: a face of `B` keeps `n^B`; a face of `-RA` gets `-R n^A`; an edge-edge
-//! parallelogram gets `sign * (e^B x R e^A)` normalised, the sign fixed at construction; the offset is the largest
-//! `n . v` over the face's vertices, as the construction does). O(size of the obstacle) and no hull.
+//! Paper: Ayyadevara et al. 2002 (\[A\]) section IV-B (manuscript 4.2) and eq. 4; `docs/algorithms.md`, "Critical
+//! orientations and extrapolation". While the structure (faces, edges, vertex provenance `[i, j]`, face kinds) stays
+//! constant, the obstacle at a new angle is obtained by moving every vertex to `V_j^B - R(theta) V_i^A` (eq. 4) and
+//! recomputing each face plane from its generating features ([`NormalRecipe`]: a face of `B` keeps `n^B`; a face of
+//! `-RA` gets `-R n^A`; an edge-edge parallelogram gets `sign * (e^B x R e^A)` normalised, the sign fixed at
+//! construction; the offset is the largest `n . v` over the face's vertices, as the construction does). O(size of the
+//! obstacle) and no hull.
 //!
 //! Two outputs: [`ObstacleStructure::extrapolate`] returns a full [`Obstacle`] (it copies the template's face and
 //! edge tables through `ConvexPolytope::with_geometry`: no search, but one allocation per face), and

@@ -2,7 +2,7 @@
 //!
 //! Critical orientations, constant-structure ("constant topology") orientation intervals and extrapolation of
 //! convex-pair c-space obstacles as the moving component rotates about world `z` (Ayyadevara et al. 2002, \[A\]
-//! section IV and Appendix C; DESIGN.md section 4):
+//! section IV and Appendix C; `docs/algorithms.md`, "Critical orientations and extrapolation"):
 //!
 //! * [`trig`]: closed-form roots and tolerance bands of `alpha cos + beta sin + gamma` (\[A\] eq. 14-16);
 //! * [`critical`]: every event kind (normal crossing arc, the permanently degenerate polar and equatorial families,

@@ -1,11 +1,11 @@
 //! Obstacle sweeps over discrete orientations: build at interval starts, extrapolate elsewhere.
 //!
 //! Paper: Ayyadevara et al. 2002 (\[A\]) section IV-B (manuscript 4.2) and Table I (constructions vs extrapolations);
-//! DESIGN.md section 4. A [`PairSweep`] holds one convex pair, its event bands over the full turn
-//! ([`PairEvents`], computed once in O(F_B E_A + F_A E_B)), and the structures built so far. Asked for the obstacle at
-//! angle index `k` it extrapolates from a cached structure whose interval covers the angle (O(size)), or builds the
-//! obstacle from scratch (the Gauss-map construction) and caches its structure with its interval (O(bands)).
-//! Counters and timers record constructions and extrapolations.
+//! `docs/algorithms.md`, "Critical orientations and extrapolation". A [`PairSweep`] holds one convex pair, its event
+//! bands over the full turn ([`PairEvents`], computed once in O(F_B E_A + F_A E_B)), and the structures built so far.
+//! Asked for the obstacle at angle index `k` it extrapolates from a cached structure whose interval covers the angle
+//! (O(size)), or builds the obstacle from scratch (the Gauss-map construction) and caches its structure with its
+//! interval (O(bands)). Counters and timers record constructions and extrapolations.
 
 use crate::critical::PairEvents;
 use crate::extrapolate::{ExtrapolateError, ExtrapolatedGeometry, ObstacleStructure, rotation_z};

@@ -1,7 +1,7 @@
 //! Interference pairs of the new part at a configuration (\[A\] eq. 8, section 5.1.3): a broad phase on axis-aligned
 //! boxes and the exact separating-axis narrow phase of `stackplan-cspace` on the complete axis set
 //! (`classify_pair_all_axes`, and for pairs closer than the clearance their distance by closest features of the exact
-//! hulls, `stackplan_cspace::distance`, reached through its former name `gjk_distance`).
+//! hulls, `stackplan_cspace::distance`, reached as `interference::gjk_distance`).
 //!
 //! * Without clearance a pair is reported only when it *penetrates* by more than the tolerance; touching is free.
 //! * With clearance `delta > 0`, a pair closer than `delta` is reported (touching included).
@@ -304,11 +304,9 @@ fn scan_direct(
 /// The lists of a finished [`CandidateQueue`] ([`CandidateQueue::recycle`]), emptied, for the next one: no allocation
 /// per detection once warm.
 ///
-/// (Up to the 14th session the scratch also kept each (orientation, moving, stack component) pair's separating axes
-/// with the stack component's projections, built on the pair's second test. Measured in the 15th: the pairs are
-/// tested a few times each, so building the axes cost more than re-deriving them on the fly saved; the Channel
-/// search ran 5.6 % fewer instructions and the Triangle one 9 % fewer without them, and a 15-part Complex plan held
-/// 376 MB of them.)
+/// The scratch keeps no per-pair separating axes: the pairs are tested a few times each, so building and keeping
+/// the axes costs more than deriving them on the fly (the Channel search runs 5.6 % and the Triangle one 9 % more
+/// instructions with such a cache, and a 15-part Complex plan holds 376 MB of it).
 #[derive(Debug, Clone, Default)]
 pub struct DetectScratch {
     spare: QueueLists,
@@ -499,9 +497,8 @@ impl CandidateQueue {
 
     /// Upper bound of a pair's violation from a lower bound `best` of its scan's largest value, plus (with a
     /// clearance, where `classify_pair` replaces the gap by the pair's distance) a margin of `1e-3 clearance + tol`.
-    /// The margin covered parry's GJK, whose distance was the true one only up to its own accuracy; the distance is now
-    /// exact up to rounding (`stackplan_cspace::distance`) and never below the gap, so the margin only loosens the
-    /// bound (a few more pairs scanned), never the order of the candidates.
+    /// The distance is exact up to rounding (`stackplan_cspace::distance`) and never below the gap, so the margin
+    /// only loosens the bound (a few more pairs scanned), never the order of the candidates.
     fn bound(&self, best: f64) -> f64 {
         if self.horizontal {
             -best

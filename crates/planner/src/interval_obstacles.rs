@@ -1,6 +1,6 @@
 //! Obstacles over the discrete orientations: constructed where no stored structure holds, extrapolated inside the
-//! constant-topology intervals of those that do (\[A\] IV-B and App. C, eq. 4; DESIGN.md section 4; the seed's Table I
-//! counts the two).
+//! constant-topology intervals of those that do (\[A\] IV-B and App. C, eq. 4; `docs/algorithms.md`, "Critical
+//! orientations and extrapolation"; the seed's Table I counts the two).
 //!
 //! The planner's orientations are `R = R_z(theta) R_rest`. For one moving component in one resting pose and one stack
 //! component, the obstacle keeps its face/edge/vertex structure over intervals of `theta`

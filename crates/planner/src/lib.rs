@@ -1,7 +1,7 @@
 //! # stackplan-planner
 //!
 //! Placement of one part in a stack of stationary parts by best-first search over partial c-space obstacles
-//! (Ayyadevara et al. 2002, \[A\] sections V-VI; DESIGN.md section 6).
+//! (Ayyadevara et al. 2002, \[A\] sections V-VI; `docs/algorithms.md`, "Placement search").
 //!
 //! * [`request`]: inputs (part, resting poses, theta set, stack, floor volume or fixed `p_z`, clearance, cost,
 //!   insertion, `k`) and their validation;

@@ -1,6 +1,7 @@
-//! The placement QP on one free-space cell (\[A\] VI-A-1, DESIGN.md section 5): an adapter over
-//! `stackplan-freespace`'s exact active-set solver ([`stackplan_freespace::minimize`], KKT-verified, lexicographic
-//! tie-break "lowest z, then y, then x" when the Hessian is singular, e.g. `w = 0` or `w = 1` in cost (1)).
+//! The placement QP on one free-space cell (\[A\] VI-A-1; `docs/algorithms.md`, "Free space and the placement QP"):
+//! an adapter over `stackplan-freespace`'s exact active-set solver ([`stackplan_freespace::minimize`], KKT-verified,
+//! lexicographic tie-break "lowest z, then y, then x" when the Hessian is singular, e.g. `w = 0` or `w = 1` in
+//! cost (1)).
 //!
 //! The planner writes costs as `constant + sum_i h_i (p_i - c_i)^2`; freespace's form is
 //! `1/2 sum H_i p_i^2 + g . p + c0`, so `H_i = 2 h_i`, `g_i = -2 h_i c_i`, `c0 = constant + sum_i h_i c_i^2`.

@@ -57,8 +57,8 @@ pub fn polygon_side_planes(polygon: &[DVec2]) -> Vec<(DVec2, f64)> {
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Cost {
     /// The new part's term of \[A\] eq. (1) with the rotated part's bounding-box extents and c.g. height
-    /// (DESIGN.md section 5): `w [(p_x + x_max - x0)^2 + (p_x + x_min - x0)^2 + (p_y + y_max - y0)^2 +
-    /// (p_y + y_min - y0)^2] + 4 (1 - w) (p_z + z_c - z0)^2`.
+    /// (`docs/algorithms.md`, "Free space and the placement QP"): `w [(p_x + x_max - x0)^2 + (p_x + x_min - x0)^2 +
+    /// (p_y + y_max - y0)^2 + (p_y + y_min - y0)^2] + 4 (1 - w) (p_z + z_c - z0)^2`.
     Stacking {
         /// Weight of floor-space use against c.g. height, in `[0, 1]`.
         w: f64,

@@ -5,9 +5,9 @@
 //! its length is set by the slowest partition (a partition stops at its placement, at the bound or after its pops).
 //! The rayon worker that finished first otherwise goes idle, yields a few times and sleeps on a futex; the next
 //! round (a few microseconds of merging later) must then wake it, and on a virtual machine a wake-up takes tens to
-//! hundreds of microseconds. The 15-part Complex plans run about 400-650 rounds, so those wake-ups cost several
-//! percent of the plan (docs/benchmarks.md, session 35). Spinning until the round ends costs the CPU time the
-//! waiting thread would have slept through, at most [`SPIN_LIMIT`] per round.
+//! hundreds of microseconds. The 15-part Complex plans run about 400-650 rounds, so those wake-ups would cost
+//! several percent of the plan. Spinning until the round ends costs the CPU time the waiting thread would have slept
+//! through, at most [`SPIN_LIMIT`] per round.
 //!
 //! Safety of the wait: a partition waits only for partitions *running* their round (started, not finished), and a
 //! running partition is on another thread (this thread is inside its own, finished step; the steps call no parallel

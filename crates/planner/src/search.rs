@@ -1,5 +1,5 @@
-//! Best-first search over (orientation, free-space cell) nodes: the placement of one part (\[A\] V-A..C, DESIGN.md
-//! section 6).
+//! Best-first search over (orientation, free-space cell) nodes: the placement of one part (\[A\] V-A..C;
+//! `docs/algorithms.md`, "Placement search").
 //!
 //! A node is an orientation `theta_k`, a convex cell `K` of positions (an H-polytope, \[A\] VI-A-1) and the optimum
 //! `p*` of the cost over `K` (`f(p*)` is the key). The roots are `(theta_k, Omega(theta_k))`. Loop:
@@ -30,8 +30,8 @@
 //!    mask of the faces, `InsideCuts`). Each child's own box (the parent's tightened by its kept inside cuts and
 //!    its outside half-space, grown by the tolerance: [`stackplan_freespace::outer_box::tighten_box`]) then drops
 //!    the children it proves empty (their ids taken too) and adds the cost's minimum over it to the key
-//!    ([`Quadratic::box_lower_bound`]; session 28: 44 000 of the 362 000 children past the first test in the 15-part
-//!    Complex plan at `w 0.9` are dropped, and the key rises for 147 000). When a pushed child is popped its
+//!    ([`Quadratic::box_lower_bound`]; in a 15-part Complex plan about one child in eight past the first test is
+//!    dropped, and the key rises for two in five). When a pushed child is popped its
 //!    emptiness is decided by a
 //!    phase 1 from the parent's optimum (`Cell::is_empty_with`: the optimum violates only
 //!    `n_k . p >= d_k`, so this is usually one LP move); a non-empty child's cell is built from a second phase 1 on
@@ -2305,10 +2305,10 @@ mod tests {
     use super::*;
 
     /// Footprints clipped from an octagonal floor and grown (stage 1 of a plan on a floor that is no rectangle):
-    /// each continues the last one's frontier. With the exact test about a third of them did not (their corners on
-    /// the floor's slanted sides are interpolated), and those stage-1 searches started from the roots: the 15-part
-    /// Complex plan at `w 0.1` on such a floor (circumradius 560 mm) took 1.51 s instead of 1.11 s, the same plan
-    /// (session 34). A polygon larger by 1e-7 mm is not inside.
+    /// each continues the last one's frontier. With an exact test about a third of them would not (their corners on
+    /// the floor's slanted sides are interpolated), and those stage-1 searches would start from the roots: the
+    /// 15-part Complex plan at `w 0.1` on such a floor (circumradius 560 mm) takes 1.51 s that way instead of 1.11 s,
+    /// the same plan. A polygon larger by 1e-7 mm is not inside.
     #[test]
     fn grown_footprints_on_a_slanted_floor_continue_the_last_ones_frontier() {
         let octagon: Vec<glam::DVec2> = (0..8)

@@ -1,5 +1,5 @@
 //! Settling a released part: the vertical drop from the position the search found, where the robot releases the
-//! part, to where it comes to rest (\[A\] VII-B; DESIGN.md section 7).
+//! part, to where it comes to rest (\[A\] VII-B; `docs/algorithms.md`, "Stability, grasp and insertion").
 //!
 //! **Why.** With the seed's clearance for robot positioning error ("the parts are separated in the plane by at least
 //! 5 mm", \[A\] VII-B, grown as in eq. 10-11) an obstacle face of unit normal `n` moves out by `delta |n_xy|`. A
@@ -28,8 +28,8 @@
 //! at once) decides "no drop" without the other pairs: the pairs whose boxes touch at a moving component's bottom
 //! (where a part released on a flat top rests) are probed first, and the full pass also ends at such a stop. The
 //! result is the full pass's (an obstacle that cannot be built among the pairs not visited is then not reported).
-//! In the 15-part Complex plan at w = 0.9 (128 candidates, most of them resting where released) settling fell from
-//! 370 M to 110 M instructions.
+//! In the 15-part Complex plan at w = 0.9 (128 candidates, most of them resting where released) this takes settling
+//! from 370 M to 110 M instructions.
 //!
 //! Cost: O(m + s) for the whole part's box against the `s` stack components (`m` moving components), then O(m k)
 //! box tests against the `k` under it, plus O(sum of the faces of the pairs whose xy boxes overlap) and the construction of
@@ -191,12 +191,12 @@ pub fn settle(
 ///
 /// **Why.** The search's optimum of a cell can float above what holds it: beside the obstacle whose face plane
 /// bounds the cell from below (the plane reaches past the face), or anywhere when the cost does not depend on the
-/// height (`w = 1`). Released there, a part dropped up to 0.8 m in a 6-part Complex plan at `w = 1`; the robot can let
-/// it go just above where it rests. The vertical line through the part meets each pair's obstacle (interior by more
+/// height (`w = 1`). Released there, a part would drop up to 0.8 m in a 6-part Complex plan at `w = 1`; the robot can
+/// let it go just above where it rests. The vertical line through the part meets each pair's obstacle (interior by more
 /// than the tolerance, the search's test) in an open interval of heights, and `h` is the least height at or above the
 /// rest not inside any of them, found by raising it past each interval that holds it (at most one pass per
 /// interval); the segment from there up to the search's release is free of the zero-clearance obstacles (`settle`
-/// dropped the part along it), so the part reaches the release point from above as before.
+/// dropped the part along it), so the part reaches the release point from above, as it would the search's.
 ///
 /// Cost: the pairs whose boxes come within the clearance of the part's vertical sweep, each one obstacle from the
 /// cache (usually built by the search or the settling already) and O(F) per interval.

@@ -1,4 +1,5 @@
-//! The stacking planner for n identical parts (\[A\] section II-B, "generate and test"; DESIGN.md sections 6-7).
+//! The stacking planner for n identical parts (\[A\] section II-B, "generate and test"; `docs/algorithms.md`,
+//! "Placement search" and "Stability, grasp and insertion").
 //!
 //! Parts are added one at a time; the parts already placed never move. For each new part:
 //!
@@ -94,11 +95,10 @@ pub struct PlanOptions {
     pub partitions: usize,
 }
 
-/// The default of [`PlanOptions::max_candidates`]. 1024 until session 34, when the 15-part Complex plan at `w = 1`
-/// without clearance stopped after 9 parts: every one of part 10's first 1024 candidates (positions on and around
-/// the full-height column) was not stable on its supports, while the floor beside it was free; the 1091st passes.
-/// Only such plans test more than 1024 (every plan of the regression scenarios tests fewer); with candidates found
-/// not stable remembered (`GrowingStack`), a repeated one costs a few µs.
+/// The default of [`PlanOptions::max_candidates`]. Some plans reject more than 1024 candidates in a row while the
+/// floor beside the stack is free: candidates on and around a full-height column at `w = 1`, or the 13th part of
+/// the `plan-l-corner-w0.1` scenario, which passes at its 1109th candidate. With candidates found not stable
+/// remembered (`GrowingStack`), a repeated one costs a few µs.
 pub const DEFAULT_MAX_CANDIDATES: usize = 4096;
 
 /// [`PlanOptions::max_candidates`] of a plan file written before the field existed.
@@ -312,8 +312,8 @@ pub fn plan_stack(part: &Part, options: &PlanOptions) -> Result<Plan, PlanError>
 ///
 /// The plan runs on a thread of rayon's current pool (the calling thread when it is one): the searches' rounds
 /// ([`crate::search`]) are then parallel loops started from a worker, which hands the other partition to the other
-/// worker directly instead of queueing the whole loop from outside and sleeping until it ends (a wake-up per round;
-/// docs/benchmarks.md, session 35). The plan does not depend on it, nor on the number of threads.
+/// worker directly instead of queueing the whole loop from outside and sleeping until it ends (a wake-up per
+/// round). The plan does not depend on it, nor on the number of threads.
 pub fn plan_stack_with_progress(
     part: &Part,
     options: &PlanOptions,

@@ -158,8 +158,8 @@ fn bench(c: &mut Criterion) {
 /// `stacks/triangle-plan-15.json`: the parts nest, so many pairs come near the clearance), on the pairs `check_stack`
 /// tests: each part at its release position (lifted by its `release_drop`) against the components of the parts
 /// placed before it whose boxes come within the clearance and whose z-ranges overlap. The whole test
-/// (`horizontal_distance_at_least`), and its two filters alone: the separating axes' bound (session 28) and the slice
-/// of the Minkowski difference (which decided these pairs before it).
+/// (`horizontal_distance_at_least`), and its two filters alone: the separating axes' bound and the slice of the
+/// Minkowski difference (which the bound spares most of these pairs).
 fn bench_clearance(c: &mut Criterion) {
     let plan = read_stack(concat!(env!("CARGO_MANIFEST_DIR"), "/benches/stacks/triangle-plan-15.json")).expect("plan");
     let placed = |lift: &dyn Fn(usize) -> f64| -> Vec<PlacedPart<'_>> {

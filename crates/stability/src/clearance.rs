@@ -63,7 +63,7 @@ pub fn horizontal_distance_at_least(a: &WorldComponent, b: &WorldComponent, delt
     }
     // the exact distance from the slice of the Minkowski difference (cheap for a component's few vertices): a value
     // clearly above `delta` is one the SOCP would also put above it, so the SOCP is left out; near `delta` (and for
-    // pairs with many vertices) the SOCP decides, as before
+    // pairs with many vertices) the SOCP decides
     if a.polytope.vertices().len() * b.polytope.vertices().len() <= SLICE_MAX_DIFFERENCES
         && let Some(sliced) = horizontal_distance_by_slice(a, b, tol)
         && sliced >= delta + SLICE_MARGIN

@@ -1,4 +1,5 @@
-//! Contact patches between the parts of a stack and with the floor (DESIGN.md section 7; \[A\] II-B condition (ii)).
+//! Contact patches between the parts of a stack and with the floor (`docs/algorithms.md`, "Stability, grasp and
+//! insertion"; \[A\] II-B condition (ii)).
 //!
 //! For every pair of convex components of different parts whose bounding boxes meet, the separating-axis test
 //! ([`crate::sat`]) gives the largest signed separation `g` and its axis `n` (from the first component to the second):

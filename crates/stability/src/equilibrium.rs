@@ -1,4 +1,5 @@
-//! Static equilibrium with Coulomb friction as a second-order cone program (DESIGN.md section 7; \[A\] II-B (ii)).
+//! Static equilibrium with Coulomb friction as a second-order cone program (`docs/algorithms.md`, "Stability, grasp and
+//! insertion"; \[A\] II-B (ii)).
 //!
 //! Unknowns: a force `f_k = fn_k n_k + ft1_k t1_k + ft2_k t2_k` at every contact point `k` (the patch vertices of
 //! [`crate::contacts`]), exerted by body `a` on part `b` of its patch (and `-f_k` on `a`), inside the friction cone

@@ -1,4 +1,5 @@
-//! Suction grasp: upward horizontal faces that hold a suction cup (DESIGN.md section 7; \[A\] II-B condition (iii)).
+//! Suction grasp: upward horizontal faces that hold a suction cup (`docs/algorithms.md`, "Stability, grasp and
+//! insertion"; \[A\] II-B condition (iii)).
 //!
 //! For a part in a pose, the candidate grasp regions are the horizontal planar faces whose outward normal is within
 //! [`UP_COS_TOLERANCE`] of +z. Coplanar upward component faces at the same height (within the part's tolerance) form

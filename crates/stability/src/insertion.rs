@@ -1,4 +1,5 @@
-//! Insertion straight down and removal straight up (\[A\] II-B condition (iv); DESIGN.md sections 3 and 7).
+//! Insertion straight down and removal straight up (\[A\] II-B condition (iv); `docs/algorithms.md`, "C-space obstacle
+//! of a convex pair" and "Stability, grasp and insertion").
 //!
 //! Part `i` reaches its pose by translating along -z from far above. It collides on the way iff some component `C`
 //! of it, swept upward to above everything present (`C (+) [0, L z]`), penetrates a component of a part already in

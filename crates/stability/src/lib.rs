@@ -1,6 +1,7 @@
 //! # stackplan-stability
 //!
-//! Conditions (ii)-(iv) of a stacking configuration (Ayyadevara et al. 2002, \[A\] II-B; DESIGN.md section 7):
+//! Conditions (ii)-(iv) of a stacking configuration (Ayyadevara et al. 2002, \[A\] II-B; `docs/algorithms.md`,
+//! "Stability, grasp and insertion"):
 //!
 //! * [`resting_poses`](mod@resting_poses): the faces of a part's convex hull it rests on stably, with rotation
 //!   (phi, psi), margin and c.g. height — the planner's candidate orientations;
@@ -14,7 +15,7 @@
 //! * [`growing`]: a stack that grows one part at a time and the verdict on a candidate for its next part (the
 //!   planner's per-candidate test).
 //!
-//! Helpers: [`sat`] (separating-axis test with sweeps), [`polygon2d`] (planar hulls and clipping), [`world`]
+//! Building blocks: [`sat`] (separating-axis test with sweeps), [`polygon2d`] (planar hulls and clipping), [`world`]
 //! (placed parts in world coordinates). Lengths in millimetres, angles in radians, forces in mass units times g.
 
 pub mod addition;

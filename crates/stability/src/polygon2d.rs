@@ -1,4 +1,4 @@
-//! Small planar helpers: convex hull of points, intersection of (possibly degenerate) convex sets, distances.
+//! Small planar routines: convex hull of points, intersection of (possibly degenerate) convex sets, distances.
 //!
 //! Contact patches are intersections of two convex supporting sets projected onto the contact plane; each set is a
 //! point, a segment or a convex polygon. [`convex_hull_2d`] is Andrew's monotone chain (A. M. Andrew, *Another

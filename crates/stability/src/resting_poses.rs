@@ -1,4 +1,5 @@
-//! Resting poses of a part on a flat floor (DESIGN.md section 7; \[A\] II-B, the orientation parameters (phi, psi)).
+//! Resting poses of a part on a flat floor (`docs/algorithms.md`, "Stability, grasp and insertion"; \[A\] II-B, the
+//! orientation parameters (phi, psi)).
 //!
 //! A rigid body resting on a plane touches it with the convex hull of its contact set, which is a face of the convex
 //! hull of the body (\[A\] leaves this to the author's thesis; it is the classical "stable faces" analysis). The body

@@ -106,7 +106,7 @@ fn a_part_on_supports_at_two_heights_is_held_by_friction_beyond_their_hull() {
     // the pre-check's case: a plate leg on the floor at x in [0, 2] and a slab resting on a fixed block at x in
     // [12, 20], 50 higher; the slab reaches x = 60, so the c.g. (x = 25.9) lies beyond the supports (x <= 20). In
     // the plane: supports at (a, 0) and (b, h) hold a c.g. up to a + (b - a + mu h) / 2 when mu h > b - a (friction
-    // pushes the foot outwards and the slab back: a couple); the old pre-check called every case unstable
+    // pushes the foot outwards and the slab back: a couple), so a pre-check by the hull of the supports is wrong here
     let block = box_part("block", DVec3::new(8.0, 20.0, 50.0));
     let part = boxes_part(
         "stepped",

@@ -6,23 +6,23 @@
 //! every collider (rapier averages the two coefficients, so every contact gets `mu`), restitution 0 (rapier's
 //! default), no sleeping. Every choice below was measured (see the crate README, "Physics cross-check"):
 //!
-//! * **floor = a half-space** `z <= 0`. A box collider as floor was the cause of the seed-dependent failures of the
-//!   random-column property: when a convex-hull part touches a box collider at exactly zero distance (the checked
-//!   configuration), parry's first contact manifold can have a horizontal normal and a penetration depth of 7 m; the
-//!   first step then pushes the part sideways at rapier's maximum corrective velocity (3 `length_unit`/s), and stable
-//!   columns ended 1.3-2.2 mm away (the kick scaled exactly with `length_unit`). [`assert_starts_touching`] guards
-//!   against any such artefact: no contact of the first step may be deeper than 0.01 mm.
+//! * **floor = a half-space** `z <= 0`. With a box collider as floor the random-column property fails for some
+//!   seeds: when a convex-hull part touches a box collider at exactly zero distance (the checked configuration),
+//!   parry's first contact manifold can have a horizontal normal and a penetration depth of 7 m; the first step then
+//!   pushes the part sideways at rapier's maximum corrective velocity (3 `length_unit`/s), and stable columns end
+//!   1.3-2.2 mm away (the kick scales exactly with `length_unit`). [`assert_starts_touching`] guards against any such
+//!   artefact: no contact of the first step may be deeper than 0.01 mm.
 //! * **gravity ramped** from 0 to g over the first 0.2 s, then 3 s at full gravity (measured over the whole run): the
 //!   parts are loaded quasi-statically, as a stack placed part by part is. Released at full gravity from rest, the
 //!   first steps are a small impact (rapier resolves the contacts of the first step iteratively while everything
-//!   accelerates), and a heavy box whose c.g. lies 0.2 mm inside the edge of a light support toppled whatever the
+//!   accelerates), and a heavy box whose c.g. lies 0.2 mm inside the edge of a light support topples whatever the
 //!   solver iterations (8, 16, 30, 60); with the ramp it moves 0.005 mm.
 //! * **stiff contacts**: 1000 Hz natural frequency (damping ratio 10, rapier's) for all contacts, step 1/480 s,
-//!   16 solver iterations. Rapier's contacts are springs: with 200 Hz a column with an off-centre load tilted by up
-//!   to 1.2 degrees while it settled (0.9 mm of motion at load margin 0.06); the settling tilt scales with
-//!   1/frequency^2 (1000 Hz: 0.08 mm). With 8 iterations a 4096-case run (seed 19411) found a stable column (load
-//!   margin 0.47: a 76 x 76 mm plate on a 30 x 35 mm base, two boxes on the plate) whose top box crept 1.2 mm
-//!   sideways in 3 s (a shrink variant 2.5 mm): the contact solver had not converged. With 16 it moves 0.006 mm
+//!   16 solver iterations. Rapier's contacts are springs: with 200 Hz a column with an off-centre load tilts by up
+//!   to 1.2 degrees while it settles (0.9 mm of motion at load margin 0.06); the settling tilt scales with
+//!   1/frequency^2 (1000 Hz: 0.08 mm). With 8 iterations a stable column of a 4096-case run (seed 19411; load
+//!   margin 0.47: a 76 x 76 mm plate on a 30 x 35 mm base, two boxes on the plate) has its top box creep 1.2 mm
+//!   sideways in 3 s (a shrink variant 2.5 mm): the contact solver has not converged. With 16 it moves 0.006 mm
 //!   (kept in the regressions file).
 //! * contact recycling off: it reuses contacts while a pair drifts less than 0.05 `length_unit` = 5 mm, far coarser
 //!   than the 1 mm criterion.

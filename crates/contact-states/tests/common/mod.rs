@@ -1,4 +1,4 @@
-//! Shared test helper: an independent check of a contact state at a configuration.
+//! Shared by the tests: an independent check of a contact state at a configuration.
 
 use stackplan_contact_states::criteria::{ContactPart, Weights};
 use stackplan_contact_states::pose::{Config, Pose};

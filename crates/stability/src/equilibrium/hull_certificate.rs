@@ -1,6 +1,6 @@
-//! The vertical-force certificate of one rigid body on its contact points, for verdicts only (DESIGN.md section 7;
-//! \[A\] II-B (ii)): the closed-form test "c.g. over the support polygon" generalised to inclined contacts that admit
-//! a vertical push.
+//! The vertical-force certificate of one rigid body on its contact points, for verdicts only (`docs/algorithms.md`,
+//! "Stability, grasp and insertion"; \[A\] II-B (ii)): the closed-form test "c.g. over the support polygon" generalised
+//! to inclined contacts that admit a vertical push.
 //!
 //! A rigid body of weight `m g` (c.g. `c`) on contact points `p_k` with normals `n_k` (pointing into the body) is in
 //! equilibrium when *some* admissible force distribution balances it ([`super`]'s equations with `alpha = 0`). A

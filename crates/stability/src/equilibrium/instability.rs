@@ -1,5 +1,6 @@
-//! Exact certificates of instability, tried before the SOCP would have to prove infeasibility (DESIGN.md section 7;
-//! \[A\] II-B (ii), the stability condition of a candidate and of the stack it joins).
+//! Exact certificates of instability, tried before the SOCP would have to prove infeasibility (`docs/algorithms.md`,
+//! "Stability, grasp and insertion"; \[A\] II-B (ii), the stability condition of a candidate and of the stack it
+//! joins).
 //!
 //! **Argument (virtual work, the easy direction of Farkas' lemma).** Give a set `S` of movable parts of a group one
 //! rigid virtual motion, a twist with velocity `v(p)` at every point `p`, and leave every other body at rest. In an

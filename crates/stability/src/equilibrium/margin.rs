@@ -1,6 +1,6 @@
-//! Robustness margins with fewer and smaller SOCPs (DESIGN.md section 7; the margin of [`super`]). The reference is
-//! one SOCP per group and load direction (`EquilibriumOptions::margins_by_socp_only`); everything here returns the
-//! same margin up to the solver's tolerance, by the following exact arguments.
+//! Robustness margins with fewer and smaller SOCPs (`docs/algorithms.md`, "Stability, grasp and insertion"; the margin
+//! of [`super`]). The reference is one SOCP per group and load direction (`EquilibriumOptions::margins_by_socp_only`);
+//! everything here returns the same margin up to the solver's tolerance, by the following exact arguments.
 //!
 //! 1. **Support trees.** Contract the fixed bodies (floor, fixed parts) of a group to one node, the ground. When the
 //!    graph "movable parts and ground, joined when they share a contact point" is a tree (a column of parts each

@@ -1,5 +1,6 @@
 //! Support trees: the exact split of a group's equilibrium problem into one rigid-body problem per tree edge, and the
-//! closed-form minimum-norm forces of a flat support (DESIGN.md section 7; the equations of [`super`]).
+//! closed-form minimum-norm forces of a flat support (`docs/algorithms.md`, "Stability, grasp and insertion"; the
+//! equations of [`super`]).
 //!
 //! Contract the fixed bodies (floor, fixed parts) of a group to one node, the ground. When the graph "movable parts
 //! and ground, joined when they share a contact point" is a tree (a column of parts each resting on the one below, a

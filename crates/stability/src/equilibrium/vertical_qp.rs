@@ -1,5 +1,5 @@
-//! The vertical-force certificate of a group's stability as a small QP (DESIGN.md section 7; \[A\] II-B (ii)), for
-//! verdicts only.
+//! The vertical-force certificate of a group's stability as a small QP (`docs/algorithms.md`, "Stability, grasp and
+//! insertion"; \[A\] II-B (ii)), for verdicts only.
 //!
 //! A group of movable parts is stable when *some* admissible force distribution exists. Vertical forces `f_k >= 0` at
 //! the contact points whose normal is vertical or lies in the friction cone of the vertical (`|n_xy| <= mu |n_z|`,
