@@ -7,16 +7,13 @@ use stackplan_geom::sheet_metal::Decomposition;
 /// Where a part comes from, shared by every command that reads one.
 #[derive(Debug, Clone, clap::Args)]
 pub struct PartArgs {
-    /// Part file (.json, .stl, .obj) or a built-in example `example:NAME` (channel, triangle, complex, cube,
-    /// l-corner, block).
+    /// Part file (.step/.stp, .stl, .obj, .json) or a built-in example `example:NAME` (channel, triangle, complex,
+    /// cube, l-corner, block). STEP solids and non-convex meshes are recognised as sheet metal.
     pub part: String,
     /// Split concave sheet-metal faces by plain triangulation (the seed's component counts) instead of merging
     /// triangles into larger convex pieces.
     #[arg(long)]
     pub triangulate: bool,
-    /// Decompose non-convex mesh shells approximately (VHACD) instead of rejecting them.
-    #[arg(long)]
-    pub decompose: bool,
 }
 
 impl PartArgs {
@@ -28,47 +25,87 @@ impl PartArgs {
 
 /// Reads the part named by `args`.
 pub fn load_part(args: &PartArgs) -> anyhow::Result<Part> {
-    load_part_spec(&args.part, args.decomposition(), args.decompose)
+    load_part_spec(&args.part, args.decomposition())
 }
 
-/// `--mesh-tolerance` as bits of an `f64` (NaN bits: not given), set once by `main`.
-static MESH_TOLERANCE: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(u64::MAX);
-
-/// Sets `--mesh-tolerance` for every part read after it (once, from `main`).
-pub fn set_mesh_tolerance(tolerance: Option<f64>) {
-    MESH_TOLERANCE.store(tolerance.map_or(u64::MAX, f64::to_bits), std::sync::atomic::Ordering::Relaxed);
+/// How every part file is read: the global options `--mesh-tolerance`, `--units`, `--bend-tolerance`, `--solid`
+/// and `--decompose`, set once by `main`.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ReadSettings {
+    /// `--mesh-tolerance` (mm).
+    pub mesh_tolerance: Option<f64>,
+    /// `--units` of mesh files.
+    pub units: stackplan_geom::io::Units,
+    /// `--bend-tolerance` (mm).
+    pub bend_tolerance: Option<f64>,
+    /// `--solid` of a STEP file.
+    pub solid: Option<usize>,
+    /// `--decompose`: VHACD instead of sheet-metal recognition for non-convex meshes.
+    pub decompose: bool,
 }
 
-/// `--mesh-tolerance`, if given.
-pub fn mesh_tolerance() -> Option<f64> {
-    let bits = MESH_TOLERANCE.load(std::sync::atomic::Ordering::Relaxed);
-    (bits != u64::MAX).then(|| f64::from_bits(bits))
+static READ_SETTINGS: std::sync::OnceLock<ReadSettings> = std::sync::OnceLock::new();
+
+/// Sets the read settings for every part read after it (once, from `main`), after checking them.
+pub fn set_read_settings(settings: ReadSettings) -> anyhow::Result<()> {
+    if let Some(t) = settings.mesh_tolerance
+        && !(t > 0.0 && t.is_finite())
+    {
+        anyhow::bail!("--mesh-tolerance must be a positive, finite length (mm), got {}", short_number(t));
+    }
+    if let Some(t) = settings.bend_tolerance
+        && !(t > 0.0 && t.is_finite())
+    {
+        anyhow::bail!("--bend-tolerance must be a positive, finite length (mm), got {}", short_number(t));
+    }
+    // a second call keeps the first settings (tests call main's pieces more than once)
+    let _ = READ_SETTINGS.set(settings);
+    Ok(())
 }
 
-/// Checks `--mesh-tolerance`: positive and finite, if given.
-pub fn check_mesh_tolerance() -> anyhow::Result<()> {
-    match mesh_tolerance() {
-        Some(t) if !(t > 0.0 && t.is_finite()) => {
-            anyhow::bail!("--mesh-tolerance must be a positive, finite length (mm), got {}", short_number(t))
-        }
-        _ => Ok(()),
+/// The read options of a part file, from the global settings and `decomposition`.
+pub fn read_options(decomposition: Decomposition) -> stackplan_geom::io::ReadOptions {
+    let s = READ_SETTINGS.get().copied().unwrap_or_default();
+    stackplan_geom::io::ReadOptions {
+        decomposition,
+        decompose_mesh: s.decompose,
+        mesh_tolerance: s.mesh_tolerance,
+        units: s.units,
+        bend_tolerance: s.bend_tolerance,
+        solid: s.solid,
+        ..Default::default()
     }
 }
 
-/// Reads a part from a path or `example:NAME` (with `--mesh-tolerance`, if given).
-pub fn load_part_spec(spec: &str, decomposition: Decomposition, decompose_mesh: bool) -> anyhow::Result<Part> {
+/// Reads a part from a path or `example:NAME`, with the global read settings.
+pub fn load_part_spec(spec: &str, decomposition: Decomposition) -> anyhow::Result<Part> {
     if let Some(name) = spec.strip_prefix("example:") {
         return stackplan_geom::examples::part_by_name(name, decomposition).with_context(|| {
             format!("no built-in example named {name:?} (try channel, triangle, complex, cube, l-corner, block)")
         });
     }
-    let options = stackplan_geom::io::ReadOptions {
-        decomposition,
-        decompose_mesh,
-        mesh_tolerance: mesh_tolerance(),
-        ..Default::default()
-    };
-    Ok(stackplan_geom::io::read_part(std::path::Path::new(spec), &options)?)
+    let part = stackplan_geom::io::read_part(std::path::Path::new(spec), &read_options(decomposition))?;
+    warn_implausible_size(spec, &part);
+    Ok(part)
+}
+
+/// Warns when a part's size is implausible for a sheet-metal part in millimetres: under 20 mm or over 20 m across,
+/// most likely a file in inches or metres read as millimetres (mesh files carry no unit: `--units`).
+pub fn warn_implausible_size(spec: &str, part: &Part) {
+    let (lo, hi) = part.aabb();
+    let size = (hi - lo).max_element();
+    let units = READ_SETTINGS.get().map(|s| s.units).unwrap_or_default();
+    if size < 20.0 {
+        tracing::warn!(
+            "{spec}: the part is only {} mm across, read as {units}; if the file is in inches or metres, say so with              --units in or --units m",
+            short_number((size * 1000.0).round() / 1000.0)
+        );
+    } else if size > 20_000.0 {
+        tracing::warn!(
+            "{spec}: the part is {} m across, read as {units}; if the file is in smaller units, say so with --units",
+            short_number((size / 10.0).round() / 100.0)
+        );
+    }
 }
 
 /// The decomposition of `--triangulate`: plain triangulation (the seed's component counts) or convex merging.
@@ -147,8 +184,8 @@ pub fn load_pair(
     pair: Option<&str>,
 ) -> anyhow::Result<PartPair> {
     let decomposition = decomposition(triangulate);
-    let moving = load_part_spec(moving, decomposition, false)?;
-    let fixed = load_part_spec(fixed, decomposition, false)?;
+    let moving = load_part_spec(moving, decomposition)?;
+    let fixed = load_part_spec(fixed, decomposition)?;
     let fixed_pose = match fixed_pose {
         Some(p) => read_pose(p)?,
         None => stackplan_geom::Pose::IDENTITY,

@@ -41,6 +41,21 @@ pub struct Cli {
     /// part's size, and for single-precision coordinates 16 roundings to f32 of the largest; see docs/formats.md).
     #[arg(long, global = true, value_name = "MM")]
     pub mesh_tolerance: Option<f64>,
+    /// The length unit of STL and OBJ files, which carry none: mm, cm, m or in. STEP files name their own unit.
+    #[arg(long, global = true, value_name = "UNIT", default_value = "mm")]
+    pub units: stackplan_geom::io::Units,
+    /// For STEP files and non-convex meshes recognised as sheet metal: how far a convex piece may stand outside the
+    /// solid at a bend or a rounded outline (mm). Bends are covered by segments whose outer arc is made of tangents
+    /// and inner arc of chords, so that the pieces always contain the steel.
+    #[arg(long, global = true, value_name = "MM", default_value_t = stackplan_geom::cad::recognise::DEFAULT_BEND_TOLERANCE)]
+    pub bend_tolerance: f64,
+    /// Which solid of a STEP file with several (0-based, in file order).
+    #[arg(long, global = true, value_name = "N")]
+    pub solid: Option<usize>,
+    /// Decompose a non-convex mesh approximately (VHACD) instead of recognising it as sheet metal. The pieces only
+    /// approximate the solid (they may fill holes and stand outside it), and the part says so wherever it goes.
+    #[arg(long, global = true)]
+    pub decompose: bool,
     /// The command.
     #[command(subcommand)]
     pub command: Command,
@@ -103,13 +118,19 @@ pub fn main() -> ExitCode {
     };
     init_logging(cli.verbose, cli.quiet);
     output::set_quiet(cli.quiet);
-    input::set_mesh_tolerance(cli.mesh_tolerance);
+    let settings = input::ReadSettings {
+        mesh_tolerance: cli.mesh_tolerance,
+        units: cli.units,
+        bend_tolerance: Some(cli.bend_tolerance),
+        solid: cli.solid,
+        decompose: cli.decompose,
+    };
     if let Some(n) = cli.threads
         && let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build_global()
     {
         tracing::warn!("could not set the thread count: {e}");
     }
-    let result = input::check_mesh_tolerance().and_then(|()| match &cli.command {
+    let result = input::set_read_settings(settings).and_then(|()| match &cli.command {
         Command::Part(c) => cmd::part::run(c),
         Command::Plan(a) => cmd::plan::run(a),
         Command::Render(a) => cmd::render::run(a),

@@ -40,6 +40,21 @@ pub enum PartOrigin {
     Mesh,
     /// A mesh decomposed by an approximate convex decomposition (VHACD): the components only approximate the input.
     ApproximateDecomposition,
+    /// A solid from CAD (a STEP B-rep or one closed mesh) recognised as sheet metal and decomposed conservatively
+    /// ([`crate::cad::recognise`]): the components contain the solid and stand outside it by at most
+    /// `max_deviation`.
+    RecognisedSheet {
+        /// Sheet thickness (mm).
+        thickness: f64,
+        /// Number of plates.
+        plates: usize,
+        /// Number of bends.
+        bends: usize,
+        /// The solid's volume (mm^3); the components' volume is the part's.
+        solid_volume: f64,
+        /// The largest distance by which a component stands outside the solid (mm).
+        max_deviation: f64,
+    },
 }
 
 /// Why a set of components does not make a part.

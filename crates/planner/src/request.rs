@@ -132,6 +132,8 @@ pub struct PlacementRequest<'a> {
     /// Largest number of search nodes popped before giving up with [`PlacementError::NodeBudget`] (per partition
     /// of the orientations: each partition counts its own pops).
     pub node_budget: usize,
+    /// When the search gives up with [`PlacementError::TimeLimit`] (checked every 1024 nodes); `None`: never.
+    pub deadline: Option<std::time::Instant>,
     /// Into how many partitions the search splits the orientations (blocks of a few consecutive orientations dealt
     /// round-robin, searched in parallel and merged in the search's total order, [`crate::search`]'s "Partitions";
     /// 1: the sequential search). The results depend on this number, never on the thread count. Default
@@ -145,6 +147,10 @@ pub const DEFAULT_PARTITIONS: usize = 2;
 
 /// The largest [`PlacementRequest::partitions`] accepted.
 pub const MAX_PARTITIONS: usize = 64;
+
+/// The default of [`PlacementRequest::node_budget`]: about 2-4 GB of search state at its end for parts of a few
+/// hundred pieces, so that a search that cannot finish stops before it exhausts a 24 GB machine.
+pub const DEFAULT_NODE_BUDGET: usize = 2_000_000;
 
 /// `n` angles `0, 2 pi / n, ...` (a full turn in equal steps).
 pub fn uniform_thetas(n: usize) -> Vec<f64> {
@@ -223,7 +229,8 @@ impl<'a> PlacementRequest<'a> {
             use_symmetry: true,
             extrapolate: true,
             merge_plates: true,
-            node_budget: 2_000_000,
+            node_budget: DEFAULT_NODE_BUDGET,
+            deadline: None,
             partitions: DEFAULT_PARTITIONS,
         }
     }
@@ -344,6 +351,12 @@ pub enum PlacementError {
         "the obstacle cache was built for another part or another stack (use one cache per part and growing stack)"
     )]
     ForeignCache,
+    /// The search ran past its deadline ([`PlacementRequest::deadline`]).
+    #[error("the search ran out of time after finding {found} placement(s)")]
+    TimeLimit {
+        /// Placements found before giving up.
+        found: usize,
+    },
     /// The search popped more nodes than allowed (a safeguard; the search always terminates in exact arithmetic).
     #[error("the search exceeded its node budget of {budget} nodes after finding {found} placement(s)")]
     NodeBudget {

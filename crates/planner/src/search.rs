@@ -1696,6 +1696,9 @@ impl Search<'_, '_> {
             if *pops > self.request.node_budget as u64 {
                 return Err(PlacementError::NodeBudget { budget: self.request.node_budget, found: found_points.len() });
             }
+            if *pops % 1024 == 0 && self.request.deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+                return Err(PlacementError::TimeLimit { found: found_points.len() });
+            }
             let node = match popped {
                 Popped::Pending { family, id, face } => {
                     // build and solve the child now; push it back with its true cost (>= its key)

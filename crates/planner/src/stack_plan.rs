@@ -93,6 +93,18 @@ pub struct PlanOptions {
     /// count; 1: the sequential search).
     #[serde(default = "default_partitions")]
     pub partitions: usize,
+    /// Largest number of nodes one placement search may pop (per partition): past it the plan ends with the parts
+    /// placed so far and says why. [`crate::request::DEFAULT_NODE_BUDGET`].
+    #[serde(default = "default_node_budget")]
+    pub node_budget: usize,
+    /// Seconds the whole plan may take: past them the plan ends with the parts placed so far and says why. `None`:
+    /// no limit.
+    #[serde(default)]
+    pub time_limit: Option<f64>,
+}
+
+fn default_node_budget() -> usize {
+    crate::request::DEFAULT_NODE_BUDGET
 }
 
 /// The default of [`PlanOptions::max_candidates`]. Some plans reject more than 1024 candidates in a row while the
@@ -130,6 +142,8 @@ impl PlanOptions {
             max_resting_poses: 3,
             nest_allowance: 5.0,
             partitions: default_partitions(),
+            node_budget: default_node_budget(),
+            time_limit: None,
         }
     }
 }
@@ -402,7 +416,20 @@ fn plan_stack_here(
     let mut planned: Vec<PlannedPart> = Vec::new();
     let mut stats = PlanStats::default();
     let mut stopped = None;
+    let started_plan = std::time::Instant::now();
+    let deadline = options
+        .time_limit
+        .filter(|t| t.is_finite() && *t >= 0.0)
+        .map(|t| started_plan + std::time::Duration::from_secs_f64(t.min(1e9)));
     'parts: for index in 0..options.count {
+        if deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+            stopped = Some(format!(
+                "the time limit of {} s was reached after {index} of {} parts",
+                options.time_limit.unwrap_or(0.0),
+                options.count
+            ));
+            break;
+        }
         let stack: Vec<StackPart<'_>> = placed.iter().map(|&pose| StackPart { part, pose }).collect();
         // stage 1: within the stack's footprint (grown by the nesting allowance); stage 2: the whole floor
         let mut stages: Vec<(u8, FloorVolume)> = Vec::new();
@@ -443,12 +470,18 @@ fn plan_stack_here(
             let limit =
                 if stage == last_stage || beaten_at.is_some() { options.max_candidates } else { options.candidates };
             let started = std::time::Instant::now();
+            request.node_budget = options.node_budget;
+            request.deadline = deadline;
             let mut search = match PlacementSearch::new(&request, &cache, &mut caches) {
                 Ok(search) => search,
                 // stage 1's clipped floor may be malformed (a sliver): fall through to stage 2
                 Err(PlacementError::BadFloor(msg)) if stage == 1 => {
                     tracing::debug!(index, "stage 1 floor rejected: {msg}");
                     continue;
+                }
+                Err(e @ (PlacementError::NodeBudget { .. } | PlacementError::TimeLimit { .. })) => {
+                    stopped = Some(limit_reason(index, options, &e, started_plan));
+                    break 'parts;
                 }
                 Err(e) => return Err(e.into()),
             };
@@ -463,7 +496,14 @@ fn plan_stack_here(
                 let started = std::time::Instant::now();
                 // a later stage's part is taken only when strictly cheaper than an earlier stage's (below): past the
                 // cheapest accepted cost the search has nothing left that could be taken
-                let next = search.next_placements_within(1, beaten_at.unwrap_or(f64::INFINITY))?;
+                let next = match search.next_placements_within(1, beaten_at.unwrap_or(f64::INFINITY)) {
+                    Ok(next) => next,
+                    Err(e @ (PlacementError::NodeBudget { .. } | PlacementError::TimeLimit { .. })) => {
+                        stopped = Some(limit_reason(index, options, &e, started_plan));
+                        break 'parts;
+                    }
+                    Err(e) => return Err(e.into()),
+                };
                 stats.seconds_search += started.elapsed().as_secs_f64();
                 let Some(candidate) =
                     next.placements.first().filter(|c| beaten_at.is_none_or(|at| cheaper(c.cost, at)))
@@ -748,6 +788,22 @@ fn accept(
     Ok(Err(format!("the best interference-free positions were rejected (last: {reason})")))
 }
 
+/// Why a plan ended at part `index` on a search limit (node budget or time), with the parts it keeps.
+fn limit_reason(index: usize, options: &PlanOptions, e: &PlacementError, started: std::time::Instant) -> String {
+    let limit = match e {
+        PlacementError::TimeLimit { .. } => {
+            format!("the time limit of {} s was reached", options.time_limit.unwrap_or(0.0))
+        }
+        _ => format!("the search exceeded its node budget of {} nodes", options.node_budget),
+    };
+    format!(
+        "part {} of {} could not be placed: {limit} after {:.1} s; the {index} parts placed before it are kept",
+        index + 1,
+        options.count,
+        started.elapsed().as_secs_f64()
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -827,6 +883,25 @@ mod tests {
             max_resting_poses: 1,
             ..PlanOptions::new(count, floor)
         }
+    }
+
+    #[test]
+    fn a_search_limit_ends_the_plan_with_the_parts_placed_so_far_and_the_reason() {
+        let part = block(40.0, 40.0, 20.0);
+        let floor = FloorVolume::rectangle(0.0, 0.0, 400.0, 400.0, 500.0);
+        let full = plan_stack(&part, &options(6, 0.5, floor.clone())).expect("plan");
+        assert_eq!(full.parts.len(), 6, "{:?}", full.stopped);
+        // a node budget below what the later parts need
+        let tight = PlanOptions { node_budget: 1, ..options(6, 0.5, floor.clone()) };
+        let plan = plan_stack(&part, &tight).expect("a limit is no error");
+        assert!(plan.parts.len() < 6);
+        let reason = plan.stopped.as_deref().unwrap_or_default();
+        assert!(reason.contains("node budget of 1 nodes") && reason.contains("are kept"), "{reason}");
+        assert_eq!(plan.parts[..], full.parts[..plan.parts.len()], "the parts placed before the limit are the same");
+        // a time limit already over: nothing placed, and the plan says why
+        let none = plan_stack(&part, &PlanOptions { time_limit: Some(0.0), ..options(6, 0.5, floor) }).expect("plan");
+        assert!(none.parts.is_empty());
+        assert!(none.stopped.as_deref().is_some_and(|s| s.contains("time limit of 0 s")), "{:?}", none.stopped);
     }
 
     #[test]

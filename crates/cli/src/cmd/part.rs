@@ -85,6 +85,9 @@ pub struct PartInfo {
     /// Every convex component, only with `--json`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pieces: Option<Vec<PieceJson>>,
+    /// What sheet-metal recognition found, for a STEP file or a non-convex mesh (absent otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub recognition: Option<stackplan_geom::cad::recognise::Recognition>,
 }
 
 /// One convex component in `part info --json`.
@@ -151,12 +154,17 @@ pub fn part_info(part: &Part, with_pieces: bool) -> PartInfo {
                 })
                 .collect()
         }),
+        recognition: None,
     }
 }
 
 fn info(args: &InfoArgs) -> anyhow::Result<Outcome> {
     let part = load_part(&args.part)?;
-    let info = part_info(&part, args.json);
+    let mut info = part_info(&part, args.json);
+    if matches!(part.origin, stackplan_geom::PartOrigin::RecognisedSheet { .. }) {
+        let options = crate::input::read_options(args.part.decomposition());
+        info.recognition = Some(stackplan_geom::io::sheet::read_sheet(&args.part.part, &options)?.1);
+    }
     if args.json {
         output::print_json(&info)?;
     } else {
@@ -179,9 +187,54 @@ fn info(args: &InfoArgs) -> anyhow::Result<Outcome> {
             info.bounding_box[1][2],
             info.boundary_faces,
         );
+        let text = match &info.recognition {
+            Some(r) => text + &recognition_text(r),
+            None => text,
+        };
         output::print_text(&text)?;
     }
     Ok(Outcome::Success)
+}
+
+/// The recognised sheet, plates and bends as text.
+fn recognition_text(r: &stackplan_geom::cad::recognise::Recognition) -> String {
+    use std::fmt::Write as _;
+    let mut out = String::new();
+    let holes: usize = r.plates.iter().map(|p| p.holes).sum();
+    let _ = writeln!(out, "sheet metal     thickness {:.4} mm, {} plates ({holes} holes), {} bends", r.thickness, r.plates.len(), r.bends.len());
+    for (k, p) in r.plates.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "  plate {:<3}     {:.1} mm^2, {} holes, {} arcs, {} pieces (from {})",
+            k + 1,
+            p.area,
+            p.holes,
+            p.arcs,
+            p.pieces.len(),
+            p.faces.iter().map(ToString::to_string).collect::<Vec<_>>().join(", ")
+        );
+    }
+    for (k, b) in r.bends.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "  bend {:<3}      inner radius {:.4} mm, angle {:.2} deg, width {:.2} mm, {} pieces",
+            k + 1,
+            b.bend.inner_radius,
+            b.bend.angle.to_degrees(),
+            b.bend.axial[1] - b.bend.axial[0],
+            b.pieces.len()
+        );
+    }
+    let _ = writeln!(
+        out,
+        "solid volume    {:.1} mm^3\npieces volume   {:.1} mm^3 ({:+.3} %)\nlargest outward deviation {:.4} mm (bend tolerance {} mm)",
+        r.solid_volume,
+        r.pieces_volume,
+        100.0 * (r.pieces_volume / r.solid_volume - 1.0),
+        r.max_deviation,
+        r.bend_tolerance
+    );
+    out
 }
 
 fn export(args: &ExportArgs) -> anyhow::Result<Outcome> {

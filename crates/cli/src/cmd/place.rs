@@ -10,7 +10,7 @@ use crate::output;
 use anyhow::{Context, bail};
 use serde::Serialize;
 use stackplan::planner::{Cost, FloorVolume, PlacementRequest, StackPart, place, thetas_with_step};
-use stackplan_geom::io::stack::read_stack;
+use stackplan_geom::io::stack::read_stack_with;
 use stackplan_geom::{DVec2, DVec3};
 use std::path::PathBuf;
 
@@ -94,7 +94,7 @@ struct Output<'a> {
 /// Runs `place`.
 pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let part = load_part(&args.part)?;
-    let stack_file = read_stack(&args.stack)?;
+    let stack_file = read_stack_with(&args.stack, &crate::input::read_options(args.part.decomposition()))?;
     crate::input::check_dtheta_deg(args.dtheta_deg)?;
     let check_lengths = crate::input::check_lengths;
     if let Some(floor) = &args.floor {

@@ -110,7 +110,7 @@ impl PlannerArgs {
         }
         crate::input::check_lengths("--clearance", &[self.clearance])?;
         crate::input::check_lengths("--cup-diameter", &[self.cup_diameter])?;
-        load_part_spec(spec, crate::input::decomposition(self.triangulate), false)
+        load_part_spec(spec, crate::input::decomposition(self.triangulate))
     }
 
     /// The planner's options for `part` and weight `w` (the floor and height defaults scale with the part).

@@ -108,9 +108,9 @@ pub struct RecognisedBend {
     pub pieces: Vec<usize>,
 }
 
-/// A solid recognised as sheet metal, with its part.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SheetPart {
+/// What was recognised in a solid: the sheet, its plates and bends, and how the pieces compare with the solid.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Recognition {
     /// The sheet thickness (mm).
     pub thickness: f64,
     /// The plates.
@@ -123,8 +123,8 @@ pub struct SheetPart {
     pub pieces_volume: f64,
     /// The largest distance by which a piece stands outside the solid (mm), by construction.
     pub max_deviation: f64,
-    /// The part: plates' prisms first, then the bends' segments.
-    pub part: Part,
+    /// The bend tolerance the pieces were made with (mm).
+    pub bend_tolerance: f64,
 }
 
 /// Why a solid is not recognised as sheet metal. Every message names the faces.
@@ -241,7 +241,7 @@ struct Cylinder {
 const ARC_STEP: f64 = std::f64::consts::PI / 36.0;
 
 /// Recognises `brep` as sheet metal and builds its conservative part. See the module documentation.
-pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<SheetPart, RecogniseError> {
+pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<(Part, Recognition), RecogniseError> {
     if !(options.bend_tolerance > 0.0 && options.bend_tolerance.is_finite()) {
         return Err(RecogniseError::BadTolerance(options.bend_tolerance));
     }
@@ -412,12 +412,14 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
     // 5. the check: every boundary point inside the pieces
     check_cover(brep, &components, tol.max(1e-9 * diagonal(&components)), thickness, &partners, &planes)?;
     let solid_volume = brep.volume.unwrap_or(exact_volume);
-    let mut part = Part::from_components(
-        name,
-        components,
-        options.density,
-        PartOrigin::SheetMetal { thickness },
-    )?;
+    let origin = PartOrigin::RecognisedSheet {
+        thickness,
+        plates: plate_records.len(),
+        bends: bends.len(),
+        solid_volume,
+        max_deviation,
+    };
+    let mut part = Part::from_components(name, components, options.density, origin)?;
     part.plates = plates;
     let pieces_volume = part.mass.volume;
     tracing::debug!(
@@ -431,7 +433,16 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
         max_deviation,
         "recognised sheet metal"
     );
-    Ok(SheetPart { thickness, plates: plate_records, bends, solid_volume, pieces_volume, max_deviation, part })
+    let recognition = Recognition {
+        thickness,
+        plates: plate_records,
+        bends,
+        solid_volume,
+        pieces_volume,
+        max_deviation,
+        bend_tolerance: options.bend_tolerance,
+    };
+    Ok((part, recognition))
 }
 
 fn plate_error(source: SheetMetalError, plates: &[RecognisedPlate]) -> RecogniseError {
@@ -998,7 +1009,7 @@ mod tests {
     #[test]
     fn an_l_profile_gives_two_plates_one_bend_and_pieces_that_contain_it() {
         for hole in [false, true] {
-            let sheet = recognise(&l_profile(hole), "l", &RecogniseOptions::default()).expect("recognised");
+            let (part, sheet) = recognise(&l_profile(hole), "l", &RecogniseOptions::default()).expect("recognised");
             assert!((sheet.thickness - T).abs() < 1e-12);
             assert_eq!(sheet.plates.len(), 2);
             assert_eq!(sheet.plates.iter().map(|p| p.holes).sum::<usize>(), usize::from(hole));
@@ -1013,7 +1024,7 @@ mod tests {
             assert!(sheet.pieces_volume <= exact * 1.01, "{} vs {exact}", sheet.pieces_volume);
             assert!(sheet.max_deviation <= DEFAULT_BEND_TOLERANCE + 1e-12 && sheet.max_deviation > 0.0);
             // every sampled point of the solid lies in a piece
-            let comps = &sheet.part.components;
+            let comps = &part.components;
             let mut inside = 0;
             for i in 0..40 {
                 for j in 0..12 {

@@ -81,6 +81,21 @@ impl Welder {
     }
 }
 
+/// A mesh file's welded polygons, in millimetres, with the part name and the length tolerance ([`mesh_tolerance`]).
+#[derive(Debug, Clone)]
+pub(crate) struct Mesh {
+    pub name: String,
+    pub points: Vec<DVec3>,
+    pub polygons: Vec<MeshPolygon>,
+    pub tolerance: f64,
+}
+
+/// Welded points in `units`, converted to millimetres (unchanged for millimetres).
+pub(crate) fn scale_points(points: Vec<DVec3>, units: super::Units) -> Vec<DVec3> {
+    let factor = units.millimetres();
+    if factor == 1.0 { points } else { points.into_iter().map(|p| p * factor).collect() }
+}
+
 /// One polygon of a mesh: welded vertex indices and where it came from in the file.
 #[derive(Debug, Clone)]
 pub(crate) struct MeshPolygon {
@@ -438,6 +453,20 @@ pub(crate) fn part_from_shells(
         };
         match checked {
             Ok(polytope) => components.push(polytope),
+            Err(IoError::NotConvex { .. }) if !options.decompose_mesh && open.is_none() => {
+                // a closed shell that is not convex: a sheet-metal part from CAD, recognised from all the shells
+                let polygons: Vec<MeshPolygon> =
+                    shells.iter().flat_map(|(s, _)| s.polygons.iter().cloned()).collect();
+                let (part, recognition) = super::sheet::recognise_mesh(file, name.clone(), points, &polygons, options, tolerance)?;
+                tracing::info!(
+                    file = %file.display(),
+                    thickness = recognition.thickness,
+                    plates = recognition.plates.len(),
+                    bends = recognition.bends.len(),
+                    "mesh recognised as sheet metal"
+                );
+                return Ok(part);
+            }
             Err(IoError::NotConvex { .. }) if options.decompose_mesh => {
                 let pieces = decompose(points, shell, tolerance).map_err(|detail| IoError::Decomposition {
                     file: file.to_path_buf(),

@@ -19,6 +19,7 @@ pub mod glb;
 pub mod json;
 pub mod mesh;
 pub mod obj;
+pub mod sheet;
 mod snap;
 pub mod stack;
 pub mod stl;
@@ -28,6 +29,7 @@ use crate::part::{Part, PartError};
 use crate::polytope::PolytopeError;
 use crate::pose::PoseError;
 use crate::sheet_metal::{Decomposition, SheetMetalError};
+use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::path::{Path, PathBuf};
 
@@ -274,6 +276,22 @@ pub enum IoError {
         /// Why.
         detail: String,
     },
+    /// The solid was read but is not recognised as sheet metal (the reason names the faces).
+    #[error("{}: not recognised as sheet metal: {source}", file.display())]
+    NotSheetMetal {
+        /// The file.
+        file: PathBuf,
+        /// The reason.
+        source: crate::cad::recognise::RecogniseError,
+    },
+    /// A mesh that cannot be split into the faces of a solid for sheet-metal recognition (open, non-manifold).
+    #[error("{}: {source}", file.display())]
+    MeshFaces {
+        /// The file.
+        file: PathBuf,
+        /// The reason (names the triangle).
+        source: crate::cad::mesh_faces::MeshFaceError,
+    },
     /// A stack placement whose rotation is not a proper rotation.
     #[error("{}: placement {placement}: {source}", file.display())]
     BadPose {
@@ -314,6 +332,8 @@ impl IoError {
             | IoError::Part { file, .. }
             | IoError::Polytope { file, .. }
             | IoError::Decomposition { file, .. }
+            | IoError::NotSheetMetal { file, .. }
+            | IoError::MeshFaces { file, .. }
             | IoError::BadPose { file, .. }
             | IoError::StackPart { file, .. } => file,
         }
@@ -321,6 +341,58 @@ impl IoError {
 
     pub(crate) fn os(file: &Path, source: std::io::Error) -> Self {
         IoError::Os { file: file.to_path_buf(), source }
+    }
+}
+
+/// The length unit of a mesh file (STL and OBJ carry none). Parts are in millimetres everywhere else: STEP files
+/// say their unit, part JSON is in millimetres.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Units {
+    /// Millimetres (the default).
+    #[default]
+    Mm,
+    /// Centimetres.
+    Cm,
+    /// Metres.
+    M,
+    /// Inches (25.4 mm).
+    In,
+}
+
+impl Units {
+    /// Millimetres per unit.
+    pub fn millimetres(self) -> f64 {
+        match self {
+            Units::Mm => 1.0,
+            Units::Cm => 10.0,
+            Units::M => 1000.0,
+            Units::In => 25.4,
+        }
+    }
+}
+
+impl fmt::Display for Units {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Units::Mm => "mm",
+            Units::Cm => "cm",
+            Units::M => "m",
+            Units::In => "in",
+        })
+    }
+}
+
+impl std::str::FromStr for Units {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.to_ascii_lowercase().as_str() {
+            "mm" => Ok(Units::Mm),
+            "cm" => Ok(Units::Cm),
+            "m" => Ok(Units::M),
+            "in" | "inch" => Ok(Units::In),
+            _ => Err(format!("unknown unit {s:?}: expected mm, cm, m or in")),
+        }
     }
 }
 
@@ -340,16 +412,28 @@ pub struct ReadOptions {
     /// tolerance: the kernel's (`1e-9 x` the mesh's extent), and for STL, whose coordinates are single precision,
     /// 16 `f32` roundings of its largest coordinate ([`mesh`]).
     pub mesh_tolerance: Option<f64>,
+    /// The length unit of mesh files (STL, OBJ); ignored for STEP (which names its unit) and part JSON (mm).
+    pub units: Units,
+    /// The bend tolerance of sheet-metal recognition (mm, positive): how far a piece may stand outside the solid
+    /// at a bend or a rounded outline. Default [`crate::cad::recognise::DEFAULT_BEND_TOLERANCE`].
+    pub bend_tolerance: Option<f64>,
+    /// Which solid of a STEP file with several (0-based, in file order); without it several solids are an error.
+    pub solid: Option<usize>,
 }
 
-/// Reads a part, choosing the format by extension: `.json`, `.stl`, `.obj` (case-insensitive).
+/// Reads a part, choosing the format by extension: `.json`, `.step`/`.stp`, `.stl`, `.obj` (case-insensitive). STEP
+/// solids, and mesh shells that are not convex, are recognised as sheet metal ([`sheet`]).
 pub fn read_part(path: impl AsRef<Path>, options: &ReadOptions) -> Result<Part, IoError> {
     let path = path.as_ref();
     match extension(path).as_deref() {
         Some("json") => json::read_part_json(path, options),
         Some("stl") => stl::read_stl(path, options),
         Some("obj") => obj::read_obj(path, options),
-        _ => Err(IoError::UnsupportedExtension { file: path.to_path_buf(), expected: ".json, .stl or .obj" }),
+        Some("step" | "stp") => sheet::read_sheet(path, options).map(|(part, _)| part),
+        _ => Err(IoError::UnsupportedExtension {
+            file: path.to_path_buf(),
+            expected: ".json, .step, .stp, .stl or .obj",
+        }),
     }
 }
 
@@ -365,7 +449,7 @@ pub fn write_part(path: impl AsRef<Path>, part: &Part) -> Result<(), IoError> {
     }
 }
 
-fn extension(path: &Path) -> Option<String> {
+pub(crate) fn extension(path: &Path) -> Option<String> {
     path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase)
 }
 

@@ -16,6 +16,7 @@
 //! JSON writer).
 
 use super::mesh::{
+    Mesh, scale_points,
     MeshPolygon, Precision, Shell, Welder, mesh_tolerance, part_from_shells, significant_digits, written_faces,
 };
 use super::{IoError, Place, ReadOptions, check_coordinate, stem_name};
@@ -34,6 +35,24 @@ pub fn read_obj(path: impl AsRef<Path>, options: &ReadOptions) -> Result<Part, I
 
 /// Parses OBJ from memory; `file` is only used in error messages and as the part name.
 pub fn parse_obj(bytes: &[u8], file: &Path, options: &ReadOptions) -> Result<Part, IoError> {
+    let (shells, points, tolerance) = parse_obj_groups(bytes, file, options)?;
+    part_from_shells(file, stem_name(file), &points, shells, options, tolerance)
+}
+
+/// An OBJ file's polygons (all groups), in millimetres, for sheet-metal recognition.
+pub(crate) fn parse_obj_mesh(bytes: &[u8], file: &Path, options: &ReadOptions) -> Result<Mesh, IoError> {
+    let (shells, points, tolerance) = parse_obj_groups(bytes, file, options)?;
+    let polygons = shells.into_iter().flat_map(|(s, _)| s.polygons).collect();
+    Ok(Mesh { name: stem_name(file), points, polygons, tolerance })
+}
+
+/// The groups of an OBJ file as shells, the welded points in millimetres, and the length tolerance.
+#[allow(clippy::type_complexity)]
+fn parse_obj_groups(
+    bytes: &[u8],
+    file: &Path,
+    options: &ReadOptions,
+) -> Result<(Vec<(Shell, Option<usize>)>, Vec<DVec3>, f64), IoError> {
     let text = String::from_utf8_lossy(bytes);
     let syntax =
         |line: usize, message: String| IoError::Syntax { file: file.to_path_buf(), at: Place::Line(line), message };
@@ -103,8 +122,9 @@ pub fn parse_obj(bytes: &[u8], file: &Path, options: &ReadOptions) -> Result<Par
     if shells.is_empty() {
         return Err(IoError::Empty { file: file.to_path_buf(), at: Place::WholeFile, what: "the OBJ has no faces" });
     }
-    let tolerance = mesh_tolerance(file, &welder.points, Precision::of_text(digits), options)?;
-    part_from_shells(file, stem_name(file), &welder.points, shells, options, tolerance)
+    let points = scale_points(welder.points, options.units);
+    let tolerance = mesh_tolerance(file, &points, Precision::of_text(digits), options)?;
+    Ok((shells, points, tolerance))
 }
 
 /// The part as OBJ text.

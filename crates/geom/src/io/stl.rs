@@ -19,7 +19,7 @@
 //! the read form of the rounded part (the same as ASCII's for coordinates representable in `f32`): bit for bit where
 //! its faces are exactly planar in `f32`, else with those faces flattened (`super::snap`).
 
-use super::mesh::{
+use super::mesh::{Mesh, scale_points,
     MeshPolygon, Precision, Welder, mesh_tolerance, part_from_shells, significant_digits, split_shells, written_faces,
 };
 use super::{IoError, Place, ReadOptions, check_coordinate, stem_name};
@@ -37,6 +37,13 @@ pub fn read_stl(path: impl AsRef<Path>, options: &ReadOptions) -> Result<Part, I
 
 /// Parses STL from memory; `file` is only used in error messages and as the default name.
 pub fn parse_stl(bytes: &[u8], file: &Path, options: &ReadOptions) -> Result<Part, IoError> {
+    let mesh = parse_stl_mesh(bytes, file, options)?;
+    let shells = split_shells(&mesh.points, mesh.polygons, mesh.tolerance);
+    part_from_shells(file, mesh.name, &mesh.points, shells, options, mesh.tolerance)
+}
+
+/// An STL file's welded triangles, in millimetres ([`ReadOptions::units`]), with its name and length tolerance.
+pub(crate) fn parse_stl_mesh(bytes: &[u8], file: &Path, options: &ReadOptions) -> Result<Mesh, IoError> {
     let mut welder = Welder::default();
     let (name, triangles, precision) = if is_ascii(bytes) {
         let (name, triangles, digits) = parse_ascii(bytes, file, &mut welder)?;
@@ -51,10 +58,10 @@ pub fn parse_stl(bytes: &[u8], file: &Path, options: &ReadOptions) -> Result<Par
             what: "the STL has no triangles",
         });
     }
-    let tolerance = mesh_tolerance(file, &welder.points, precision, options)?;
-    let shells = split_shells(&welder.points, triangles, tolerance);
+    let points = scale_points(welder.points, options.units);
+    let tolerance = mesh_tolerance(file, &points, precision, options)?;
     let name = name.filter(|n| !n.is_empty()).unwrap_or_else(|| stem_name(file));
-    part_from_shells(file, name, &welder.points, shells, options, tolerance)
+    Ok(Mesh { name, points, polygons: triangles, tolerance })
 }
 
 fn binary_size(bytes: &[u8]) -> Option<(u64, u64)> {
