@@ -8,3 +8,4 @@ mod hull_props;
 mod io_broken;
 mod io_never_panics;
 mod io_roundtrip;
+mod step;
