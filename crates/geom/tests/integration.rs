@@ -9,3 +9,4 @@ mod io_broken;
 mod io_never_panics;
 mod io_roundtrip;
 mod realparts;
+mod step;

@@ -1,5 +1,6 @@
 //! File formats: part JSON (sheet-metal and convex-pieces forms), STL (ASCII and binary), OBJ, binary glTF export,
-//! and the stack file. The formats are specified precisely in `docs/formats.md`.
+//! the stack file, and STEP B-reps read into [`crate::cad::Brep`]. The formats are specified precisely in
+//! `docs/formats.md`; what the STEP reader takes from ISO 10303-21 files is described in [`step`].
 //!
 //! Every reader returns an [`IoError`] that names the file and the place (line, line and column, byte offset, piece,
 //! shell, face or placement index) and never panics on any input. Every writer goes through
@@ -22,6 +23,7 @@ pub mod obj;
 pub mod sheet;
 mod snap;
 pub mod stack;
+pub mod step;
 pub mod stl;
 
 use crate::hull::HullError;
@@ -80,6 +82,8 @@ pub enum Place {
     Placement(usize),
     /// A JSON key path such as `sheet_metal.thickness`.
     Key(String),
+    /// A STEP entity instance by its instance number (`#17` is 17).
+    Entity(u64),
     /// The file as a whole (empty file, no geometry).
     WholeFile,
 }
@@ -96,6 +100,7 @@ impl fmt::Display for Place {
             Place::FacePoint { face, hole: Some(h), point } => write!(f, "face {face}, hole {h}, point {point}"),
             Place::Placement(i) => write!(f, "placement {i}"),
             Place::Key(k) => write!(f, "key `{k}`"),
+            Place::Entity(n) => write!(f, "entity #{n}"),
             Place::WholeFile => write!(f, "whole file"),
         }
     }
@@ -120,7 +125,8 @@ pub enum IoError {
         /// The supported extensions.
         expected: &'static str,
     },
-    /// Malformed text: bad JSON, an unknown key, a bad token in OBJ or ASCII STL, a bad number.
+    /// Malformed text: bad JSON, an unknown key, a bad token in OBJ or ASCII STL, a bad number, a STEP entity whose
+    /// arguments are not what its type requires (count, kinds, referenced types, a zero direction).
     #[error("{}: {at}: {message}", file.display())]
     Syntax {
         /// The file.
@@ -302,6 +308,57 @@ pub enum IoError {
         /// The reason.
         source: PoseError,
     },
+    /// A STEP entity reached from the solid whose type the reader does not handle: a surface other than a plane or a
+    /// circular cylinder, a curve other than a line, a circle or a degree-1 spline or polyline, a solid with voids.
+    #[error(
+        "{}: {at}: {kind} {role} are not supported{}",
+        file.display(),
+        face.map(|f| format!(" (face #{f})")).unwrap_or_default()
+    )]
+    Unsupported {
+        /// The file.
+        file: PathBuf,
+        /// The entity of the unsupported type.
+        at: Place,
+        /// Its type name as written (`CONICAL_SURFACE`), or a description (`B_SPLINE_CURVE_WITH_KNOTS of degree 3`).
+        kind: String,
+        /// What it would have been: `faces`, `edges`, `loops`, `solids`.
+        role: &'static str,
+        /// The STEP face it belongs to, if any.
+        face: Option<u64>,
+    },
+    /// A STEP reference to an instance that the file does not define.
+    #[error("{}: {at}: refers to #{target}, which is not in the file", file.display())]
+    MissingReference {
+        /// The file.
+        file: PathBuf,
+        /// The referring entity.
+        at: Place,
+        /// The missing instance number.
+        target: u64,
+    },
+    /// A STEP file with several solids and no choice among them.
+    #[error(
+        "{}: whole file: the file holds {count} solids; choose one with --solid N (0 to {}, in file order)",
+        file.display(),
+        count.saturating_sub(1)
+    )]
+    SeveralSolids {
+        /// The file.
+        file: PathBuf,
+        /// How many solids it holds.
+        count: usize,
+    },
+    /// A STEP solid index beyond the file's solids.
+    #[error("{}: whole file: --solid {index} asked, but the file holds {count} solid(s) (0-based)", file.display())]
+    NoSuchSolid {
+        /// The file.
+        file: PathBuf,
+        /// The index asked for.
+        index: usize,
+        /// How many solids the file holds.
+        count: usize,
+    },
     /// The part referenced by a stack file could not be read.
     #[error("{}: key `part`: {source}", file.display())]
     StackPart {
@@ -335,6 +392,10 @@ impl IoError {
             | IoError::NotSheetMetal { file, .. }
             | IoError::MeshFaces { file, .. }
             | IoError::BadPose { file, .. }
+            | IoError::Unsupported { file, .. }
+            | IoError::MissingReference { file, .. }
+            | IoError::SeveralSolids { file, .. }
+            | IoError::NoSuchSolid { file, .. }
             | IoError::StackPart { file, .. } => file,
         }
     }
