@@ -9,6 +9,8 @@
 //! apart, with their mid-surface outline and holes) and the bends (pairs of coaxial cylinders whose radii differ by
 //! the thickness), and [`bend`] turns each bend into convex segments that contain it.
 
+pub mod mesh_faces;
+
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
