@@ -10,6 +10,7 @@
 //! the thickness), and [`bend`] turns each bend into convex segments that contain it.
 
 pub mod bend;
+pub mod mesh_faces;
 pub mod recognise;
 
 use glam::DVec3;

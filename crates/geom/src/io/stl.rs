@@ -80,7 +80,7 @@ fn is_ascii(bytes: &[u8]) -> bool {
     head.len() >= 5 && head[..5].eq_ignore_ascii_case(b"solid") && !bytes.contains(&0)
 }
 
-fn parse_binary(bytes: &[u8], file: &Path, welder: &mut Welder) -> Result<Vec<MeshPolygon>, IoError> {
+pub(crate) fn parse_binary(bytes: &[u8], file: &Path, welder: &mut Welder) -> Result<Vec<MeshPolygon>, IoError> {
     let actual = bytes.len() as u64;
     let Some((triangles, expected)) = binary_size(bytes) else {
         return Err(IoError::Truncated {
