@@ -6,7 +6,8 @@
 //! (hashing).
 //!
 //! **Planar regions.** Two triangles across an edge are coplanar when the angle between their unit normals is below
-//! `1e-3` rad (plus what rounding of the vertices can turn a short triangle's normal by) and the far vertex of each
+//! `1e-3 + t/8 (1/h1 + 1/h2)` rad (`h1`, `h2` their heights above the shared edge: what rounding the vertices
+//! by `t/16` can turn the normals by) and the far vertex of each
 //! lies within the planar tolerance `max(10 t, 1e-4 mm)` of the other's plane (`t` the mesh's length tolerance, a few
 //! `f32` roundings of its largest coordinate). Regions are the connected components of that relation (union-find),
 //! numbered by their first triangle in input order. A triangle whose height is within `t` of zero has no reliable
@@ -23,13 +24,20 @@
 //! fit of centre and radius to these conditions). A chord cannot pass for a skin: three points of the arc fix its
 //! circle, which is not tangent to a chord at its end. Only a run of a single facet has just two points, and inside a
 //! uniformly tessellated arc the facets on either side of one facet look like skins of a smaller circle; such a run is
-//! rejected when the chain continues on one circle beyond both of its skins. Runs are searched from every smooth
-//! shared line, walking while the next region is the only one smoothly joined along a parallel line and the points
-//! stay near the circle tangent to the first skin through the last point; the longest runs are taken first, and a
-//! region is the facet of at most one run (a skin may serve two runs: the base of a U-channel). The facets of a run
-//! become one cylindrical face, its axis the mean direction of its shared lines; every vertex of its triangles must
-//! lie on the fitted cylinder within four times the fit tolerance, else the mesh is reported. Regions with smooth
-//! neighbours that are not the facets of a run (tessellated hole walls, chamfers) stay planar faces.
+//! rejected when the chain continues on one circle beyond both of its skins.
+//!
+//! Runs are searched from every smooth shared line, with either region as the first skin, walking while the next
+//! region is the only one smoothly joined to the current one along a parallel line and the points stay within 2 % of
+//! the radius of the circle tangent to the first skin at the first point through the last. A walk is abandoned at its
+//! third point when the first skin is itself a chord of the arc (its own far shared line lies on the circle through
+//! the first three points, within ten fit tolerances: a true skin's far line is off that circle by about
+//! `sqrt(r^2 + L^2) - r` for a skin of width `L`), so a closed chain of facets (a tessellated hole wall) costs O(1) per facet. Once a walk has five
+//! points, the full fit is tried only where the current region is tangent, within a hundred fit tolerances, to the
+//! circle tangent to the first skin through the last point. The longest runs are taken first, and a region is the
+//! facet of at most one run (a skin may serve two runs: the base of a U-channel). The facets of a run become one
+//! cylindrical face, its axis the mean direction of its shared lines, refitted; every vertex of its triangles must lie
+//! on the fitted cylinder within four fit tolerances, else the mesh is reported. Regions with smooth neighbours that
+//! are not the facets of a run (tessellated hole walls, chamfers) stay planar faces.
 //!
 //! **Loops.** A face's boundary is its triangles' directed edges whose partner belongs to another face, chained at
 //! each vertex by turning about it through the face's own triangles (so a face touching itself at a vertex still
@@ -40,8 +48,9 @@
 //!
 //! **Volume**: the divergence theorem over the triangles about the centre of the bounding box.
 //!
-//! Cost: O(T log T) for T triangles, plus O(k^3) for each chain of k facets of one bend (k is small: a bend of
-//! angle `a` has at most `a / 0.2` facets at the usual angular deflection).
+//! Cost: O(T log T) for T triangles, plus O(k^2) for each bend tessellated into k facets (the walks from its two
+//! skins, each step checking every point so far). With the usual angular deflection of 0.2 rad, k is at most 16 for
+//! a bend of 180 degrees.
 
 use super::{Brep, BrepFace, FaceSource, Segment, Surface};
 use crate::accurate_normal::accurate_cross;
@@ -375,7 +384,7 @@ impl<'a> Mesh<'a> {
         }
         let (nt, ns) = (ct.normalize(), cs.normalize());
         let angle = nt.cross(ns).length().atan2(nt.dot(ns));
-        let allowed = COPLANAR_ANGLE + self.tolerance * (1.0 / ht + 1.0 / hs);
+        let allowed = COPLANAR_ANGLE + self.tolerance / 8.0 * (1.0 / ht + 1.0 / hs);
         angle <= allowed && (pd - pa).dot(nt).abs() <= self.planar && (pc - pa).dot(ns).abs() <= self.planar
     }
 
@@ -576,10 +585,14 @@ impl<'a> Mesh<'a> {
         let mut run = Run { skins: [skin, skin], facets: Vec::new(), lines: vec![first] };
         let mut points = vec![frame.project(lines[first].middle())];
         let mut current = lines[first].other(skin);
+        let before = match self.parallel_lines(lines, smooth_at, skin, first, d).as_slice() {
+            &[b] => Some(frame.project(lines[b].middle())),
+            _ => None,
+        };
         let mut best: Option<Run> = None;
         let limit = regions.regions.len();
         while run.facets.len() < limit {
-            if !run.facets.is_empty() {
+            if !run.facets.is_empty() && self.tangent_at_end(&points, tangent_normal, &frame, regions, current) {
                 // `current` as the end skin
                 let candidate = Run { skins: [skin, current], facets: run.facets.clone(), lines: run.lines.clone() };
                 if self.valid(regions, lines, &candidate, &frame, smooth_at) {
@@ -596,12 +609,32 @@ impl<'a> Mesh<'a> {
             run.facets.push(current);
             run.lines.push(line);
             points.push(frame.project(lines[line].middle()));
+            if points.len() == 3
+                && let Some(before) = before
+                && let Some(c) = circumcircle(points[0], points[1], points[2])
+                && ((before - c.centre).length() - c.radius).abs() <= 10.0 * self.fit_tolerance(c.radius)
+            {
+                // the skin is itself a chord of the arc that the walk follows
+                return None;
+            }
             if !gate(&points, tangent_normal) {
                 break;
             }
             current = following;
         }
         best
+    }
+
+    /// A cheap test before the fit, once a run is long enough for the circle tangent to the first skin through the
+    /// last point to be well determined: whether `end` is nearly tangent to that circle at the last point.
+    fn tangent_at_end(&self, points: &[DVec2], normal: DVec2, frame: &Frame, regions: &Regions, end: usize) -> bool {
+        let (Some(&p0), Some(&pl)) = (points.first(), points.last()) else { return false };
+        if points.len() < 5 {
+            return true;
+        }
+        let Some(c) = tangent_circle(p0, normal, pl) else { return false };
+        let t = frame.project_direction(regions.regions[end].normal).perp();
+        (c.centre - pl).dot(t).abs() <= 100.0 * self.fit_tolerance(c.radius)
     }
 
     /// Whether a run's points fit one circle tangent to both skins (and, for a single facet, the chain does not
@@ -1132,6 +1165,23 @@ mod tests {
             assert!(
                 matches!(brep.faces[0].source, FaceSource::Mesh { region: 0, ref first_triangle } if first_triangle == "byte 84")
             );
+        }
+    }
+
+    #[test]
+    fn shallow_bends_of_one_and_two_facets() {
+        let (r, t) = (4.0, 1.0);
+        for facets in [1, 2] {
+            let steps = [
+                Step::Straight { length: 12.0, pieces: 1 },
+                Step::Bend { angle: 0.3, radius: r, facets },
+                Step::Straight { length: 9.0, pieces: 1 },
+            ];
+            let (points, tris) = bent_sheet(t, &steps, 20.0);
+            let brep = mesh_faces(&points, &tris, 1e-9).expect("segments");
+            assert_eq!(cylinders(&brep).len(), 2, "{facets} facets");
+            check_bend(&brep, r, r + t);
+            check_loops(&brep, 1e-9);
         }
     }
 
