@@ -35,8 +35,9 @@
 //! points, the full fit is tried only where the current region is tangent, within a hundred fit tolerances, to the
 //! circle tangent to the first skin through the last point. The longest runs are taken first, and a region is the
 //! facet of at most one run (a skin may serve two runs: the base of a U-channel). The facets of a run become one
-//! cylindrical face, its axis the mean direction of its shared lines, refitted; every vertex of its triangles must lie
-//! on the fitted cylinder within four fit tolerances, else the mesh is reported. Regions with smooth neighbours that
+//! cylindrical face, its axis the mean direction of its shared lines, refitted; seen along the axis, every vertex of a
+//! facet must lie on the facet's chord (between the points of its two shared lines, which are on the circle) within
+//! four fit tolerances, else the mesh is reported. Regions with smooth neighbours that
 //! are not the facets of a run (tessellated hole walls, chamfers) stay planar faces.
 //!
 //! **Loops.** A face's boundary is its triangles' directed edges whose partner belongs to another face, chained at
@@ -133,7 +134,7 @@ pub enum MeshFaceError {
     /// A run of facets fitted as a bend with a vertex off the fitted cylinder.
     #[error(
         "a chain of facets about the axis through {point} along {axis} is not a circular cylinder: vertex {vertex} \
-         (of the triangle at {place}) is {distance:.3e} mm off the fitted circle of radius {radius}"
+         (of the triangle at {place}) is {distance:.3e} mm off its facet's chord of the fitted circle of radius {radius}"
     )]
     NotCylinder {
         /// Where the triangle is in the file.
@@ -146,7 +147,7 @@ pub enum MeshFaceError {
         radius: f64,
         /// The vertex index.
         vertex: usize,
-        /// Its distance from the fitted cylinder.
+        /// Its distance from its facet's chord of the fitted circle (seen along the axis).
         distance: f64,
     },
     /// The boundary of a face does not chain into loops (a bug if it ever shows).
@@ -696,14 +697,17 @@ impl<'a> Mesh<'a> {
         }
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
         let mut worst: Option<(f64, usize, usize)> = None;
-        for &f in &run.facets {
+        for (i, &f) in run.facets.iter().enumerate() {
+            // the facet's chord: every vertex of the facet projects onto it
+            let q0 = frame.project(lines[run.lines[i]].middle());
+            let q1 = frame.project(lines[run.lines[i + 1]].middle());
             for &t in &regions.regions[f].triangles {
                 for &v in &self.tris[t] {
                     let p = self.points[v];
                     let s = (p - frame.origin).dot(axis);
                     lo = lo.min(s);
                     hi = hi.max(s);
-                    let off = ((frame.project(p) - circle.centre).length() - circle.radius).abs();
+                    let off = segment_distance(frame.project(p), q0, q1);
                     if worst.is_none_or(|(w, _, _)| off > w) {
                         worst = Some((off, v, t));
                     }
@@ -889,6 +893,14 @@ impl<'a> Mesh<'a> {
             .sum::<f64>()
             / 6.0
     }
+}
+
+/// The distance of `p` from the segment `ab`.
+fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> f64 {
+    let ab = b - a;
+    let len2 = ab.length_squared();
+    let s = if len2 > 0.0 { ((p - a).dot(ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    (p - a - s * ab).length()
 }
 
 /// Whether the points stay near the circle tangent to the first skin (2-D unit normal `normal`) at the first point
@@ -1166,6 +1178,42 @@ mod tests {
                 matches!(brep.faces[0].source, FaceSource::Mesh { region: 0, ref first_triangle } if first_triangle == "byte 84")
             );
         }
+    }
+
+    /// The mesh with the edge `a`-`b` split at its midpoint, each of its two triangles into two.
+    fn split_edge(points: &mut Vec<DVec3>, tris: &[MeshPolygon], a: usize, b: usize) -> Vec<MeshPolygon> {
+        let m = points.len();
+        points.push(0.5 * (points[a] + points[b]));
+        let mut out: Vec<[usize; 3]> = Vec::new();
+        for t in tris {
+            let v = [t.vertices[0], t.vertices[1], t.vertices[2]];
+            match (0..3).find(|&k| [v[k], v[(k + 1) % 3]] == [a, b] || [v[k], v[(k + 1) % 3]] == [b, a]) {
+                Some(k) => {
+                    let (x, y, z) = (v[k], v[(k + 1) % 3], v[(k + 2) % 3]);
+                    out.push([x, m, z]);
+                    out.push([m, y, z]);
+                }
+                None => out.push(v),
+            }
+        }
+        polygons(&out)
+    }
+
+    #[test]
+    fn a_vertex_on_a_chord_is_part_of_the_cylinder() {
+        let (r, t) = (2.5, 1.5);
+        let steps = [
+            Step::Straight { length: 40.0, pieces: 2 },
+            Step::Bend { angle: FRAC_PI_2, radius: r, facets: 8 },
+            Step::Straight { length: 30.0, pieces: 1 },
+        ];
+        let (mut points, tris) = bent_sheet(t, &steps, 50.0);
+        // section points 3 and 4 bound the second facet of the outer surface, at z = 0
+        let tris = split_edge(&mut points, &tris, 3, 4);
+        let brep = mesh_faces(&points, &tris, 1e-9).expect("segments");
+        assert_eq!(cylinders(&brep).len(), 2);
+        check_bend(&brep, r, r + t);
+        check_loops(&brep, 1e-9);
     }
 
     #[test]
