@@ -6,7 +6,8 @@
 //! (hashing).
 //!
 //! **Planar regions.** Two triangles across an edge are coplanar when the angle between their unit normals is below
-//! `1e-3` rad (plus what rounding of the vertices can turn a short triangle's normal by) and the far vertex of each
+//! `1e-3 + t/8 (1/h1 + 1/h2)` rad (`h1`, `h2` their heights above the shared edge: what rounding the vertices
+//! by `t/16` can turn the normals by) and the far vertex of each
 //! lies within the planar tolerance `max(10 t, 1e-4 mm)` of the other's plane (`t` the mesh's length tolerance, a few
 //! `f32` roundings of its largest coordinate). Regions are the connected components of that relation (union-find),
 //! numbered by their first triangle in input order. A triangle whose height is within `t` of zero has no reliable
@@ -23,13 +24,21 @@
 //! fit of centre and radius to these conditions). A chord cannot pass for a skin: three points of the arc fix its
 //! circle, which is not tangent to a chord at its end. Only a run of a single facet has just two points, and inside a
 //! uniformly tessellated arc the facets on either side of one facet look like skins of a smaller circle; such a run is
-//! rejected when the chain continues on one circle beyond both of its skins. Runs are searched from every smooth
-//! shared line, walking while the next region is the only one smoothly joined along a parallel line and the points
-//! stay near the circle tangent to the first skin through the last point; the longest runs are taken first, and a
-//! region is the facet of at most one run (a skin may serve two runs: the base of a U-channel). The facets of a run
-//! become one cylindrical face, its axis the mean direction of its shared lines; every vertex of its triangles must
-//! lie on the fitted cylinder within four times the fit tolerance, else the mesh is reported. Regions with smooth
-//! neighbours that are not the facets of a run (tessellated hole walls, chamfers) stay planar faces.
+//! rejected when the chain continues on one circle beyond both of its skins.
+//!
+//! Runs are searched from every smooth shared line, with either region as the first skin, walking while the next
+//! region is the only one smoothly joined to the current one along a parallel line and the points stay within 2 % of
+//! the radius of the circle tangent to the first skin at the first point through the last. A walk is abandoned at its
+//! third point when the first skin is itself a chord of the arc (its own far shared line lies on the circle through
+//! the first three points, within ten fit tolerances: a true skin's far line is off that circle by about
+//! `sqrt(r^2 + L^2) - r` for a skin of width `L`), so a closed chain of facets (a tessellated hole wall) costs O(1) per facet. Once a walk has five
+//! points, the full fit is tried only where the current region is tangent, within a hundred fit tolerances, to the
+//! circle tangent to the first skin through the last point. The longest runs are taken first, and a region is the
+//! facet of at most one run (a skin may serve two runs: the base of a U-channel). The facets of a run become one
+//! cylindrical face, its axis the mean direction of its shared lines, refitted; seen along the axis, every vertex of a
+//! facet must lie on the facet's chord (between the points of its two shared lines, which are on the circle) within
+//! four fit tolerances, else the mesh is reported. Regions with smooth neighbours that
+//! are not the facets of a run (tessellated hole walls, chamfers) stay planar faces.
 //!
 //! **Loops.** A face's boundary is its triangles' directed edges whose partner belongs to another face, chained at
 //! each vertex by turning about it through the face's own triangles (so a face touching itself at a vertex still
@@ -40,8 +49,9 @@
 //!
 //! **Volume**: the divergence theorem over the triangles about the centre of the bounding box.
 //!
-//! Cost: O(T log T) for T triangles, plus O(k^3) for each chain of k facets of one bend (k is small: a bend of
-//! angle `a` has at most `a / 0.2` facets at the usual angular deflection).
+//! Cost: O(T log T) for T triangles, plus O(k^2) for each bend tessellated into k facets (the walks from its two
+//! skins, each step checking every point so far). With the usual angular deflection of 0.2 rad, k is at most 16 for
+//! a bend of 180 degrees.
 
 use super::{Brep, BrepFace, FaceSource, Segment, Surface};
 use crate::accurate_normal::accurate_cross;
@@ -124,7 +134,7 @@ pub enum MeshFaceError {
     /// A run of facets fitted as a bend with a vertex off the fitted cylinder.
     #[error(
         "a chain of facets about the axis through {point} along {axis} is not a circular cylinder: vertex {vertex} \
-         (of the triangle at {place}) is {distance:.3e} mm off the fitted circle of radius {radius}"
+         (of the triangle at {place}) is {distance:.3e} mm off its facet's chord of the fitted circle of radius {radius}"
     )]
     NotCylinder {
         /// Where the triangle is in the file.
@@ -137,7 +147,7 @@ pub enum MeshFaceError {
         radius: f64,
         /// The vertex index.
         vertex: usize,
-        /// Its distance from the fitted cylinder.
+        /// Its distance from its facet's chord of the fitted circle (seen along the axis).
         distance: f64,
     },
     /// The boundary of a face does not chain into loops (a bug if it ever shows).
@@ -375,7 +385,7 @@ impl<'a> Mesh<'a> {
         }
         let (nt, ns) = (ct.normalize(), cs.normalize());
         let angle = nt.cross(ns).length().atan2(nt.dot(ns));
-        let allowed = COPLANAR_ANGLE + self.tolerance * (1.0 / ht + 1.0 / hs);
+        let allowed = COPLANAR_ANGLE + self.tolerance / 8.0 * (1.0 / ht + 1.0 / hs);
         angle <= allowed && (pd - pa).dot(nt).abs() <= self.planar && (pc - pa).dot(ns).abs() <= self.planar
     }
 
@@ -576,10 +586,14 @@ impl<'a> Mesh<'a> {
         let mut run = Run { skins: [skin, skin], facets: Vec::new(), lines: vec![first] };
         let mut points = vec![frame.project(lines[first].middle())];
         let mut current = lines[first].other(skin);
+        let before = match self.parallel_lines(lines, smooth_at, skin, first, d).as_slice() {
+            &[b] => Some(frame.project(lines[b].middle())),
+            _ => None,
+        };
         let mut best: Option<Run> = None;
         let limit = regions.regions.len();
         while run.facets.len() < limit {
-            if !run.facets.is_empty() {
+            if !run.facets.is_empty() && self.tangent_at_end(&points, tangent_normal, &frame, regions, current) {
                 // `current` as the end skin
                 let candidate = Run { skins: [skin, current], facets: run.facets.clone(), lines: run.lines.clone() };
                 if self.valid(regions, lines, &candidate, &frame, smooth_at) {
@@ -596,12 +610,32 @@ impl<'a> Mesh<'a> {
             run.facets.push(current);
             run.lines.push(line);
             points.push(frame.project(lines[line].middle()));
+            if points.len() == 3
+                && let Some(before) = before
+                && let Some(c) = circumcircle(points[0], points[1], points[2])
+                && ((before - c.centre).length() - c.radius).abs() <= 10.0 * self.fit_tolerance(c.radius)
+            {
+                // the skin is itself a chord of the arc that the walk follows
+                return None;
+            }
             if !gate(&points, tangent_normal) {
                 break;
             }
             current = following;
         }
         best
+    }
+
+    /// A cheap test before the fit, once a run is long enough for the circle tangent to the first skin through the
+    /// last point to be well determined: whether `end` is nearly tangent to that circle at the last point.
+    fn tangent_at_end(&self, points: &[DVec2], normal: DVec2, frame: &Frame, regions: &Regions, end: usize) -> bool {
+        let (Some(&p0), Some(&pl)) = (points.first(), points.last()) else { return false };
+        if points.len() < 5 {
+            return true;
+        }
+        let Some(c) = tangent_circle(p0, normal, pl) else { return false };
+        let t = frame.project_direction(regions.regions[end].normal).perp();
+        (c.centre - pl).dot(t).abs() <= 100.0 * self.fit_tolerance(c.radius)
     }
 
     /// Whether a run's points fit one circle tangent to both skins (and, for a single facet, the chain does not
@@ -663,14 +697,17 @@ impl<'a> Mesh<'a> {
         }
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
         let mut worst: Option<(f64, usize, usize)> = None;
-        for &f in &run.facets {
+        for (i, &f) in run.facets.iter().enumerate() {
+            // the facet's chord: every vertex of the facet projects onto it
+            let q0 = frame.project(lines[run.lines[i]].middle());
+            let q1 = frame.project(lines[run.lines[i + 1]].middle());
             for &t in &regions.regions[f].triangles {
                 for &v in &self.tris[t] {
                     let p = self.points[v];
                     let s = (p - frame.origin).dot(axis);
                     lo = lo.min(s);
                     hi = hi.max(s);
-                    let off = ((frame.project(p) - circle.centre).length() - circle.radius).abs();
+                    let off = segment_distance(frame.project(p), q0, q1);
                     if worst.is_none_or(|(w, _, _)| off > w) {
                         worst = Some((off, v, t));
                     }
@@ -856,6 +893,14 @@ impl<'a> Mesh<'a> {
             .sum::<f64>()
             / 6.0
     }
+}
+
+/// The distance of `p` from the segment `ab`.
+fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> f64 {
+    let ab = b - a;
+    let len2 = ab.length_squared();
+    let s = if len2 > 0.0 { ((p - a).dot(ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    (p - a - s * ab).length()
 }
 
 /// Whether the points stay near the circle tangent to the first skin (2-D unit normal `normal`) at the first point
@@ -1132,6 +1177,59 @@ mod tests {
             assert!(
                 matches!(brep.faces[0].source, FaceSource::Mesh { region: 0, ref first_triangle } if first_triangle == "byte 84")
             );
+        }
+    }
+
+    /// The mesh with the edge `a`-`b` split at its midpoint, each of its two triangles into two.
+    fn split_edge(points: &mut Vec<DVec3>, tris: &[MeshPolygon], a: usize, b: usize) -> Vec<MeshPolygon> {
+        let m = points.len();
+        points.push(0.5 * (points[a] + points[b]));
+        let mut out: Vec<[usize; 3]> = Vec::new();
+        for t in tris {
+            let v = [t.vertices[0], t.vertices[1], t.vertices[2]];
+            match (0..3).find(|&k| [v[k], v[(k + 1) % 3]] == [a, b] || [v[k], v[(k + 1) % 3]] == [b, a]) {
+                Some(k) => {
+                    let (x, y, z) = (v[k], v[(k + 1) % 3], v[(k + 2) % 3]);
+                    out.push([x, m, z]);
+                    out.push([m, y, z]);
+                }
+                None => out.push(v),
+            }
+        }
+        polygons(&out)
+    }
+
+    #[test]
+    fn a_vertex_on_a_chord_is_part_of_the_cylinder() {
+        let (r, t) = (2.5, 1.5);
+        let steps = [
+            Step::Straight { length: 40.0, pieces: 2 },
+            Step::Bend { angle: FRAC_PI_2, radius: r, facets: 8 },
+            Step::Straight { length: 30.0, pieces: 1 },
+        ];
+        let (mut points, tris) = bent_sheet(t, &steps, 50.0);
+        // section points 3 and 4 bound the second facet of the outer surface, at z = 0
+        let tris = split_edge(&mut points, &tris, 3, 4);
+        let brep = mesh_faces(&points, &tris, 1e-9).expect("segments");
+        assert_eq!(cylinders(&brep).len(), 2);
+        check_bend(&brep, r, r + t);
+        check_loops(&brep, 1e-9);
+    }
+
+    #[test]
+    fn shallow_bends_of_one_and_two_facets() {
+        let (r, t) = (4.0, 1.0);
+        for facets in [1, 2] {
+            let steps = [
+                Step::Straight { length: 12.0, pieces: 1 },
+                Step::Bend { angle: 0.3, radius: r, facets },
+                Step::Straight { length: 9.0, pieces: 1 },
+            ];
+            let (points, tris) = bent_sheet(t, &steps, 20.0);
+            let brep = mesh_faces(&points, &tris, 1e-9).expect("segments");
+            assert_eq!(cylinders(&brep).len(), 2, "{facets} facets");
+            check_bend(&brep, r, r + t);
+            check_loops(&brep, 1e-9);
         }
     }
 
