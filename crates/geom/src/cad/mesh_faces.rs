@@ -163,7 +163,6 @@ pub enum MeshFaceError {
 /// `points` are welded vertices (neighbouring triangles share vertex indices), `triangles` have three vertex
 /// indices each, counter-clockwise seen from outside, and `tolerance` is the mesh's length tolerance
 /// ([`crate::io::mesh`]).
-#[cfg_attr(not(test), expect(dead_code, reason = "the mesh readers call it once recognition consumes the faces"))]
 pub(crate) fn mesh_faces(points: &[DVec3], triangles: &[MeshPolygon], tolerance: f64) -> Result<Brep, MeshFaceError> {
     let mesh = Mesh::new(points, triangles, tolerance)?;
     let regions = mesh.planar_regions()?;

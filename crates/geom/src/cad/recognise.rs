@@ -816,14 +816,18 @@ fn check_cover(
                 }
             }
             if best > tol {
-                // a planar face with an opposite face at another distance: say so
-                let index = brep.faces.iter().position(|f| std::ptr::eq(f, face)).unwrap_or(0);
-                if let Some(pf) = planes.iter().position(|q| q.index == index)
-                    && let Some((j, d)) = partners[pf]
-                    && (d - thickness).abs() > 2.0 * tol.max(thickness * 1e-6)
-                {
+                // of the planar faces through the point with an opposite face at another distance than the sheet's,
+                // the one nearest the sheet's thickness says best where the solid is no sheet
+                let culprit = planes
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, q)| (p - q.point).dot(q.normal).abs() <= 10.0 * tol)
+                    .filter_map(|(k, q)| partners[k].map(|(j, d)| (q, j, d)))
+                    .filter(|(_, _, d)| (d - thickness).abs() > 2.0 * tol.max(thickness * 1e-6))
+                    .min_by(|x, y| (x.2 - thickness).abs().total_cmp(&(y.2 - thickness).abs()));
+                if let Some((q, j, d)) = culprit {
                     return Err(RecogniseError::NotConstantThickness {
-                        a: face.source.clone(),
+                        a: q.face.source.clone(),
                         b: planes[j].face.source.clone(),
                         distance: d,
                         thickness,
