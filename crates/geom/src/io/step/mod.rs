@@ -1,7 +1,7 @@
 //! STEP (ISO 10303-21 exchange files of the AP203, AP214 and AP242 schemas) read into a [`Brep`].
 //!
-//! [`p21`] parses the clear-text encoding of ISO 10303-21 into entity instances; [`brep`] walks the entity graph
-//! from one solid down to its points and builds the faces.
+//! Two private modules do the work: `p21` parses the clear-text encoding of ISO 10303-21 into entity instances,
+//! and `brep` walks the entity graph from one solid down to its points and builds the faces.
 //!
 //! What is read, with the entity names of ISO 10303-42 (geometric and topological representation) as the AP214 and
 //! AP242 schemas use them:
