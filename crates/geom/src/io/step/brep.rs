@@ -389,7 +389,7 @@ impl<'a> Graph<'a> {
                 Err(self.syntax(id, format!("length unit of {s} mm is not positive and finite")))
             }
             None if is_length => {
-                tracing::warn!(file = %self.file.display(), "length unit #{id} ({}) is not understood", inst.type_name());
+                tracing::debug!(file = %self.file.display(), "length unit #{id} ({}) is not understood", inst.type_name());
                 Ok(None)
             }
             other => Ok(other),
