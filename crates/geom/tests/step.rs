@@ -158,7 +158,7 @@ fn real_parts_enclose_the_labelled_volume() {
         let brep = read_real(n);
         let label = json(&realpart(n, "_labels.json"))["part_volume_3d"].as_f64().expect("labelled volume") * 1000.0;
         let v = volume(&brep);
-        assert!(((v - label) / label).abs() < 1e-6, "bendfm_{n}: volume {v} mm^3, label {label}");
+        assert!(((v - label) / label).abs() < 1e-7, "bendfm_{n}: volume {v} mm^3, label {label}");
     }
 }
 
@@ -351,6 +351,33 @@ fn a_box_reads_to_the_same_millimetres_in_every_length_unit() {
             }
         }
     }
+}
+
+#[test]
+fn cylinder_and_circle_radii_are_scaled_to_millimetres() {
+    // The inch box's shell with one more face: a cylinder of radius 0.5 in about the z axis through (1, 2, 0) in,
+    // bounded by a full circle (one vertex) at z = 0, written clockwise (.F.) about the circle's axis.
+    let extra = "#8001 = CARTESIAN_POINT('',(1.,2.,0.));\n#8002 = DIRECTION('',(0.,0.,1.));\n\
+        #8003 = DIRECTION('',(1.,0.,0.));\n#8004 = AXIS2_PLACEMENT_3D('',#8001,#8002,#8003);\n\
+        #8005 = CYLINDRICAL_SURFACE('',#8004,0.5);\n#8006 = CIRCLE('',#8004,0.5);\n\
+        #8007 = CARTESIAN_POINT('',(1.5,2.,0.));\n#8008 = VERTEX_POINT('',#8007);\n\
+        #8009 = EDGE_CURVE('',#8008,#8008,#8006,.F.);\n#8010 = ORIENTED_EDGE('',*,*,#8009,.T.);\n\
+        #8011 = EDGE_LOOP('',(#8010));\n#8012 = FACE_BOUND('',#8011,.T.);\n\
+        #8013 = ADVANCED_FACE('',(#8012),#8005,.F.);\n";
+    let text = box_step(CORNER, SIZE, 25.4, INCH);
+    let shell = first_instance(&text, "CLOSED_SHELL");
+    let text =
+        text.replace(&format!("#{shell} = CLOSED_SHELL('',("), &format!("{extra}#{shell} = CLOSED_SHELL('',(#8013,"));
+    let brep = parse(&text, &StepOptions::default()).expect("reads");
+    assert_eq!(brep.faces.len(), 7);
+    let face = &brep.faces[0];
+    assert_eq!(face.source, FaceSource::Step { entity: 8013 });
+    let Surface::Cylinder { point, axis, radius, convex } = face.surface else { panic!("{face:?}") };
+    assert!(point.distance(DVec3::new(25.4, 50.8, 0.0)) < 1e-12 && axis == DVec3::Z && !convex);
+    assert!((radius - 12.7).abs() < 1e-12, "{radius}");
+    let [Segment::Arc { center, axis, radius, start, end }] = face.loops[0][..] else { panic!("{face:?}") };
+    assert!(center.distance(point) < 1e-12 && axis == -DVec3::Z && (radius - 12.7).abs() < 1e-12);
+    assert!(start == end && start.distance(DVec3::new(38.1, 50.8, 0.0)) < 1e-12);
 }
 
 #[test]

@@ -297,8 +297,8 @@ impl<'a> Graph<'a> {
 
     /// mm per length unit of the file, for `solid`: see the module documentation.
     fn length_scale(&self, solid: u64) -> Result<f64, IoError> {
-        if let Some(context) = self.context_of(solid) {
-            let inst = self.instance(context, context)?;
+        if let Some((representation, context)) = self.context_of(solid) {
+            let inst = self.instance(context, representation)?;
             if let Some(scale) = self.context_length_unit(context, inst)? {
                 return Ok(scale);
             }
@@ -328,15 +328,16 @@ impl<'a> Graph<'a> {
         }
     }
 
-    /// The context of the first representation (`..._REPRESENTATION(name, items, context)`) whose items hold `item`.
-    fn context_of(&self, item: u64) -> Option<u64> {
-        self.ex.order.iter().find_map(|id| {
-            let inst = self.ex.instances.get(id)?;
+    /// The first representation (`..._REPRESENTATION(name, items, context)`) whose items hold `item`, and its
+    /// context.
+    fn context_of(&self, item: u64) -> Option<(u64, u64)> {
+        self.ex.order.iter().find_map(|&id| {
+            let inst = self.ex.instances.get(&id)?;
             records(inst).iter().find_map(|rec| match rec.args.as_slice() {
                 [_, Value::List(items), Value::Ref(context)]
                     if rec.name.ends_with("REPRESENTATION") && items.contains(&Value::Ref(item)) =>
                 {
-                    Some(*context)
+                    Some((id, *context))
                 }
                 _ => None,
             })
@@ -389,7 +390,7 @@ impl<'a> Graph<'a> {
                 Err(self.syntax(id, format!("length unit of {s} mm is not positive and finite")))
             }
             None if is_length => {
-                tracing::warn!(file = %self.file.display(), "length unit #{id} ({}) is not understood", inst.type_name());
+                tracing::debug!(file = %self.file.display(), "length unit #{id} ({}) is not understood", inst.type_name());
                 Ok(None)
             }
             other => Ok(other),

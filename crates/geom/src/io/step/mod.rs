@@ -1,7 +1,7 @@
 //! STEP (ISO 10303-21 exchange files of the AP203, AP214 and AP242 schemas) read into a [`Brep`].
 //!
-//! [`p21`] parses the clear-text encoding of ISO 10303-21 into entity instances; [`brep`] walks the entity graph
-//! from one solid down to its points and builds the faces.
+//! Two private modules do the work: `p21` parses the clear-text encoding of ISO 10303-21 into entity instances,
+//! and `brep` walks the entity graph from one solid down to its points and builds the faces.
 //!
 //! What is read, with the entity names of ISO 10303-42 (geometric and topological representation) as the AP214 and
 //! AP242 schemas use them:
@@ -33,9 +33,11 @@
 //! Entities that the solid does not reach (products, presentation, parameter-space curves) are never looked at
 //! beyond their syntax.
 //!
-//! Complexity: linear in the file size. Instances are kept in a hash map by instance number, and the solid's graph
-//! is walked once per use of each entity (a vertex is read once per edge that uses it).
-
+//! Complexity: parsing is linear in the file size. Instances are kept in a hash map by instance number, and the
+//! solid's graph is walked once per use of each entity (a face once per shell that lists it, an edge once per loop
+//! that uses it, a vertex once per edge), which for a valid solid (each face listed once, each edge in two loops) is
+//! linear in the file size too.
+//!
 mod brep;
 mod p21;
 
