@@ -55,7 +55,12 @@ fn step_gives_the_labelled_thickness_bends_radii_and_volume() {
     for n in 0..6 {
         let l = labels(n);
         let (part, r) = sheet(n, "stp");
-        assert!((r.thickness - l.thickness).abs() <= 1e-6 * l.thickness, "{n}: thickness {} vs {}", r.thickness, l.thickness);
+        assert!(
+            (r.thickness - l.thickness).abs() <= 1e-6 * l.thickness,
+            "{n}: thickness {} vs {}",
+            r.thickness,
+            l.thickness
+        );
         assert_eq!(r.bends.len(), l.bends, "{n}: bends");
         for (a, b) in inner_radii(&r).iter().zip(&l.radii) {
             assert!((a - b).abs() <= 1e-6, "{n}: radius {a} vs {b}");
@@ -115,11 +120,7 @@ fn stl_triangles(path: &Path) -> Vec<[DVec3; 3]> {
         .map(|t| {
             let rec = &bytes[84 + 50 * t..84 + 50 * (t + 1)];
             let f = |k: usize| f32::from_le_bytes(rec[k..k + 4].try_into().expect("f32")) as f64;
-            [
-                DVec3::new(f(12), f(16), f(20)),
-                DVec3::new(f(24), f(28), f(32)),
-                DVec3::new(f(36), f(40), f(44)),
-            ]
+            [DVec3::new(f(12), f(16), f(20)), DVec3::new(f(24), f(28), f(32)), DVec3::new(f(36), f(40), f(44))]
         })
         .collect()
 }
@@ -257,7 +258,13 @@ fn write_stl(dir: &Path, name: &str, triangles: &[[DVec3; 3]]) -> PathBuf {
 
 /// The 12 triangles of a box, counter-clockwise seen from outside.
 fn box_triangles(lo: DVec3, hi: DVec3) -> Vec<[DVec3; 3]> {
-    let c = |i: usize| DVec3::new(if i & 1 == 0 { lo.x } else { hi.x }, if i & 2 == 0 { lo.y } else { hi.y }, if i & 4 == 0 { lo.z } else { hi.z });
+    let c = |i: usize| {
+        DVec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    };
     let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
     quads.iter().flat_map(|q| [[c(q[0]), c(q[1]), c(q[2])], [c(q[0]), c(q[2]), c(q[3])]]).collect()
 }

@@ -135,8 +135,9 @@ fn release_drops(path: &Path, extras: &[serde_json::Map<String, serde_json::Valu
 
 /// Runs `check`.
 pub fn run(args: &Args) -> anyhow::Result<Outcome> {
-    let file = stackplan::geom::io::stack::read_stack_with(&args.stack, &crate::input::read_options(Default::default()))
-        .with_context(|| format!("reading the stack {}", args.stack.display()))?;
+    let file =
+        stackplan::geom::io::stack::read_stack_with(&args.stack, &crate::input::read_options(Default::default()))
+            .with_context(|| format!("reading the stack {}", args.stack.display()))?;
     let stack: Vec<PlacedPart<'_>> = file
         .placements
         .iter()

@@ -201,7 +201,13 @@ fn recognition_text(r: &stackplan_geom::cad::recognise::Recognition) -> String {
     use std::fmt::Write as _;
     let mut out = String::new();
     let holes: usize = r.plates.iter().map(|p| p.holes).sum();
-    let _ = writeln!(out, "sheet metal     thickness {:.4} mm, {} plates ({holes} holes), {} bends", r.thickness, r.plates.len(), r.bends.len());
+    let _ = writeln!(
+        out,
+        "sheet metal     thickness {:.4} mm, {} plates ({holes} holes), {} bends",
+        r.thickness,
+        r.plates.len(),
+        r.bends.len()
+    );
     for (k, p) in r.plates.iter().enumerate() {
         let _ = writeln!(
             out,

@@ -87,15 +87,34 @@ impl Bend {
         self.angle * (self.outer_radius.powi(2) - self.inner_radius.powi(2)) / 2.0 * (self.axial[1] - self.axial[0])
     }
 
-    /// The `n` convex segments (see the module documentation), in order of angle.
+    /// The `n` convex segments at equal angles (see the module documentation), in order of angle.
     pub fn segments(&self, n: usize) -> Result<Vec<ConvexPolytope>, PolytopeError> {
         let n = n.max(1);
-        let delta = self.angle / n as f64;
-        let corner_radius = self.outer_radius / (delta / 2.0).cos();
+        let cuts: Vec<f64> = (0..=n).map(|k| self.angle * k as f64 / n as f64).collect();
+        self.segments_at(&cuts)
+    }
+
+    /// The largest distance by which the segments between the increasing angles `cuts` stand outside the bend.
+    pub fn deviation_at(&self, cuts: &[f64]) -> f64 {
+        cuts.windows(2)
+            .map(|w| {
+                let half = (w[1] - w[0]) / 2.0;
+                (self.outer_radius * (1.0 / half.cos() - 1.0)).max(self.inner_radius * (1.0 - half.cos()))
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// The convex segments between the increasing angles `cuts` (radians from [`Bend::start`], each step below pi).
+    /// A bend tessellated by chords (a mesh) is cut at some of its own vertices, so that each segment's inner chord
+    /// lies nearer the axis than the tessellation's chords it spans: the segments then contain the tessellated
+    /// bend, not only the true one.
+    pub fn segments_at(&self, cuts: &[f64]) -> Result<Vec<ConvexPolytope>, PolytopeError> {
         let (z0, z1) = (self.axis * self.axial[0], self.axis * self.axial[1]);
-        (0..n)
-            .map(|k| {
-                let (a0, a1) = (delta * k as f64, delta * (k + 1) as f64);
+        cuts.windows(2)
+            .map(|w| {
+                let (a0, a1) = (w[0], w[1]);
+                let delta = a1 - a0;
+                let corner_radius = self.outer_radius / (delta / 2.0).cos();
                 // counter-clockwise about the axis: outer arc forwards, inner chord backwards
                 let ring = [
                     self.radial(a0) * self.outer_radius,
@@ -119,6 +138,47 @@ impl Bend {
                 Ok(piece)
             })
             .collect()
+    }
+
+    /// Cut angles among `vertices` (angles of a tessellation's vertices, radians from [`Bend::start`]) with the
+    /// fewest segments whose deviation stays within `tolerance` where the tessellation allows (a step between two
+    /// neighbouring vertices is never split): greedy, the farthest vertex within the largest allowed step each time.
+    /// Always starts at 0 and ends at [`Bend::angle`]; vertices within a milliradian of an end or of each other count
+    /// as one (their angles come from rounded coordinates).
+    pub fn cuts_among(&self, vertices: &[f64], tolerance: f64) -> Vec<f64> {
+        let n = self.segments_within(tolerance);
+        let step = self.angle / n as f64;
+        // vertices measured from rounded coordinates: those within a milliradian of an end or of each other are one
+        let close = 1e-3;
+        let mut inner: Vec<f64> = vertices.iter().copied().filter(|a| *a > close && *a < self.angle - close).collect();
+        inner.sort_by(f64::total_cmp);
+        inner.dedup_by(|a, b| (*a - *b).abs() <= close);
+        let mut cuts = vec![0.0];
+        let mut k = 0;
+        let mut at = 0.0;
+        while at < self.angle {
+            if self.angle - at <= step * (1.0 + 1e-9) {
+                break;
+            }
+            // the farthest vertex within one step, else the next vertex
+            let mut next = None;
+            while k < inner.len() && inner[k] <= at + step * (1.0 + 1e-9) {
+                next = Some(inner[k]);
+                k += 1;
+            }
+            let chosen = match next {
+                Some(a) => a,
+                None if k < inner.len() => {
+                    k += 1;
+                    inner[k - 1]
+                }
+                None => break,
+            };
+            cuts.push(chosen);
+            at = chosen;
+        }
+        cuts.push(self.angle);
+        cuts
     }
 }
 
@@ -193,6 +253,43 @@ mod tests {
             assert_eq!(count, 1, "cut {k}");
         }
         assert!(volume > bend.volume());
+    }
+
+    #[test]
+    fn cuts_among_a_tessellation_keep_its_vertices_and_contain_its_chords() {
+        let bend = quarter();
+        for mesh_step in [0.05, 0.2, 0.5] {
+            // a tessellation at uneven angles: vertices on both arcs
+            let mut angles = vec![0.0];
+            let mut a: f64 = 0.0;
+            let mut k = 0;
+            while a < bend.angle {
+                a = (a + mesh_step * (0.7 + 0.6 * ((k * 7 % 5) as f64 / 4.0))).min(bend.angle);
+                angles.push(a);
+                k += 1;
+            }
+            let cuts = bend.cuts_among(&angles, 0.1);
+            assert_eq!(cuts.first(), Some(&0.0));
+            assert_eq!(cuts.last(), Some(&bend.angle));
+            assert!(cuts.iter().all(|c| angles.iter().any(|a| (a - c).abs() < 1e-12)), "cuts off the vertices");
+            assert!(cuts.windows(2).all(|w| w[1] > w[0]));
+            let pieces = bend.segments_at(&cuts).expect("segments");
+            // points on the tessellation's chords (inner and outer), at the axial middle, lie in the segments
+            for w in angles.windows(2) {
+                for t in 0..=20 {
+                    let s = t as f64 / 20.0;
+                    for r in [bend.inner_radius, bend.outer_radius] {
+                        let p = bend.radial(w[0]) * r * (1.0 - s) + bend.radial(w[1]) * r * s;
+                        let p = bend.center + p + bend.axis * 10.0;
+                        assert!(inside(&pieces, p), "step {mesh_step}: chord point {p} outside");
+                    }
+                }
+            }
+            // where the tessellation is fine enough, the deviation is within the tolerance
+            if mesh_step <= 0.05 {
+                assert!(bend.deviation_at(&cuts) <= 0.1);
+            }
+        }
     }
 
     #[test]

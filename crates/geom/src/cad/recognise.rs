@@ -131,7 +131,9 @@ pub struct Recognition {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RecogniseError {
     /// No pair of opposite planar faces with the material between them.
-    #[error("no two opposite planar faces enclose material: this is no sheet (--decompose reads any solid approximately)")]
+    #[error(
+        "no two opposite planar faces enclose material: this is no sheet (--decompose reads any solid approximately)"
+    )]
     NoPlates,
     /// A bend's radii do not differ by the thickness.
     #[error(
@@ -209,7 +211,6 @@ pub enum RecogniseError {
 
 /// One planar face, prepared: its frame and its loops as 2-D polygons (arcs sampled) for overlap tests.
 struct PlanarFace<'a> {
-    index: usize,
     face: &'a BrepFace,
     point: DVec3,
     normal: DVec3,
@@ -231,10 +232,6 @@ struct Cylinder {
     convex: bool,
     faces: Vec<usize>,
     points: Vec<DVec3>,
-    /// The least distance from the axis of the faces' boundary edges (mm).
-    least: f64,
-    /// The largest distance from the axis of the faces' boundary points (mm).
-    most: f64,
 }
 
 /// Sampling step on arcs for tests (radians): 5 degrees.
@@ -249,9 +246,8 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
     let planes: Vec<PlanarFace<'_>> = brep
         .faces
         .iter()
-        .enumerate()
-        .filter_map(|(index, face)| match face.surface {
-            Surface::Plane { point, normal } => planar_face(index, face, point, normal),
+        .filter_map(|face| match face.surface {
+            Surface::Plane { point, normal } => planar_face(face, point, normal),
             Surface::Cylinder { .. } => None,
         })
         .collect();
@@ -287,6 +283,8 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
     }
     let mut sheet = SheetMetal { thickness, faces: Vec::new() };
     let mut plate_records: Vec<RecognisedPlate> = Vec::new();
+    // each plate's mid-plane: (unit normal, a point)
+    let mut mid_planes: Vec<(DVec3, DVec3)> = Vec::new();
     let mut max_deviation: f64 = 0.0;
     let mut exact_volume = 0.0;
     for members in groups.values() {
@@ -301,9 +299,7 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
             let d = partners[i]
                 .filter(|&(_, d)| at_thickness(d))
                 .map(|(_, d)| d)
-                .or_else(|| {
-                    partners.iter().find_map(|p| p.filter(|&(j, d)| j == i && at_thickness(d)).map(|(_, d)| d))
-                })
+                .or_else(|| partners.iter().find_map(|p| p.filter(|&(j, d)| j == i && at_thickness(d)).map(|(_, d)| d)))
                 .unwrap_or(thickness);
             let shift = -f.normal * (d / 2.0);
             let (rings, deviation, arcs) = conservative_rings(f, options.bend_tolerance);
@@ -311,6 +307,7 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
             let lift = |ring: &Vec<DVec3>| -> Vec<DVec3> {
                 ring.iter().map(|p| *p - f.normal * (*p - f.point).dot(f.normal) + shift).collect()
             };
+            mid_planes.push((f.normal, f.point + shift));
             let mut rings3: Vec<Vec<DVec3>> = rings.iter().map(lift).collect();
             let outline = rings3.remove(0);
             plate_records.push(RecognisedPlate {
@@ -333,7 +330,7 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
     let cylinders = merge_cylinders(brep, tol);
     let mut bends: Vec<RecognisedBend> = Vec::new();
     let mut used = vec![false; cylinders.len()];
-    let mut piece_radii: Vec<(f64, f64)> = Vec::new();
+    let mut tessellations: Vec<Option<Vec<DVec3>>> = Vec::new();
     for (i, inner) in cylinders.iter().enumerate() {
         if inner.convex {
             continue;
@@ -365,15 +362,17 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
         used[i] = true;
         used[j] = true;
         let (axial, start, angle) = ranges(inner, outer);
-        let bend = Bend {
+        let fitted = Bend {
             center: inner.point,
             axis: inner.axis,
             inner_radius: inner.radius,
-            outer_radius: outer.radius,
+            outer_radius: inner.radius + thickness,
             start,
             angle,
             axial,
         };
+        let points: Vec<DVec3> = inner.points.iter().chain(&outer.points).copied().collect();
+        let bend = fit_to_plates(&fitted, &mid_planes, &sheet.faces, thickness, 10.0 * sheet_tol, &points);
         exact_volume += bend.volume();
         bends.push(RecognisedBend {
             bend,
@@ -381,8 +380,12 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
             outer_faces: outer.faces.iter().map(|&f| brep.faces[f].source.clone()).collect(),
             pieces: Vec::new(),
         });
-        // the pieces' radii: the chords of a tessellated inner arc lie inside it
-        piece_radii.push((inner.radius.min(inner.least), outer.radius.max(outer.most)));
+        // a tessellated inner arc (polylines only): its vertices, where the segments must be cut
+        let tessellated = inner
+            .faces
+            .iter()
+            .all(|&f| brep.faces[f].loops.iter().flatten().all(|s| matches!(s, Segment::Line { .. })));
+        tessellations.push(tessellated.then(|| inner.points.clone()));
     }
     // 4. pieces
     let (base, counts) = sheet
@@ -395,17 +398,24 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
         record.pieces = (next..next + count).collect();
         next += count;
     }
-    for (b, &(r, big_r)) in bends.iter_mut().zip(&piece_radii) {
-        let cover = Bend { inner_radius: r, outer_radius: big_r, ..b.bend };
-        let n = cover.segments_within(options.bend_tolerance);
-        let pieces = cover.segments(n).map_err(|source| RecogniseError::Bend {
+    for (b, tessellation) in bends.iter_mut().zip(&tessellations) {
+        // a bend given by chords (a mesh) is cut at its own vertices; an exact one at equal angles
+        let cuts = match tessellation {
+            Some(points) => {
+                let angles: Vec<f64> =
+                    points.iter().map(|p| angle_of(b.bend.axis, b.bend.start, b.bend.center, *p)).collect();
+                b.bend.cuts_among(&angles, options.bend_tolerance)
+            }
+            None => {
+                let n = b.bend.segments_within(options.bend_tolerance);
+                (0..=n).map(|k| b.bend.angle * k as f64 / n as f64).collect()
+            }
+        };
+        let pieces = b.bend.segments_at(&cuts).map_err(|source| RecogniseError::Bend {
             inner: b.inner_faces.first().cloned().unwrap_or(FaceSource::Step { entity: 0 }),
             source,
         })?;
-        // how far the segments stand outside the true (or fitted) cylinders
-        let half = cover.angle / (2.0 * n as f64);
-        let outward = (big_r / half.cos() - b.bend.outer_radius).max(b.bend.inner_radius - r * half.cos());
-        max_deviation = max_deviation.max(outward);
+        max_deviation = max_deviation.max(b.bend.deviation_at(&cuts));
         b.pieces = (components.len()..components.len() + pieces.len()).collect();
         components.extend(pieces);
     }
@@ -484,7 +494,7 @@ fn find(parent: &mut [usize], mut x: usize) -> usize {
 }
 
 /// A planar face's frame, 2-D rings (arcs sampled) and exact area; `None` for a face without a usable loop.
-fn planar_face(index: usize, face: &BrepFace, point: DVec3, normal: DVec3) -> Option<PlanarFace<'_>> {
+fn planar_face(face: &BrepFace, point: DVec3, normal: DVec3) -> Option<PlanarFace<'_>> {
     let normal = normal.normalize_or_zero();
     if normal == DVec3::ZERO || face.loops.is_empty() {
         return None;
@@ -522,7 +532,7 @@ fn planar_face(index: usize, face: &BrepFace, point: DVec3, normal: DVec3) -> Op
             }
         }
     }
-    Some(PlanarFace { index, face, point, normal, u, v, rings, area, lo, hi })
+    Some(PlanarFace { face, point, normal, u, v, rings, area, lo, hi })
 }
 
 /// The signed area of a loop about `normal` (mm^2), exact: the polygon of the segments' end points plus, for each
@@ -666,55 +676,19 @@ fn merge_cylinders(brep: &Brep, tol: f64) -> Vec<Cylinder> {
             continue;
         }
         let points = face.boundary_points(ARC_STEP);
-        let distance = |p: DVec3| {
-            let d = p - point;
-            (d - axis * d.dot(axis)).length()
-        };
-        // the least distance of a boundary edge from the axis (chords of a tessellated inner arc)
-        let mut least = radius;
-        let mut most: f64 = radius;
-        for lp in &face.loops {
-            for s in lp {
-                match *s {
-                    Segment::Line { start, end } => {
-                        least = least.min(segment_axis_distance(start, end, point, axis));
-                        most = most.max(distance(start)).max(distance(end));
-                    }
-                    Segment::Arc { .. } => {
-                        for p in s.points((s.sweep() / ARC_STEP).ceil().max(1.0) as usize) {
-                            least = least.min(distance(p));
-                            most = most.max(distance(p));
-                        }
-                    }
-                }
-            }
-        }
-        let candidate = Cylinder { point, axis, radius, convex, faces: vec![index], points, least, most };
-        match out.iter_mut().find(|c| c.convex == convex && (c.radius - radius).abs() <= tol && coaxial(c, &candidate, tol))
+        let candidate = Cylinder { point, axis, radius, convex, faces: vec![index], points };
+        match out
+            .iter_mut()
+            .find(|c| c.convex == convex && (c.radius - radius).abs() <= tol && coaxial(c, &candidate, tol))
         {
             Some(c) => {
                 c.faces.push(index);
                 c.points.extend(candidate.points);
-                c.least = c.least.min(least);
-                c.most = c.most.max(most);
             }
             None => out.push(candidate),
         }
     }
     out
-}
-
-/// The least distance from the axis line of the segment `a b` (measured perpendicular to the axis).
-fn segment_axis_distance(a: DVec3, b: DVec3, point: DVec3, axis: DVec3) -> f64 {
-    let flat = |p: DVec3| {
-        let d = p - point;
-        d - axis * d.dot(axis)
-    };
-    let (p, q) = (flat(a), flat(b));
-    let e = q - p;
-    let len2 = e.length_squared();
-    let s = if len2 > 0.0 { (-p.dot(e) / len2).clamp(0.0, 1.0) } else { 0.0 };
-    (p + e * s).length()
 }
 
 /// Whether two cylinders share their axis line (within `tol` over their extent).
@@ -788,6 +762,77 @@ fn ranges(inner: &Cylinder, outer: &Cylinder) -> ([f64; 2], DVec3, f64) {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), z| (lo.min(z), hi.max(z)));
     let (start, angle) = angle_range(inner.axis, inner.point, &points);
     ([lo, hi], start, angle)
+}
+
+/// The bend rebuilt from the two plates it joins, so that its end faces lie on the plates' ends and its radial
+/// sides on their skins (to rounding, whatever the precision of the fitted cylinders): the axis is parallel to
+/// both plates at `r + t / 2` from their mid-planes on the fitted axis' side, the bend starts square to one plate and
+/// ends square to the other. A plate joins the bend when it is parallel to the axis at that distance and its outline
+/// has a corner on the bend's tangent line (within `tol`). Without exactly two such plates that are not parallel (a
+/// bend between two bends, a hem) the fitted bend is kept.
+fn fit_to_plates(
+    fitted: &Bend,
+    mid_planes: &[(DVec3, DVec3)],
+    faces: &[SheetFace],
+    thickness: f64,
+    tol: f64,
+    points: &[DVec3],
+) -> Bend {
+    let a = fitted.axis;
+    let c = fitted.center;
+    let mid = fitted.inner_radius + thickness / 2.0;
+    let mut joined: Vec<(DVec3, DVec3, f64)> = Vec::new();
+    for ((n, p), face) in mid_planes.iter().zip(faces) {
+        if n.dot(a).abs() > 1e-6 {
+            continue;
+        }
+        let offset = n.dot(c - *p);
+        if (offset.abs() - mid).abs() > tol {
+            continue;
+        }
+        let side = offset.signum();
+        // the tangent line: the axis moved onto the plate
+        let foot = c - *n * (side * mid);
+        let on_line = face.outline.iter().any(|q| {
+            let d = *q - foot;
+            (d - a * d.dot(a)).length() <= tol
+        });
+        if on_line {
+            joined.push((*n, *p, side));
+        }
+    }
+    let [(n1, p1, s1), (n2, p2, s2)] = joined[..] else {
+        tracing::debug!(plates = joined.len(), "a bend joins other than two plates: its fitted cylinders are kept");
+        return *fitted;
+    };
+    let cross = n1.cross(n2);
+    if cross.length() < 1e-6 {
+        return *fitted;
+    }
+    let mut axis = cross.normalize();
+    if axis.dot(a) < 0.0 {
+        axis = -axis;
+    }
+    // the centre: n1 . x = s1 mid, n2 . x = s2 mid (from the planes' points), axis . x = axis . c
+    let rows = glam::DMat3::from_cols(n1, n2, axis).transpose();
+    let rhs = DVec3::new(n1.dot(p1) + s1 * mid, n2.dot(p2) + s2 * mid, axis.dot(c));
+    if rows.determinant().abs() < 1e-12 {
+        return *fitted;
+    }
+    let center = rows.inverse() * rhs;
+    let (u0, u1) = (-n1 * s1, -n2 * s2);
+    let mut angle = axis.dot(u0.cross(u1)).atan2(u0.dot(u1));
+    // counter-clockwise about the axis from the start: from the first plate's side to the second's, or back
+    let start = if angle >= 0.0 { u0 } else { u1 };
+    angle = angle.abs();
+    if !(angle > 1e-9 && (angle - fitted.angle).abs() < 0.1 + 0.1 * fitted.angle) {
+        return *fitted;
+    }
+    let (lo, hi) = points
+        .iter()
+        .map(|q| (*q - center).dot(axis))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), z| (l.min(z), h.max(z)));
+    Bend { center, axis, start, angle, axial: [lo, hi], ..*fitted }
 }
 
 /// Checks that every boundary point of the solid lies in the union of the pieces (within `tol`).
@@ -905,7 +950,8 @@ mod tests {
             start: DVec3::new(-20.0, 20.0, z),
             end: DVec3::new(-20.0, 20.0, z),
         };
-        let mut a_bottom = plane(&[[-L1, 0.0, 0.0], [-L1, W, 0.0], [0.0, W, 0.0], [0.0, 0.0, 0.0]], [0.0, 0.0, -1.0], 1);
+        let mut a_bottom =
+            plane(&[[-L1, 0.0, 0.0], [-L1, W, 0.0], [0.0, W, 0.0], [0.0, 0.0, 0.0]], [0.0, 0.0, -1.0], 1);
         let mut a_top = plane(&[[-L1, 0.0, t], [0.0, 0.0, t], [0.0, W, t], [-L1, W, t]], [0.0, 0.0, 1.0], 2);
         if hole {
             a_bottom.loops.push(vec![circle(0.0)]);

@@ -455,9 +455,9 @@ pub(crate) fn part_from_shells(
             Ok(polytope) => components.push(polytope),
             Err(IoError::NotConvex { .. }) if !options.decompose_mesh && open.is_none() => {
                 // a closed shell that is not convex: a sheet-metal part from CAD, recognised from all the shells
-                let polygons: Vec<MeshPolygon> =
-                    shells.iter().flat_map(|(s, _)| s.polygons.iter().cloned()).collect();
-                let (part, recognition) = super::sheet::recognise_mesh(file, name.clone(), points, &polygons, options, tolerance)?;
+                let polygons: Vec<MeshPolygon> = shells.iter().flat_map(|(s, _)| s.polygons.iter().cloned()).collect();
+                let (part, recognition) =
+                    super::sheet::recognise_mesh(file, name.clone(), points, &polygons, options, tolerance)?;
                 tracing::info!(
                     file = %file.display(),
                     thickness = recognition.thickness,

@@ -16,8 +16,8 @@
 //! JSON writer).
 
 use super::mesh::{
-    Mesh, scale_points,
-    MeshPolygon, Precision, Shell, Welder, mesh_tolerance, part_from_shells, significant_digits, written_faces,
+    Mesh, MeshPolygon, Precision, Shell, Welder, mesh_tolerance, part_from_shells, scale_points, significant_digits,
+    written_faces,
 };
 use super::{IoError, Place, ReadOptions, check_coordinate, stem_name};
 use crate::part::Part;

@@ -9,7 +9,7 @@
 use super::mesh::{Mesh, MeshPolygon};
 use super::{IoError, Place, ReadOptions, extension, read_bytes, resolve_density, stem_name};
 use crate::cad::Brep;
-use crate::cad::recognise::{DEFAULT_BEND_TOLERANCE, Recognition, RecogniseOptions, recognise};
+use crate::cad::recognise::{DEFAULT_BEND_TOLERANCE, RecogniseOptions, Recognition, recognise};
 use crate::part::Part;
 use glam::DVec3;
 use std::path::Path;

@@ -19,8 +19,9 @@
 //! the read form of the rounded part (the same as ASCII's for coordinates representable in `f32`): bit for bit where
 //! its faces are exactly planar in `f32`, else with those faces flattened (`super::snap`).
 
-use super::mesh::{Mesh, scale_points,
-    MeshPolygon, Precision, Welder, mesh_tolerance, part_from_shells, significant_digits, split_shells, written_faces,
+use super::mesh::{
+    Mesh, MeshPolygon, Precision, Welder, mesh_tolerance, part_from_shells, scale_points, significant_digits,
+    split_shells, written_faces,
 };
 use super::{IoError, Place, ReadOptions, check_coordinate, stem_name};
 use crate::part::Part;
