@@ -71,6 +71,16 @@ fn part(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
     f.insert("bounding_box_max".into(), hi.to_array().to_vec().into());
     f.insert("boundary_faces".into(), p.boundary.len().into());
     f.insert("vertices".into(), p.vertex_count().into());
+    // a part recognised from CAD: what was recognised
+    if let stackplan_geom::PartOrigin::RecognisedSheet { thickness, plates, bends, solid_volume, max_deviation } =
+        p.origin
+    {
+        f.insert("thickness".into(), thickness.into());
+        f.insert("plates".into(), plates.into());
+        f.insert("bends".into(), bends.into());
+        f.insert("solid_volume".into(), solid_volume.into());
+        f.insert("max_deviation".into(), max_deviation.into());
+    }
     Ok(f)
 }
 

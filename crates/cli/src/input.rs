@@ -108,6 +108,30 @@ pub fn warn_implausible_size(spec: &str, part: &Part) {
     }
 }
 
+/// A sentence on how a part was made, for parts whose pieces are not the part exactly: recognised sheet metal
+/// (conservative: the pieces contain the solid) or an approximate decomposition (VHACD). `None` for the others.
+pub fn origin_note(origin: &stackplan_geom::PartOrigin, pieces_volume: f64) -> Option<String> {
+    use stackplan_geom::PartOrigin;
+    match origin {
+        PartOrigin::RecognisedSheet { thickness, plates, bends, solid_volume, max_deviation } => Some(format!(
+            "recognised sheet metal, {thickness:.3} mm thick, {plates} plates and {bends} bends; its convex pieces \
+             contain the solid, hold {:+.3} % of its volume and stand out of it by at most {max_deviation:.3} mm",
+            100.0 * (pieces_volume / solid_volume - 1.0)
+        )),
+        PartOrigin::ApproximateDecomposition { mesh_volume } => Some(match mesh_volume {
+            Some(v) => format!(
+                "approximate convex decomposition (VHACD) of a mesh: the pieces hold {:+.1} % of the mesh's volume, \
+                 may fill its holes and stand outside it, so interference-free plans are not guaranteed in steel",
+                100.0 * (pieces_volume / v - 1.0)
+            ),
+            None => "approximate convex decomposition (VHACD) of a mesh: the pieces may fill its holes and stand \
+                     outside it, so interference-free plans are not guaranteed in steel"
+                .to_string(),
+        }),
+        _ => None,
+    }
+}
+
 /// The decomposition of `--triangulate`: plain triangulation (the seed's component counts) or convex merging.
 pub fn decomposition(triangulate: bool) -> Decomposition {
     if triangulate { Decomposition::Triangulation } else { Decomposition::ConvexMerge }

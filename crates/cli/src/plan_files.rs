@@ -89,6 +89,8 @@ pub struct PlanFile {
     pub placements: Vec<Map<String, Value>>,
     /// Planning time recorded in the file (s).
     pub seconds: f64,
+    /// How the planned part was made (`plan.part_origin`; absent in older files and plain stack files).
+    pub part_origin: Option<stackplan_geom::PartOrigin>,
 }
 
 /// The plan file's JSON: a stack file (`part` inline, `placements` = the planned parts) plus the `plan` summary
@@ -102,6 +104,7 @@ pub fn plan_document_text(part: &Part, plan: &Plan, seconds: f64) -> anyhow::Res
         m.insert("part_name".into(), json!(part.name));
         m.insert("placed".into(), json!(plan.parts.len()));
         m.insert("seconds".into(), json!(seconds));
+        m.insert("part_origin".into(), serde_json::to_value(&part.origin)?);
     }
     crate::output::json_text(&json!({ "part": inline, "placements": placements, "plan": summary }))
 }
@@ -121,6 +124,7 @@ pub fn parse_plan_file(bytes: &[u8], path: &Path) -> Result<PlanFile, PlanFileEr
     let count = stack.placements.len();
     check_placed(&summary, path, count)?;
     let seconds = summary.get("seconds").and_then(Value::as_f64).unwrap_or(0.0);
+    let part_origin = summary.get("part_origin").and_then(|v| serde_json::from_value(v.clone()).ok());
     // the summary is typed; the placements' planner fields (cost, theta, stage, ...) are read leniently for the
     // report: JSON has no infinity or NaN, so a non-finite number is written as `null` and shown as "-"
     summary.insert("parts".into(), Value::Array(Vec::new()));
@@ -135,7 +139,7 @@ pub fn parse_plan_file(bytes: &[u8], path: &Path) -> Result<PlanFile, PlanFileEr
     if count == 0 {
         return Err(PlanFileError::Empty { file: path.to_path_buf() });
     }
-    Ok(PlanFile { part: stack.part, plan, poses: stack.placements, placements: stack.extras, seconds })
+    Ok(PlanFile { part: stack.part, plan, poses: stack.placements, placements: stack.extras, seconds, part_origin })
 }
 
 /// The `plan` summary of a stack file (`StackFile::plan`; a JSON `null` reads as absent): `None` for a plain stack
@@ -429,7 +433,7 @@ fn report_html(file: &PlanFile, svg_text: &str) -> String {
 <style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse}}td,th{{border:1px solid #ccc;padding:3px 8px;text-align:right}}img{{max-width:100%}}</style>
 </head><body>
 <h1>Stacking plan: {placed} x {name}</h1>
-<p id="summary">{status}. Height {height:.1} mm, footprint {fx:.1} x {fy:.1} mm, total cost {cost:.1} (w = {w}),
+{origin}<p id="summary">{status}. Height {height:.1} mm, footprint {fx:.1} x {fy:.1} mm, total cost {cost:.1} (w = {w}),
 clearance {clearance} mm, whole stack stable: {stable}. Planned in {seconds:.1} s
 ({searches} placement searches, {checked} candidates checked, {pairs} component pairs evaluated).</p>
 <h2>Pictures</h2>
@@ -445,6 +449,12 @@ clearance {clearance} mm, whole stack stable: {stable}. Planned in {seconds:.1} 
 </body></html>
 "#,
         name = esc(&part.name),
+        origin = file
+            .part_origin
+            .as_ref()
+            .and_then(|o| crate::input::origin_note(o, part.mass.volume))
+            .map(|n| format!("<p id=\"origin\">Part: {}.</p>\n", esc(&n)))
+            .unwrap_or_default(),
         placed = file.poses.len(),
         status = esc(plan.stopped.as_deref().unwrap_or("All parts placed")),
         height = plan.height,

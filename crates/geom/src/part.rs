@@ -39,7 +39,11 @@ pub enum PartOrigin {
     /// A mesh file whose shells/objects were checked to be convex.
     Mesh,
     /// A mesh decomposed by an approximate convex decomposition (VHACD): the components only approximate the input.
-    ApproximateDecomposition,
+    ApproximateDecomposition {
+        /// The enclosed volume of the mesh (mm^3), when known: the components' volume is the part's.
+        #[serde(default)]
+        mesh_volume: Option<f64>,
+    },
     /// A solid from CAD (a STEP B-rep or one closed mesh) recognised as sheet metal and decomposed conservatively
     /// ([`crate::cad::recognise`]): the components contain the solid and stand outside it by at most
     /// `max_deviation`.

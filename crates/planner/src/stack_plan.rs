@@ -265,14 +265,18 @@ pub enum PlanError {
     NoRestingPose(String),
     /// The part rests stably, but no resting pose presents an upward face that holds the suction cup.
     #[error(
-        "none of the part's {poses} stable resting poses presents an upward face that holds a {cup_diameter} mm \
-         suction cup; a smaller cup diameter may fit"
+        "none of the part's {poses} stable resting poses presents a horizontal upward face that holds a \
+         {cup_diameter} mm suction cup: {}",
+        tried.join("; ")
     )]
     NoGraspablePose {
         /// Number of stable resting poses the part has.
         poses: usize,
         /// The cup diameter asked for (mm).
         cup_diameter: f64,
+        /// Each pose tried, lowest c.g. first, and why it failed: no horizontal upward face (with the tilt of the
+        /// most level upward face), or the largest cup that fits.
+        tried: Vec<String>,
     },
     /// The placement search failed.
     #[error(transparent)]
@@ -385,7 +389,8 @@ fn plan_stack_here(
         .map(|p| p.rotation)
         .collect();
     if rests.is_empty() {
-        return Err(PlanError::NoGraspablePose { poses: poses.len(), cup_diameter: options.cup_diameter });
+        let tried = poses.iter().enumerate().map(|(k, p)| why_not_graspable(part, k, p, &grasp)).collect();
+        return Err(PlanError::NoGraspablePose { poses: poses.len(), cup_diameter: options.cup_diameter, tried });
     }
     let origin = options.origin.unwrap_or_else(|| options.floor.centre());
     let check_options = CheckOptions {
@@ -788,6 +793,37 @@ fn accept(
     Ok(Err(format!("the best interference-free positions were rejected (last: {reason})")))
 }
 
+/// Why resting pose `k` offers no grasp: no horizontal upward face (and how far the most level upward face of the
+/// part's boundary is tilted), or the largest cup that fits on one.
+fn why_not_graspable(
+    part: &Part,
+    k: usize,
+    pose: &stackplan_stability::resting_poses::RestingPose,
+    grasp: &GraspOptions,
+) -> String {
+    let faces = grasp_faces(part, pose.rotation, pose.position, grasp);
+    let head = format!("pose {} (c.g. at {:.1} mm)", k + 1, pose.cg_height);
+    match faces.iter().map(|f| f.inscribed_radius).reduce(f64::max) {
+        Some(r) => format!("{head}: the largest cup that fits is {:.1} mm", 2.0 * r),
+        None => {
+            let up = part
+                .boundary
+                .iter()
+                .map(|f| (pose.rotation * f.plane.normal).z)
+                .filter(|z| *z > 0.0)
+                .fold(f64::NEG_INFINITY, f64::max);
+            if up > 0.0 {
+                format!(
+                    "{head}: no horizontal upward face, the most level is tilted {:.1} deg",
+                    up.min(1.0).acos().to_degrees()
+                )
+            } else {
+                format!("{head}: no upward face")
+            }
+        }
+    }
+}
+
 /// Why a plan ended at part `index` on a search limit (node budget or time), with the parts it keeps.
 fn limit_reason(index: usize, options: &PlanOptions, e: &PlacementError, started: std::time::Instant) -> String {
     let limit = match e {
@@ -1049,7 +1085,7 @@ mod tests {
         let floor = FloorVolume::rectangle(-20.0, -20.0, 20.0, 20.0, 20.0);
         let error = plan_stack(&part, &options(2, 0.5, floor.clone())).err();
         assert!(
-            matches!(error, Some(PlanError::NoGraspablePose { poses: 6, cup_diameter }) if cup_diameter == 10.0),
+            matches!(error, Some(PlanError::NoGraspablePose { poses: 6, cup_diameter, .. }) if cup_diameter == 10.0),
             "{error:?}"
         );
         let message = error.map(|e| e.to_string()).unwrap_or_default();

@@ -67,6 +67,14 @@ pub struct PlannerArgs {
     /// number (ties and the open cells carried between searches), never on the thread count.
     #[arg(long, default_value_t = stackplan::planner::request::DEFAULT_PARTITIONS)]
     pub search_partitions: usize,
+    /// Seconds the plan may take (each plan, for several weights): past them the plan ends with the parts placed so
+    /// far and says why. Default: no limit.
+    #[arg(long, value_name = "SECONDS")]
+    pub time_limit: Option<f64>,
+    /// Search nodes one placement may take (per search partition): past them the plan ends with the parts placed
+    /// so far and says why. The search's memory grows with its nodes: the default keeps it to a few GB.
+    #[arg(long, value_name = "NODES", default_value_t = stackplan::planner::request::DEFAULT_NODE_BUDGET)]
+    pub node_budget: usize,
 }
 
 fn parse_floor(s: &str) -> anyhow::Result<[f64; 4]> {
@@ -110,6 +118,10 @@ impl PlannerArgs {
         }
         crate::input::check_lengths("--clearance", &[self.clearance])?;
         crate::input::check_lengths("--cup-diameter", &[self.cup_diameter])?;
+        if let Some(t) = self.time_limit {
+            anyhow::ensure!(t.is_finite() && t > 0.0, "--time-limit must be a positive number of seconds, got {t}");
+        }
+        anyhow::ensure!(self.node_budget > 0, "--node-budget must be at least 1");
         load_part_spec(spec, crate::input::decomposition(self.triangulate))
     }
 
@@ -139,6 +151,8 @@ impl PlannerArgs {
         options.cup_diameter = self.cup_diameter;
         options.candidates = self.candidates;
         options.partitions = self.search_partitions;
+        options.node_budget = self.node_budget;
+        options.time_limit = self.time_limit;
         // (the repeated search never asks for fewer than the user's own candidate count)
         options.max_candidates = options.max_candidates.max(self.candidates);
         Ok(options)
@@ -192,6 +206,9 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         seconds,
         args.out.display()
     ))?;
+    if let Some(note) = crate::input::origin_note(&part.origin, part.mass.volume) {
+        crate::output::print_summary(&format!("part {}: {note}\n", part.name))?;
+    }
     if plan.stats.cells_unsolved > 0 {
         crate::output::print_summary(&format!(
             "note: {} free-space cells could not be solved and were skipped (stats.cells_unsolved): each part is the \

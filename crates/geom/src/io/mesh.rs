@@ -421,6 +421,7 @@ pub(crate) fn part_from_shells(
     let density = resolve_density(file, None, options)?;
     let mut components = Vec::new();
     let mut approximate = false;
+    let mut mesh_volume = 0.0;
     for (index, (shell, open)) in shells.iter().enumerate() {
         let not_convex = |detail: String| IoError::NotConvex {
             file: file.to_path_buf(),
@@ -452,7 +453,10 @@ pub(crate) fn part_from_shells(
             }),
         };
         match checked {
-            Ok(polytope) => components.push(polytope),
+            Ok(polytope) => {
+                mesh_volume += polytope.volume();
+                components.push(polytope);
+            }
             Err(IoError::NotConvex { .. }) if !options.decompose_mesh && open.is_none() => {
                 // a closed shell that is not convex: a sheet-metal part from CAD, recognised from all the shells
                 let polygons: Vec<MeshPolygon> = shells.iter().flat_map(|(s, _)| s.polygons.iter().cloned()).collect();
@@ -476,6 +480,7 @@ pub(crate) fn part_from_shells(
                 tracing::info!(file = %file.display(), shell = index, pieces = pieces.len(), "VHACD decomposition");
                 components.extend(pieces);
                 approximate = true;
+                mesh_volume += enclosed_volume(points, shell);
             }
             Err(e) => return Err(e),
         }
@@ -489,9 +494,27 @@ pub(crate) fn part_from_shells(
         }
         components = flat;
     }
-    let origin = if approximate { PartOrigin::ApproximateDecomposition } else { PartOrigin::Mesh };
+    let origin = if approximate {
+        PartOrigin::ApproximateDecomposition { mesh_volume: Some(mesh_volume) }
+    } else {
+        PartOrigin::Mesh
+    };
     Part::from_components(name, components, density, origin)
         .map_err(|source| IoError::Part { file: file.to_path_buf(), source })
+}
+
+/// The volume a closed shell encloses (divergence theorem over its polygons' fans, about its first vertex).
+fn enclosed_volume(points: &[DVec3], shell: &Shell) -> f64 {
+    let Some(o) = shell.polygons.first().and_then(|p| p.vertices.first()).map(|&v| points[v]) else { return 0.0 };
+    let mut volume = 0.0;
+    for polygon in &shell.polygons {
+        let v = &polygon.vertices;
+        for k in 1..v.len().saturating_sub(1) {
+            let (a, b, c) = (points[v[0]] - o, points[v[k]] - o, points[v[k + 1]] - o);
+            volume += a.dot(b.cross(c)) / 6.0;
+        }
+    }
+    volume
 }
 
 /// VHACD on one shell; every output hull rebuilt with the exact hull.

@@ -20,7 +20,7 @@ use super::mesh::{
     written_faces,
 };
 use super::{IoError, Place, ReadOptions, check_coordinate, stem_name};
-use crate::part::Part;
+use crate::part::{Part, PartOrigin};
 use crate::pose::Pose;
 use glam::DVec3;
 use std::fmt::Write as _;
@@ -36,8 +36,21 @@ pub fn read_obj(path: impl AsRef<Path>, options: &ReadOptions) -> Result<Part, I
 /// Parses OBJ from memory; `file` is only used in error messages and as the part name.
 pub fn parse_obj(bytes: &[u8], file: &Path, options: &ReadOptions) -> Result<Part, IoError> {
     let (shells, points, tolerance) = parse_obj_groups(bytes, file, options)?;
-    part_from_shells(file, stem_name(file), &points, shells, options, tolerance)
+    let mut part = part_from_shells(file, stem_name(file), &points, shells, options, tolerance)?;
+    // a file written from an approximate or recognised part keeps its mark
+    if part.origin == PartOrigin::Mesh
+        && let Some(origin) = String::from_utf8_lossy(bytes)
+            .lines()
+            .find_map(|l| l.strip_prefix(ORIGIN_COMMENT))
+            .and_then(|json| serde_json::from_str::<PartOrigin>(json.trim()).ok())
+    {
+        part.origin = origin;
+    }
+    Ok(part)
 }
+
+/// The comment line that carries a part's origin through an OBJ file (`# stackplan origin: {json}`).
+const ORIGIN_COMMENT: &str = "# stackplan origin: ";
 
 /// An OBJ file's polygons (all groups), in millimetres, for sheet-metal recognition.
 pub(crate) fn parse_obj_mesh(bytes: &[u8], file: &Path, options: &ReadOptions) -> Result<Mesh, IoError> {
@@ -131,6 +144,12 @@ fn parse_obj_groups(
 pub fn obj_string(part: &Part) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# stackplan part {:?}: {} convex components", part.name, part.components.len());
+    // pieces that are not the solid exactly keep saying so (read back by `parse_obj`)
+    if matches!(part.origin, PartOrigin::ApproximateDecomposition { .. } | PartOrigin::RecognisedSheet { .. })
+        && let Ok(origin) = serde_json::to_string(&part.origin)
+    {
+        let _ = writeln!(s, "{ORIGIN_COMMENT}{origin}");
+    }
     let mut base = 1usize;
     for (i, c) in part.components.iter().enumerate() {
         let _ = writeln!(s, "o piece_{i}");
