@@ -653,8 +653,8 @@ fn atomic_writes_keep_ordinary_permissions() {
 
 #[test]
 fn unsupported_extensions() {
-    let e = io::read_part("part.step", &ReadOptions::default()).expect_err("step");
-    assert!(matches!(e, IoError::UnsupportedExtension { .. }) && e.to_string().contains("part.step"));
+    let e = io::read_part("part.iges", &ReadOptions::default()).expect_err("iges");
+    assert!(matches!(e, IoError::UnsupportedExtension { .. }) && e.to_string().contains("part.iges"));
     let e = io::write_part("part.txt", &bracket()).expect_err("txt");
     assert!(matches!(e, IoError::UnsupportedExtension { .. }));
 }

@@ -291,8 +291,25 @@ fn solids_that_are_no_sheet_get_errors_that_name_the_file_and_the_faces() {
     let path = write_stl(tmp.path(), "block.stl", &l_block());
     let err = read_part(&path, &ReadOptions::default()).expect_err("no sheet");
     let text = err.to_string();
-    assert!(matches!(err, IoError::NotSheetMetal { .. }), "{text}");
+    assert!(matches!(err, IoError::NotConvex { .. }), "{text}");
     assert!(text.contains("block.stl") && text.contains("10.0000 mm apart") && text.contains("4.0000 mm"), "{text}");
+    let err = read_sheet(&path, &ReadOptions::default()).expect_err("no sheet");
+    assert!(matches!(err, IoError::NotSheetMetal { .. }), "{err}");
+    // a cube with a dent: its opposite faces pair up twice, and the two plates would overlap
+    let mut dent = box_triangles(DVec3::ZERO, DVec3::splat(20.0));
+    dent.retain(|t| t.iter().any(|v| v.z < 20.0));
+    let apex = DVec3::splat(10.0);
+    for (a, b) in [(0.0, 0.0), (20.0, 0.0), (20.0, 20.0), (0.0, 20.0)]
+        .windows(2)
+        .map(|w| (w[0], w[1]))
+        .chain([((0.0, 20.0), (0.0, 0.0))])
+    {
+        dent.push([DVec3::new(a.0, a.1, 20.0), DVec3::new(b.0, b.1, 20.0), apex]);
+    }
+    let path = write_stl(tmp.path(), "dent.stl", &dent);
+    let err = read_sheet(&path, &ReadOptions::default()).expect_err("no sheet");
+    assert!(matches!(err, IoError::NotSheetMetal { .. }), "{err}");
+    assert!(err.to_string().contains("overlap"), "{err}");
 }
 
 /// An L-shaped profile extruded by 30 mm along z: legs 4 mm (horizontal) and 10 mm (vertical) thick.

@@ -185,6 +185,17 @@ pub enum RecogniseError {
         /// The sheet's thickness (mm).
         thickness: f64,
     },
+    /// Pieces of two plates (or of a plate and a bend) overlap: the faces pair up, but not as one sheet.
+    #[error(
+        "the pieces recognised from {a} and from {b} overlap: this is no sheet of constant thickness \
+         (--decompose reads any solid approximately)"
+    )]
+    Overlap {
+        /// A face of the first plate or bend.
+        a: FaceSource,
+        /// A face of the second.
+        b: FaceSource,
+    },
     /// The plates do not make a valid sheet-metal model (a self-intersecting outline, a hole touching the outline).
     #[error("the plate of {face}: {source}")]
     Plate {
@@ -419,7 +430,21 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
         b.pieces = (components.len()..components.len() + pieces.len()).collect();
         components.extend(pieces);
     }
-    // 5. the check: every boundary point inside the pieces
+    // 5. the checks: no two plates or bends overlap, and every boundary point lies inside the pieces
+    let plate_count = plate_records.len();
+    let owners: Vec<(usize, FaceSource)> = plate_records
+        .iter()
+        .enumerate()
+        .flat_map(|(k, p)| {
+            let face = p.faces.first().cloned().unwrap_or(FaceSource::Step { entity: 0 });
+            p.pieces.iter().map(move |_| (k, face.clone()))
+        })
+        .chain(bends.iter().enumerate().flat_map(|(k, b)| {
+            let face = b.inner_faces.first().cloned().unwrap_or(FaceSource::Step { entity: 0 });
+            b.pieces.iter().map(move |_| (plate_count + k, face.clone()))
+        }))
+        .collect();
+    check_overlap(&components, &owners, 10.0 * sheet_tol)?;
     check_cover(brep, &components, tol.max(1e-9 * diagonal(&components)), thickness, &partners, &planes)?;
     let solid_volume = brep.volume.unwrap_or(exact_volume);
     let origin = PartOrigin::RecognisedSheet {
@@ -833,6 +858,57 @@ fn fit_to_plates(
         .map(|q| (*q - center).dot(axis))
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), z| (l.min(z), h.max(z)));
     Bend { center, axis, start, angle, axial: [lo, hi], ..*fitted }
+}
+
+/// Checks that no two pieces of different plates or bends overlap by more than `depth`: separating-axis tests on
+/// the pieces' face normals and the cross products of their edges (exact for convex polytopes), after a box test.
+/// O(P^2) box tests and O(F E^2 V) per pair whose boxes meet.
+fn check_overlap(
+    components: &[ConvexPolytope],
+    owners: &[(usize, FaceSource)],
+    depth: f64,
+) -> Result<(), RecogniseError> {
+    let boxes: Vec<(DVec3, DVec3)> = components.iter().map(ConvexPolytope::aabb).collect();
+    for i in 0..components.len() {
+        for j in i + 1..components.len() {
+            if owners[i].0 == owners[j].0
+                || (0..3).any(|k| boxes[i].1[k] <= boxes[j].0[k] + depth || boxes[j].1[k] <= boxes[i].0[k] + depth)
+            {
+                continue;
+            }
+            if interiors_overlap(&components[i], &components[j], depth) {
+                return Err(RecogniseError::Overlap { a: owners[i].1.clone(), b: owners[j].1.clone() });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Whether two convex polytopes overlap by more than `depth` along every candidate separating axis.
+fn interiors_overlap(a: &ConvexPolytope, b: &ConvexPolytope, depth: f64) -> bool {
+    let separated_along = |axis: DVec3| {
+        let len = axis.length();
+        if len < 1e-12 {
+            return false;
+        }
+        let axis = axis / len;
+        let range = |c: &ConvexPolytope| {
+            c.vertices()
+                .iter()
+                .map(|v| v.dot(axis))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| (l.min(x), h.max(x)))
+        };
+        let ((la, ha), (lb, hb)) = (range(a), range(b));
+        ha <= lb + depth || hb <= la + depth
+    };
+    if a.planes().chain(b.planes()).any(|p| separated_along(p.normal)) {
+        return false;
+    }
+    let directions = |c: &ConvexPolytope| -> Vec<DVec3> {
+        c.edges().iter().map(|e| c.vertices()[e.vertices[1]] - c.vertices()[e.vertices[0]]).collect()
+    };
+    let (da, db) = (directions(a), directions(b));
+    !da.iter().any(|u| db.iter().any(|w| separated_along(u.cross(*w))))
 }
 
 /// Checks that every boundary point of the solid lies in the union of the pieces (within `tol`).

@@ -407,6 +407,8 @@ pub(crate) fn mesh_tolerance(
 }
 
 /// Checks every shell (or decomposes it) and builds the part.
+/// With `recognise`, a closed mesh that is not convex is recognised as sheet metal ([`super::sheet`]): an STL's
+/// shells, or an OBJ of one group (the groups of an OBJ are meant as convex pieces).
 pub(crate) fn part_from_shells(
     file: &Path,
     name: String,
@@ -414,6 +416,7 @@ pub(crate) fn part_from_shells(
     shells: Vec<(Shell, Option<usize>)>,
     options: &ReadOptions,
     tolerance: f64,
+    recognise: bool,
 ) -> Result<Part, IoError> {
     if shells.is_empty() {
         return Err(IoError::Empty { file: file.to_path_buf(), at: Place::WholeFile, what: "the mesh has no faces" });
@@ -457,19 +460,37 @@ pub(crate) fn part_from_shells(
                 mesh_volume += polytope.volume();
                 components.push(polytope);
             }
-            Err(IoError::NotConvex { .. }) if !options.decompose_mesh && open.is_none() => {
+            Err(IoError::NotConvex { file, shell, name: shell_name, detail })
+                if !options.decompose_mesh && open.is_none() && recognise =>
+            {
                 // a closed shell that is not convex: a sheet-metal part from CAD, recognised from all the shells
                 let polygons: Vec<MeshPolygon> = shells.iter().flat_map(|(s, _)| s.polygons.iter().cloned()).collect();
-                let (part, recognition) =
-                    super::sheet::recognise_mesh(file, name.clone(), points, &polygons, options, tolerance)?;
-                tracing::info!(
-                    file = %file.display(),
-                    thickness = recognition.thickness,
-                    plates = recognition.plates.len(),
-                    bends = recognition.bends.len(),
-                    "mesh recognised as sheet metal"
-                );
-                return Ok(part);
+                return match super::sheet::recognise_mesh(&file, name.clone(), points, &polygons, options, tolerance) {
+                    Ok((part, recognition)) => {
+                        tracing::info!(
+                            file = %file.display(),
+                            thickness = recognition.thickness,
+                            plates = recognition.plates.len(),
+                            bends = recognition.bends.len(),
+                            "mesh recognised as sheet metal"
+                        );
+                        Ok(part)
+                    }
+                    // both reasons: why it is no convex piece, and why it is no sheet
+                    Err(e) => {
+                        let sheet = match &e {
+                            IoError::NotSheetMetal { source, .. } => source.to_string(),
+                            IoError::MeshFaces { source, .. } => source.to_string(),
+                            other => other.to_string(),
+                        };
+                        Err(IoError::NotConvex {
+                            file,
+                            shell,
+                            name: shell_name,
+                            detail: format!("{detail}; nor is it sheet metal: {sheet}"),
+                        })
+                    }
+                };
             }
             Err(IoError::NotConvex { .. }) if options.decompose_mesh => {
                 let pieces = decompose(points, shell, tolerance).map_err(|detail| IoError::Decomposition {

@@ -36,7 +36,8 @@ pub fn read_obj(path: impl AsRef<Path>, options: &ReadOptions) -> Result<Part, I
 /// Parses OBJ from memory; `file` is only used in error messages and as the part name.
 pub fn parse_obj(bytes: &[u8], file: &Path, options: &ReadOptions) -> Result<Part, IoError> {
     let (shells, points, tolerance) = parse_obj_groups(bytes, file, options)?;
-    let mut part = part_from_shells(file, stem_name(file), &points, shells, options, tolerance)?;
+    let recognise = shells.len() == 1;
+    let mut part = part_from_shells(file, stem_name(file), &points, shells, options, tolerance, recognise)?;
     // a file written from an approximate or recognised part keeps its mark
     if part.origin == PartOrigin::Mesh
         && let Some(origin) = String::from_utf8_lossy(bytes)

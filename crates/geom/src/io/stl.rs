@@ -40,7 +40,7 @@ pub fn read_stl(path: impl AsRef<Path>, options: &ReadOptions) -> Result<Part, I
 pub fn parse_stl(bytes: &[u8], file: &Path, options: &ReadOptions) -> Result<Part, IoError> {
     let mesh = parse_stl_mesh(bytes, file, options)?;
     let shells = split_shells(&mesh.points, mesh.polygons, mesh.tolerance);
-    part_from_shells(file, mesh.name, &mesh.points, shells, options, mesh.tolerance)
+    part_from_shells(file, mesh.name, &mesh.points, shells, options, mesh.tolerance, true)
 }
 
 /// An STL file's welded triangles, in millimetres ([`ReadOptions::units`]), with its name and length tolerance.
