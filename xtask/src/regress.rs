@@ -3,7 +3,8 @@
 //!
 //! A scenario is `{"kind": "...", ...kind-specific inputs..., "tolerances": {"field": {"rel": r, "abs": a}}}`.
 //! Running it yields a flat map of named result fields (numbers, integers, strings, booleans, arrays of them).
-//! Numbers are compared with `|actual - golden| <= max(abs, rel * |golden|)` (default rel 1e-9, abs 1e-12; a field
+//! With `"expect_error": true` the scenario's request must fail, and its error message (field `error`) is compared
+//! with the golden's. Numbers are compared with `|actual - golden| <= max(abs, rel * |golden|)` (default rel 1e-9, abs 1e-12; a field
 //! named in `tolerances` uses its own); everything else must be equal. Fields prefixed with `info_` are recorded
 //! (e.g. timings) but never compared. `--slow` adds the scenarios of `fixtures/regress/slow/` when that directory
 //! exists (scenarios too slow for CI in the dev profile; goldens in `fixtures/regress/slow/golden/`). There are none:
@@ -105,6 +106,10 @@ fn run_dir(dir: &Path, bless: bool, filter: Option<&str>) -> anyhow::Result<bool
         let started = std::time::Instant::now();
         let mut fields = match crate::scenarios::run(&scenario, dir) {
             Ok(f) => f,
+            // a scenario of a request that must fail: its error text is the golden
+            Err(e) if scenario.get("expect_error").and_then(Value::as_bool) == Some(true) => {
+                std::iter::once(("error".to_string(), Value::from(format!("{e:#}")))).collect()
+            }
             Err(e) => {
                 println!("{name:<34} {:<28} {:<40} {:<40} ERROR", "-", "-", format!("{e:#}"));
                 all_ok = false;
