@@ -25,7 +25,7 @@ pub enum Example {
     /// A zero-thickness sheet-metal model (build it with [`SheetMetal::build_part`]).
     SheetMetal(SheetMetal),
     /// A solid part.
-    Solid(Part),
+    Solid(Box<Part>),
 }
 
 impl Example {
@@ -35,7 +35,7 @@ impl Example {
             Example::SheetMetal(s) => s
                 .build_part(name, 1.0, decomposition)
                 .expect("built-in sheet-metal examples are valid (checked by tests/decomposition.rs)"),
-            Example::Solid(p) => p.clone(),
+            Example::Solid(p) => (**p).clone(),
         }
     }
 }
@@ -46,9 +46,9 @@ pub fn by_name(name: &str) -> Option<Example> {
         "channel" => Some(Example::SheetMetal(channel())),
         "triangle" => Some(Example::SheetMetal(triangle())),
         "complex" => Some(Example::SheetMetal(complex())),
-        "cube" => Some(Example::Solid(cube())),
-        "l-corner" => Some(Example::Solid(l_corner_part())),
-        "block" => Some(Example::Solid(block_part())),
+        "cube" => Some(Example::Solid(Box::new(cube()))),
+        "l-corner" => Some(Example::Solid(Box::new(l_corner_part()))),
+        "block" => Some(Example::Solid(Box::new(block_part()))),
         _ => None,
     }
 }

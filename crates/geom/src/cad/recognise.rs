@@ -697,7 +697,7 @@ fn merge_cylinders(brep: &Brep, tol: f64) -> Vec<Cylinder> {
     for (index, face) in brep.faces.iter().enumerate() {
         let Surface::Cylinder { point, axis, radius, convex } = face.surface else { continue };
         let axis = axis.normalize_or_zero();
-        if axis == DVec3::ZERO || !(radius > 0.0) {
+        if axis == DVec3::ZERO || radius.is_nan() || radius <= 0.0 {
             continue;
         }
         let points = face.boundary_points(ARC_STEP);

@@ -288,7 +288,7 @@ pub enum IoError {
         /// The file.
         file: PathBuf,
         /// The reason.
-        source: crate::cad::recognise::RecogniseError,
+        source: Box<crate::cad::recognise::RecogniseError>,
     },
     /// A mesh that cannot be split into the faces of a solid for sheet-metal recognition (open, non-manifold).
     #[error("{}: {source}", file.display())]
@@ -296,7 +296,7 @@ pub enum IoError {
         /// The file.
         file: PathBuf,
         /// The reason (names the triangle).
-        source: crate::cad::mesh_faces::MeshFaceError,
+        source: Box<crate::cad::mesh_faces::MeshFaceError>,
     },
     /// A stack placement whose rotation is not a proper rotation.
     #[error("{}: placement {placement}: {source}", file.display())]

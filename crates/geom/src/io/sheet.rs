@@ -59,7 +59,7 @@ pub(crate) fn recognise_mesh(
         return Err(IoError::Empty { file: file.to_path_buf(), at: Place::WholeFile, what: "the mesh has no faces" });
     }
     let brep = crate::cad::mesh_faces::mesh_faces(points, &triangles, tolerance)
-        .map_err(|source| IoError::MeshFaces { file: file.to_path_buf(), source })?;
+        .map_err(|source| IoError::MeshFaces { file: file.to_path_buf(), source: Box::new(source) })?;
     recognise_brep(file, name, &brep, options, 10.0 * tolerance)
 }
 
@@ -78,7 +78,7 @@ fn recognise_brep(
         density,
     };
     recognise(brep, &name, &recognise_options)
-        .map_err(|source| IoError::NotSheetMetal { file: file.to_path_buf(), source })
+        .map_err(|source| IoError::NotSheetMetal { file: file.to_path_buf(), source: Box::new(source) })
 }
 
 /// The diagonal of the box of a B-rep's boundary points.
