@@ -179,6 +179,16 @@ pub fn read_pose(path: &std::path::Path) -> anyhow::Result<stackplan_geom::Pose>
     Ok(pose)
 }
 
+/// Checks `--grasp-tilt-deg`: from 0 to 89 degrees.
+pub fn check_grasp_tilt(degrees: f64) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        (0.0..=89.0).contains(&degrees),
+        "--grasp-tilt-deg must lie in [0, 89] degrees, got {}",
+        short_number(degrees)
+    );
+    Ok(())
+}
+
 /// Parses `--pair I,J` (moving component I, fixed component J).
 pub fn parse_pair(s: &str) -> anyhow::Result<(usize, usize)> {
     let (i, j) = s.split_once(',').with_context(|| format!("--pair expects I,J, got {s:?}"))?;

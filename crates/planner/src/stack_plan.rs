@@ -101,6 +101,11 @@ pub struct PlanOptions {
     /// no limit.
     #[serde(default)]
     pub time_limit: Option<f64>,
+    /// Largest tilt from level of a face that holds the suction cup (radians;
+    /// [`stackplan_stability::grasp::GraspOptions::max_tilt`]). [`PlanOptions::new`]:
+    /// [`stackplan_stability::grasp::DEFAULT_MAX_TILT`]; a plan file without it was made with level faces only (0).
+    #[serde(default)]
+    pub grasp_tilt: f64,
 }
 
 fn default_node_budget() -> usize {
@@ -144,6 +149,7 @@ impl PlanOptions {
             partitions: default_partitions(),
             node_budget: default_node_budget(),
             time_limit: None,
+            grasp_tilt: stackplan_stability::grasp::DEFAULT_MAX_TILT,
         }
     }
 }
@@ -265,8 +271,8 @@ pub enum PlanError {
     NoRestingPose(String),
     /// The part rests stably, but no resting pose presents an upward face that holds the suction cup.
     #[error(
-        "none of the part's {poses} stable resting poses presents a horizontal upward face that holds a \
-         {cup_diameter} mm suction cup: {}",
+        "none of the part's {poses} stable resting poses presents an upward face within {tilt_deg} degrees of level \
+         that holds a {cup_diameter} mm suction cup: {}",
         tried.join("; ")
     )]
     NoGraspablePose {
@@ -274,7 +280,9 @@ pub enum PlanError {
         poses: usize,
         /// The cup diameter asked for (mm).
         cup_diameter: f64,
-        /// Each pose tried, lowest c.g. first, and why it failed: no horizontal upward face (with the tilt of the
+        /// The largest tilt of a grasp face from level (degrees).
+        tilt_deg: f64,
+        /// Each pose tried, lowest c.g. first, and why it failed: no upward face within the tilt (with the tilt of the
         /// most level upward face), or the largest cup that fits.
         tried: Vec<String>,
     },
@@ -381,7 +389,8 @@ fn plan_stack_here(
         return Err(PlanError::NoRestingPose("no face of the hull holds the c.g. strictly inside".into()));
     }
     // candidate orientations: resting poses that present a suction face for the cup ([A] II-B condition 3)
-    let grasp = GraspOptions { cup_diameter: options.cup_diameter, ..GraspOptions::default() };
+    let grasp =
+        GraspOptions { cup_diameter: options.cup_diameter, max_tilt: options.grasp_tilt, ..GraspOptions::default() };
     let rests: Vec<DMat3> = poses
         .iter()
         .filter(|p| is_graspable(&grasp_faces(part, p.rotation, p.position, &grasp), &grasp))
@@ -390,7 +399,12 @@ fn plan_stack_here(
         .collect();
     if rests.is_empty() {
         let tried = poses.iter().enumerate().map(|(k, p)| why_not_graspable(part, k, p, &grasp)).collect();
-        return Err(PlanError::NoGraspablePose { poses: poses.len(), cup_diameter: options.cup_diameter, tried });
+        return Err(PlanError::NoGraspablePose {
+            poses: poses.len(),
+            cup_diameter: options.cup_diameter,
+            tilt_deg: (options.grasp_tilt.to_degrees() * 1e6).round() / 1e6,
+            tried,
+        });
     }
     let origin = options.origin.unwrap_or_else(|| options.floor.centre());
     let check_options = CheckOptions {
@@ -494,6 +508,12 @@ fn plan_stack_here(
             stats.searches += 1;
             // candidates one at a time: the search stops at the first that passes
             for tested in 0..limit {
+                // the checks of many rejected candidates can take longer than the searches
+                if deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+                    stopped =
+                        Some(limit_reason(index, options, &PlacementError::TimeLimit { found: tested }, started_plan));
+                    break 'parts;
+                }
                 if tested == options.candidates {
                     stats.repeated_searches += 1;
                     tracing::debug!(index, "every candidate failed the checks: searching for more");
@@ -793,8 +813,8 @@ fn accept(
     Ok(Err(format!("the best interference-free positions were rejected (last: {reason})")))
 }
 
-/// Why resting pose `k` offers no grasp: no horizontal upward face (and how far the most level upward face of the
-/// part's boundary is tilted), or the largest cup that fits on one.
+/// Why resting pose `k` offers no grasp: no upward face within the grasp tilt of level (and how far the most level
+/// upward face of the part's boundary is tilted), or the largest cup that fits on one.
 fn why_not_graspable(
     part: &Part,
     k: usize,
@@ -813,10 +833,7 @@ fn why_not_graspable(
                 .filter(|z| *z > 0.0)
                 .fold(f64::NEG_INFINITY, f64::max);
             if up > 0.0 {
-                format!(
-                    "{head}: no horizontal upward face, the most level is tilted {:.1} deg",
-                    up.min(1.0).acos().to_degrees()
-                )
+                format!("{head}: no such face, the most level is tilted {:.1} degrees", up.min(1.0).acos().to_degrees())
             } else {
                 format!("{head}: no upward face")
             }

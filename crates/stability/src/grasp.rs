@@ -2,7 +2,8 @@
 //! insertion"; \[A\] II-B condition (iii)).
 //!
 //! For a part in a pose, the candidate grasp regions are the horizontal planar faces whose outward normal is within
-//! [`UP_COS_TOLERANCE`] of +z. Coplanar upward component faces at the same height (within the part's tolerance) form
+//! [`UP_COS_TOLERANCE`] of +z, and the faces tilted up to [`GraspOptions::max_tilt`] from level, each analysed in its
+//! own plane (the part turned so that the face is level; the cup approaches along the face's normal). Coplanar upward component faces at the same height (within the part's tolerance) form
 //! one region — a sheet decomposed into prisms presents one top surface — and everything of the part's own material
 //! above that height is removed: every component is clipped to `z >= h + tol` and its vertical projection (a convex
 //! polygon) is subtracted. Holes of the sheet are not covered by any component face, so they are excluded
@@ -42,11 +43,21 @@ use stackplan_geom::Part;
 /// A face counts as upward when its outward normal has `n.z >= 1 - UP_COS_TOLERANCE` (about 0.0026 degrees).
 pub const UP_COS_TOLERANCE: f64 = 1e-9;
 
+/// The default [`GraspOptions::max_tilt`]: 5 degrees. A suction cup seals on a face a few degrees off level, and the
+/// stable resting poses of bent parts often rest on a flange's edge, leaving their largest face a degree or two off
+/// level.
+pub const DEFAULT_MAX_TILT: f64 = 5.0 * std::f64::consts::PI / 180.0;
+
 /// Options of the grasp analysis.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GraspOptions {
     /// Suction cup diameter (mm).
     pub cup_diameter: f64,
+    /// Largest tilt from level of a grasp face (radians, in `[0, pi/2)`): a face whose outward normal is within this
+    /// angle of +z holds the cup, which approaches along the face's normal; its region is analysed in the face's own
+    /// plane (the part turned so that the face is level). 0: level faces only. Default [`DEFAULT_MAX_TILT`].
+    #[serde(default)]
+    pub max_tilt: f64,
     /// Cup centres relative to the grasp point (mm) for a multi-cup gripper; empty = a single cup.
     pub pattern: Vec<DVec2>,
     /// Grid resolution N of the approximate search (N x N samples).
@@ -57,7 +68,7 @@ pub struct GraspOptions {
 
 impl Default for GraspOptions {
     fn default() -> Self {
-        Self { cup_diameter: 30.0, pattern: Vec::new(), grid: 48, angle_steps: 24 }
+        Self { cup_diameter: 30.0, max_tilt: DEFAULT_MAX_TILT, pattern: Vec::new(), grid: 48, angle_steps: 24 }
     }
 }
 
@@ -93,6 +104,10 @@ pub struct GraspFace {
     pub fits_cup: bool,
     /// Best placement of the cup pattern (when a pattern is given).
     pub pattern_fit: Option<PatternFit>,
+    /// Tilt of the face from level (radians; 0 for a level face). For a tilted face `height` is the world height of
+    /// `center`, and the radii are measured in the face's plane.
+    #[serde(default)]
+    pub tilt: f64,
 }
 
 /// The planar region of one face height: convex pieces minus convex obstacles.
@@ -403,8 +418,46 @@ pub fn grasp_faces(part: &Part, rotation: DMat3, position: DVec3, options: &Gras
     grasp_faces_of_components(&components, part.tolerance().linear, options)
 }
 
-/// Grasp faces of world-coordinate components (see [`grasp_faces`]).
+/// Grasp faces of world-coordinate components (see [`grasp_faces`]): the level faces, and with
+/// [`GraspOptions::max_tilt`] the faces tilted up to it, each family of parallel faces analysed with the part turned
+/// so that they are level (the minimal rotation taking their normal to +z), then turned back.
 pub fn grasp_faces_of_components(components: &[WorldComponent], tol: f64, options: &GraspOptions) -> Vec<GraspFace> {
+    let mut out = level_faces(components, tol, options);
+    if options.max_tilt > 0.0 {
+        let min_z = options.max_tilt.min(std::f64::consts::FRAC_PI_2 - 1e-6).cos();
+        let mut normals: Vec<DVec3> = Vec::new();
+        for c in components {
+            for f in c.polytope.faces() {
+                let n = f.plane.normal;
+                if n.z >= min_z && n.z < 1.0 - UP_COS_TOLERANCE && !normals.iter().any(|m| (*m - n).length() <= 1e-9) {
+                    normals.push(n);
+                }
+            }
+        }
+        for n in normals {
+            let turn = DMat3::from_quat(glam::DQuat::from_rotation_arc(n, DVec3::Z));
+            let back = turn.transpose();
+            let turned: Vec<WorldComponent> =
+                components.iter().map(|c| WorldComponent::new(c.polytope.transformed(turn, DVec3::ZERO))).collect();
+            let tilt = n.z.clamp(-1.0, 1.0).acos();
+            out.extend(level_faces(&turned, tol, options).into_iter().map(|mut f| {
+                f.polygons = f.polygons.iter().map(|p| p.iter().map(|q| back * *q).collect()).collect();
+                f.center = back * f.center;
+                f.height = f.center.z;
+                if let Some(fit) = &mut f.pattern_fit {
+                    fit.point = back * fit.point;
+                }
+                f.tilt = tilt;
+                f
+            }));
+        }
+        out.sort_by(|a, b| b.inscribed_radius.total_cmp(&a.inscribed_radius).then(b.height.total_cmp(&a.height)));
+    }
+    out
+}
+
+/// The level grasp faces of world-coordinate components.
+fn level_faces(components: &[WorldComponent], tol: f64, options: &GraspOptions) -> Vec<GraspFace> {
     // upward faces grouped by height
     let mut groups: Vec<(f64, Vec<Vec<DVec3>>)> = Vec::new();
     for c in components {
@@ -465,6 +518,7 @@ pub fn grasp_faces_of_components(components: &[WorldComponent], tol: f64, option
             exact,
             fits_cup: radius >= cup_radius,
             pattern_fit,
+            tilt: 0.0,
         });
     }
     out.sort_by(|a, b| b.inscribed_radius.total_cmp(&a.inscribed_radius).then(b.height.total_cmp(&a.height)));

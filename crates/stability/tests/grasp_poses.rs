@@ -33,6 +33,29 @@ fn box_top_is_exact() {
 }
 
 #[test]
+fn a_face_tilted_within_the_grasp_tilt_holds_the_cup_in_its_own_plane() {
+    let part = box_part("b", DVec3::new(100.0, 60.0, 10.0));
+    for (deg, max_deg, found) in [(3.0, 5.0, true), (3.0, 0.0, false), (8.0, 5.0, false), (8.0, 10.0, true)] {
+        let turn = DMat3::from_rotation_x(f64::to_radians(deg));
+        let options = GraspOptions { max_tilt: f64::to_radians(max_deg), ..opts(30.0) };
+        let faces = grasp_faces(&part, turn, DVec3::ZERO, &options);
+        assert_eq!(!faces.is_empty(), found, "{deg} degrees, tilt up to {max_deg}: {faces:?}");
+        if let Some(f) = faces.first() {
+            // the top face, measured in its plane: the inscribed disc is half its 60 mm width
+            assert!((f.tilt - f64::to_radians(deg)).abs() < 1e-9, "{}", f.tilt);
+            assert!((f.inscribed_radius - 30.0).abs() < 1e-6, "{}", f.inscribed_radius);
+            // its centre lies on the turned top face, and its polygons too
+            let top = turn * DVec3::Z;
+            let offset = top.dot(turn * DVec3::new(0.0, 0.0, 10.0));
+            assert!((top.dot(f.center) - offset).abs() < 1e-9);
+            assert!(f.polygons.iter().flatten().all(|p| (top.dot(*p) - offset).abs() < 1e-9));
+            assert!((f.height - f.center.z).abs() < 1e-12);
+            assert!(is_graspable(&faces, &options));
+        }
+    }
+}
+
+#[test]
 fn triangle_top_inradius() {
     let (a, b) = (30.0, 40.0);
     let tri = [DVec3::ZERO, DVec3::new(a, 0.0, 0.0), DVec3::new(0.0, b, 0.0)];

@@ -30,6 +30,10 @@ pub struct Args {
     /// Suction cup diameter (mm) [default: a plan file's `options.cup_diameter`, else 30].
     #[arg(long)]
     pub cup_diameter: Option<f64>,
+    /// Largest tilt from level of a face that holds the cup (degrees) [default: a plan file's `options.grasp_tilt`,
+    /// else 5].
+    #[arg(long)]
+    pub grasp_tilt_deg: Option<f64>,
     /// Contact tolerance (mm) instead of the policy's 1e-9 x stack size (for stacks with rounded coordinates).
     #[arg(long)]
     pub contact_tolerance: Option<f64>,
@@ -162,10 +166,17 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         Some(cup) => cup,
         None => option("cup_diameter")?.unwrap_or(30.0),
     };
+    let max_tilt = match args.grasp_tilt_deg {
+        Some(deg) => {
+            crate::input::check_grasp_tilt(deg)?;
+            deg.to_radians()
+        }
+        None => option("grasp_tilt")?.unwrap_or(stackplan::stability::grasp::DEFAULT_MAX_TILT),
+    };
     let options = CheckOptions {
         mu,
         clearance,
-        grasp: GraspOptions { cup_diameter, ..GraspOptions::default() },
+        grasp: GraspOptions { cup_diameter, max_tilt, ..GraspOptions::default() },
         margin_directions: args.margin_directions,
         contact_tolerance: args.contact_tolerance,
         prefix_stability: true,

@@ -67,6 +67,10 @@ pub struct PlannerArgs {
     /// number (ties and the open cells carried between searches), never on the thread count.
     #[arg(long, default_value_t = stackplan::planner::request::DEFAULT_PARTITIONS)]
     pub search_partitions: usize,
+    /// Largest tilt from level of a face that holds the suction cup (degrees, 0 to 89): the cup approaches along the
+    /// face's normal. Bent parts often rest with their largest face a degree or two off level.
+    #[arg(long, default_value_t = 5.0)]
+    pub grasp_tilt_deg: f64,
     /// Seconds the plan may take (each plan, for several weights): past them the plan ends with the parts placed so
     /// far and says why. Default: no limit.
     #[arg(long, value_name = "SECONDS")]
@@ -122,6 +126,7 @@ impl PlannerArgs {
             anyhow::ensure!(t.is_finite() && t > 0.0, "--time-limit must be a positive number of seconds, got {t}");
         }
         anyhow::ensure!(self.node_budget > 0, "--node-budget must be at least 1");
+        crate::input::check_grasp_tilt(self.grasp_tilt_deg)?;
         load_part_spec(spec, crate::input::decomposition(self.triangulate))
     }
 
@@ -152,6 +157,7 @@ impl PlannerArgs {
         options.candidates = self.candidates;
         options.partitions = self.search_partitions;
         options.node_budget = self.node_budget;
+        options.grasp_tilt = self.grasp_tilt_deg.to_radians();
         options.time_limit = self.time_limit;
         // (the repeated search never asks for fewer than the user's own candidate count)
         options.max_candidates = options.max_candidates.max(self.candidates);

@@ -17,6 +17,10 @@ pub struct PosesArgs {
     /// Suction cup diameter (mm).
     #[arg(long, default_value_t = 30.0)]
     pub cup_diameter: f64,
+    /// Largest tilt from level of a face that holds the cup (degrees, 0 to 89): the cup approaches along the face's
+    /// normal.
+    #[arg(long, default_value_t = 5.0)]
+    pub grasp_tilt_deg: f64,
     /// JSON output.
     #[arg(long)]
     pub json: bool,
@@ -65,7 +69,12 @@ pub fn run_poses(args: &PosesArgs) -> anyhow::Result<Outcome> {
         "--cup-diameter must be a non-negative number of millimetres"
     );
     let part = load_part(&args.part)?;
-    let grasp = GraspOptions { cup_diameter: args.cup_diameter, ..GraspOptions::default() };
+    crate::input::check_grasp_tilt(args.grasp_tilt_deg)?;
+    let grasp = GraspOptions {
+        cup_diameter: args.cup_diameter,
+        max_tilt: args.grasp_tilt_deg.to_radians(),
+        ..GraspOptions::default()
+    };
     let mut poses = Vec::new();
     for pose in resting_poses(&part)? {
         let faces = grasp_faces(&part, pose.rotation, pose.position, &grasp);
