@@ -420,21 +420,32 @@ pub fn grasp_faces(part: &Part, rotation: DMat3, position: DVec3, options: &Gras
 
 /// Grasp faces of world-coordinate components (see [`grasp_faces`]): the level faces, and with
 /// [`GraspOptions::max_tilt`] the faces tilted up to it, each family of parallel faces analysed with the part turned
-/// so that they are level (the minimal rotation taking their normal to +z), then turned back.
+/// so that they are level (the minimal rotation taking their normal to +z), then turned back. A tilted family whose
+/// faces add up to less area than one cup is left out: no cup fits on it.
 pub fn grasp_faces_of_components(components: &[WorldComponent], tol: f64, options: &GraspOptions) -> Vec<GraspFace> {
     let mut out = level_faces(components, tol, options);
     if options.max_tilt > 0.0 {
         let min_z = options.max_tilt.min(std::f64::consts::FRAC_PI_2 - 1e-6).cos();
-        let mut normals: Vec<DVec3> = Vec::new();
+        // families of parallel tilted faces with their total area: a family with less area than the cup cannot
+        // hold it (nor a pattern of cups), and is not analysed
+        let mut normals: Vec<(DVec3, f64)> = Vec::new();
         for c in components {
+            let v = c.polytope.vertices();
             for f in c.polytope.faces() {
                 let n = f.plane.normal;
-                if n.z >= min_z && n.z < 1.0 - UP_COS_TOLERANCE && !normals.iter().any(|m| (*m - n).length() <= 1e-9) {
-                    normals.push(n);
+                if n.z < min_z || n.z >= 1.0 - UP_COS_TOLERANCE {
+                    continue;
+                }
+                let face_area =
+                    stackplan_geom::polytope::newell_normal(f.vertices.iter().map(|&i| v[i])).length() / 2.0;
+                match normals.iter_mut().find(|(m, _)| (*m - n).length() <= 1e-9) {
+                    Some((_, a)) => *a += face_area,
+                    None => normals.push((n, face_area)),
                 }
             }
         }
-        for n in normals {
+        let cup_area = std::f64::consts::PI * (0.5 * options.cup_diameter).powi(2);
+        for n in normals.into_iter().filter(|(_, a)| *a >= cup_area).map(|(n, _)| n) {
             let turn = DMat3::from_quat(glam::DQuat::from_rotation_arc(n, DVec3::Z));
             let back = turn.transpose();
             let turned: Vec<WorldComponent> =
