@@ -30,6 +30,7 @@ pub mod predicates;
 pub mod sheet_metal;
 pub mod tolerance;
 pub mod triangulate;
+mod union_find;
 pub mod vertex_cycle;
 
 pub use glam::{DMat3, DVec2, DVec3};

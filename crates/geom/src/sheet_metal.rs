@@ -414,9 +414,15 @@ fn flat_vertex(u: DVec3, v: DVec3, w: DVec3, flat: f64) -> bool {
 
 /// The prism over a convex cycle (counter-clockwise about the extrusion direction `above - below`).
 fn prism(cycle: &[usize], below: &[DVec3], above: &[DVec3]) -> Result<ConvexPolytope, PolytopeError> {
-    let m = cycle.len();
-    let mut vertices: Vec<DVec3> = cycle.iter().map(|&i| below[i]).collect();
-    vertices.extend(cycle.iter().map(|&i| above[i]));
+    prism_between(cycle.iter().map(|&i| below[i]).collect(), cycle.iter().map(|&i| above[i]).collect())
+}
+
+/// The prism between two translated copies of a convex polygon, `bottom` counter-clockwise about the direction from
+/// it to `top` (vertex `k` of `top` above vertex `k` of `bottom`): its caps and one quadrilateral side per edge.
+pub(crate) fn prism_between(bottom: Vec<DVec3>, top: Vec<DVec3>) -> Result<ConvexPolytope, PolytopeError> {
+    let m = bottom.len();
+    let mut vertices = bottom;
+    vertices.extend(top);
     let mut faces: Vec<Vec<usize>> = Vec::with_capacity(m + 2);
     faces.push((m..2 * m).collect());
     faces.push((0..m).rev().collect());

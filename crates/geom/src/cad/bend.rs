@@ -20,6 +20,7 @@
 //! Cost: O(n) per bend.
 
 use crate::polytope::{ConvexPolytope, PolytopeError};
+use crate::sheet_metal::prism_between;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
@@ -123,17 +124,10 @@ impl Bend {
                     self.radial(a1) * self.inner_radius,
                     self.radial(a0) * self.inner_radius,
                 ];
-                let m = ring.len();
-                let mut vertices: Vec<DVec3> = ring.iter().map(|q| self.center + *q + z0).collect();
-                vertices.extend(ring.iter().map(|q| self.center + *q + z1));
-                let mut faces: Vec<Vec<usize>> = Vec::with_capacity(m + 2);
-                faces.push((m..2 * m).collect());
-                faces.push((0..m).rev().collect());
-                for i in 0..m {
-                    let j = (i + 1) % m;
-                    faces.push(vec![i, j, m + j, m + i]);
-                }
-                let piece = ConvexPolytope::new(vertices, faces)?;
+                let piece = prism_between(
+                    ring.iter().map(|q| self.center + *q + z0).collect(),
+                    ring.iter().map(|q| self.center + *q + z1).collect(),
+                )?;
                 piece.validate()?;
                 Ok(piece)
             })

@@ -57,6 +57,7 @@ use super::{Brep, BrepFace, FaceSource, Segment, Surface};
 use crate::accurate_normal::accurate_cross;
 use crate::io::Place;
 use crate::io::mesh::MeshPolygon;
+use crate::union_find::{find, union};
 use glam::{DMat3, DVec2, DVec3};
 use std::collections::HashMap;
 
@@ -995,21 +996,6 @@ fn signed_area(lp: &[DVec3], normal: DVec3) -> f64 {
         sum += (lp[i] - o).cross(lp[i + 1] - o);
     }
     0.5 * sum.dot(normal)
-}
-
-fn find(parent: &mut [usize], mut x: usize) -> usize {
-    while parent[x] != x {
-        parent[x] = parent[parent[x]];
-        x = parent[x];
-    }
-    x
-}
-
-fn union(parent: &mut [usize], a: usize, b: usize) {
-    let (ra, rb) = (find(parent, a), find(parent, b));
-    if ra != rb {
-        parent[ra.max(rb)] = ra.min(rb);
-    }
 }
 
 #[cfg(test)]

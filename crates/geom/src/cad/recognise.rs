@@ -42,6 +42,7 @@ use crate::plate::Plate;
 use crate::polygon::{PointInRing, point_in_ring};
 use crate::polytope::{ConvexPolytope, PolytopeError};
 use crate::sheet_metal::{Decomposition, SheetFace, SheetMetal, SheetMetalError};
+use crate::union_find::{find, union};
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
@@ -279,8 +280,7 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
         if let Some((j, d)) = *p
             && at_thickness(d)
         {
-            let (a, b) = (find(&mut parent, i), find(&mut parent, j));
-            parent[a] = b;
+            union(&mut parent, i, j);
         }
     }
     let mut groups: std::collections::BTreeMap<usize, Vec<usize>> = std::collections::BTreeMap::new();
@@ -508,14 +508,6 @@ fn diagonal(components: &[ConvexPolytope]) -> f64 {
         hi = hi.max(b);
     }
     (hi - lo).length()
-}
-
-fn find(parent: &mut [usize], mut x: usize) -> usize {
-    while parent[x] != x {
-        parent[x] = parent[parent[x]];
-        x = parent[x];
-    }
-    x
 }
 
 /// A planar face's frame, 2-D rings (arcs sampled) and exact area; `None` for a face without a usable loop.

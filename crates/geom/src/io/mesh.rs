@@ -55,6 +55,7 @@ use crate::part::{Part, PartOrigin};
 use crate::polytope::{ConvexPolytope, newell_normal};
 use crate::predicates::side;
 use crate::tolerance::{Tolerance, bounding_diagonal};
+use crate::union_find::{find, union};
 use glam::DVec3;
 use std::cmp::Ordering;
 use std::collections::HashMap;
@@ -243,21 +244,6 @@ fn first_met(
         }
     }
     best
-}
-
-fn find(parent: &mut [usize], mut x: usize) -> usize {
-    while parent[x] != x {
-        parent[x] = parent[parent[x]];
-        x = parent[x];
-    }
-    x
-}
-
-fn union(parent: &mut [usize], a: usize, b: usize) {
-    let (ra, rb) = (find(parent, a), find(parent, b));
-    if ra != rb {
-        parent[ra.max(rb)] = ra.min(rb);
-    }
 }
 
 /// The exact convexity check of the module documentation; returns the shell's convex polytope.
