@@ -421,21 +421,14 @@ pub fn grasp_faces(part: &Part, rotation: DMat3, position: DVec3, options: &Gras
 /// Grasp faces of world-coordinate components (see [`grasp_faces`]): the level faces, and with
 /// [`GraspOptions::max_tilt`] the faces tilted up to it, each family of parallel faces analysed with the part turned
 /// so that they are level (the minimal rotation taking their normal to +z), then turned back. A tilted family whose
-/// faces add up to less area than one cup, or that is narrower than the cup, is left out: no cup fits on it.
+/// faces add up to less area than one cup is left out: no cup fits on it.
 pub fn grasp_faces_of_components(components: &[WorldComponent], tol: f64, options: &GraspOptions) -> Vec<GraspFace> {
     let mut out = level_faces(components, tol, options);
     if options.max_tilt > 0.0 {
         let min_z = options.max_tilt.min(std::f64::consts::FRAC_PI_2 - 1e-6).cos();
-        // families of parallel tilted faces (normals within 1e-6: the faces of a part read from single-precision
-        // data are parallel only to rounding), with their total area and extent in their plane: a family with less
-        // area than the cup, or narrower than it in some direction, cannot hold it, and is not analysed
-        struct Family {
-            normal: DVec3,
-            area: f64,
-            lo: DVec2,
-            hi: DVec2,
-        }
-        let mut families: Vec<Family> = Vec::new();
+        // families of parallel tilted faces with their total area: a family with less area than the cup cannot
+        // hold it (nor a pattern of cups), and is not analysed
+        let mut normals: Vec<(DVec3, f64)> = Vec::new();
         for c in components {
             let v = c.polytope.vertices();
             for f in c.polytope.faces() {
@@ -445,34 +438,14 @@ pub fn grasp_faces_of_components(components: &[WorldComponent], tol: f64, option
                 }
                 let face_area =
                     stackplan_geom::polytope::newell_normal(f.vertices.iter().map(|&i| v[i])).length() / 2.0;
-                let k = match families.iter().position(|g| (g.normal - n).length() <= 1e-6) {
-                    Some(k) => k,
-                    None => {
-                        families.push(Family {
-                            normal: n,
-                            area: 0.0,
-                            lo: DVec2::splat(f64::INFINITY),
-                            hi: DVec2::splat(f64::NEG_INFINITY),
-                        });
-                        families.len() - 1
-                    }
-                };
-                let g = &mut families[k];
-                let u = g.normal.any_orthonormal_vector();
-                let w = g.normal.cross(u);
-                g.area += face_area;
-                for &i in &f.vertices {
-                    let q = DVec2::new(v[i].dot(u), v[i].dot(w));
-                    g.lo = g.lo.min(q);
-                    g.hi = g.hi.max(q);
+                match normals.iter_mut().find(|(m, _)| (*m - n).length() <= 1e-9) {
+                    Some((_, a)) => *a += face_area,
+                    None => normals.push((n, face_area)),
                 }
             }
         }
-        let cup = options.cup_diameter;
-        let cup_area = std::f64::consts::PI * (0.5 * cup).powi(2);
-        let pattern = !options.pattern.is_empty();
-        let holds = |g: &Family| pattern || (g.area >= cup_area && (g.hi - g.lo).min_element() >= cup);
-        for n in families.iter().filter(|g| holds(g)).map(|g| g.normal) {
+        let cup_area = std::f64::consts::PI * (0.5 * options.cup_diameter).powi(2);
+        for n in normals.into_iter().filter(|(_, a)| *a >= cup_area).map(|(n, _)| n) {
             let turn = DMat3::from_quat(glam::DQuat::from_rotation_arc(n, DVec3::Z));
             let back = turn.transpose();
             let turned: Vec<WorldComponent> =
