@@ -5,8 +5,7 @@
 //! * `cargo xtask regress [--bless] [--slow] [FILTER]` runs every scenario in `fixtures/regress/*.json` through the library,
 //!   compares the results with the golden files in `fixtures/regress/golden/` (tolerances per field), prints a table
 //!   and exits non-zero on any difference; `--bless` rewrites the goldens; `--slow` adds `fixtures/regress/slow/`
-//!   when it exists (scenarios too slow for CI; none since the seed's 121-cube Fig. 2 and 15-Complex Fig. 20 plans
-//!   became fast enough for the default set).
+//!   (scenarios too slow for CI in the dev profile: the 15-part plan of the real part `bendfm_0`).
 
 #![allow(clippy::print_stdout, clippy::print_stderr)] // xtask is a terminal program
 

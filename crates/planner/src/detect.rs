@@ -36,7 +36,7 @@ pub struct StackComponent {
     /// The component in world coordinates.
     pub world: ConvexPolytope,
     /// The component turned by its part's rotation but not moved (`R v`): the geometry up to translation, which is
-    /// all a pair's orientation events depend on ([`crate::interval_obstacles`] shares them between copies).
+    /// all a pair's orientation events depend on (`interval_obstacles.rs` shares them between copies).
     pub turned: Arc<ConvexPolytope>,
     /// Prepared for the separating-axis test.
     pub placed: PlacedConvex,

@@ -1,6 +1,6 @@
 //! The obstacles the search cuts out: the c-space obstacle of one (moving component, stack component) pair at one
 //! orientation (\[A\] App. B, built by `stackplan-cspace`'s Gauss-map overlay through its [`ObstacleCache`], or
-//! extrapolated within its constant-topology interval by [`crate::interval_obstacles`]), turned
+//! extrapolated within its constant-topology interval by `interval_obstacles.rs`), turned
 //! into the half-spaces the search subtracts:
 //!
 //! * plain: the obstacle's face planes `n_k . p <= d_k`;
@@ -52,8 +52,6 @@ impl PlaneOrigin {
 /// An obstacle ready for subtraction.
 #[derive(Debug, Clone)]
 pub struct DerivedObstacle {
-    /// Orientation index.
-    pub orientation: usize,
     /// Moving component (`usize::MAX` for [`DerivedObstacle::searched_elsewhere`]'s region, which is no pair's).
     pub moving: usize,
     /// Stack component (index into the scene; `usize::MAX` for the region of
@@ -94,13 +92,12 @@ impl DerivedObstacle {
         let raw = cache
             .get_or_build(moving, sc.part, sc.piece, &part.components[moving], orientation.rotation, &sc.world)
             .map_err(|e| e.to_string())?;
-        Ok(Self::from_obstacle(&raw, orientation.index, moving, fixed, clearance, horizontal_clearance, with_insertion))
+        Ok(Self::from_obstacle(&raw, moving, fixed, clearance, horizontal_clearance, with_insertion))
     }
 
     /// The derived obstacle of the pair's c-space obstacle `raw` (constructed or extrapolated).
     pub fn from_obstacle(
         raw: &Obstacle,
-        orientation: usize,
         moving: usize,
         fixed: usize,
         clearance: f64,
@@ -140,7 +137,7 @@ impl DerivedObstacle {
                 };
             }
         }
-        Self { orientation, moving, fixed, planes, origins, below, moving_plate: None, fixed_plate: None }
+        Self { moving, fixed, planes, origins, below, moving_plate: None, fixed_plate: None }
     }
 
     /// The region of positions at which the part, at `orientation`, lies inside the convex polygon `polygon`
@@ -156,7 +153,6 @@ impl DerivedObstacle {
             .collect();
         let origins = vec![PlaneOrigin::SearchedElsewhere; planes.len()];
         Self {
-            orientation: orientation.index,
             moving: usize::MAX,
             fixed: usize::MAX,
             planes,
@@ -170,20 +166,6 @@ impl DerivedObstacle {
     /// Whether this is the region of [`DerivedObstacle::searched_elsewhere`] (no pair's obstacle).
     pub fn is_searched_elsewhere(&self) -> bool {
         self.origins.first() == Some(&PlaneOrigin::SearchedElsewhere)
-    }
-
-    /// How deep `p` lies in the interior (the smallest slack `d_k - n_k . p`, its distance to the boundary), when
-    /// it lies inside by more than `tol` ([`DerivedObstacle::interior_contains`]); `None` otherwise.
-    pub fn interior_depth(&self, p: glam::DVec3, tol: f64) -> Option<f64> {
-        let mut depth = f64::INFINITY;
-        for pl in &self.planes {
-            let slack = pl.offset - tol - pl.normal.dot(p);
-            if slack <= 0.0 {
-                return None;
-            }
-            depth = depth.min(slack);
-        }
-        Some(depth + tol)
     }
 
     /// Whether `p` lies in the closed set grown by `tol` (`n_k . p <= d_k + tol` for every plane): on a face of the

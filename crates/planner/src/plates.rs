@@ -22,7 +22,7 @@
 //! the filled prisms through the shared [`ObstacleCache`] under component indices past the parts' own (never
 //! confused with a piece's), without extrapolation.
 //!
-//! With a clearance the obstacles are grown by their planes (mitred, [`crate::obstacles`]): a merged obstacle's
+//! With a clearance the obstacles are grown by their planes (mitred, `obstacles.rs`): a merged obstacle's
 //! growth and the union of its pairs' growths both contain the positions closer than the clearance, and differ only
 //! near corners of the pairs' obstacles; the stacking planner checks every candidate's clearance exactly. A contact
 //! with a merged obstacle is reported per pair of pieces that touch ([`touching_pieces`]).

@@ -120,7 +120,7 @@ pub struct PlacementRequest<'a> {
     /// Search one period of the part's rotational symmetry about z only (when the theta set allows it).
     pub use_symmetry: bool,
     /// Extrapolate obstacles within their constant-topology intervals instead of constructing each one
-    /// ([`crate::interval_obstacles`], \[A\] IV-B). Off: every obstacle is constructed (the reference route).
+    /// (`interval_obstacles.rs`, \[A\] IV-B). Off: every obstacle is constructed (the reference route).
     pub extrapolate: bool,
     /// Let the pieces of a sheet-metal plate stand for its filled outline where that is exact (two parallel plates,
     /// [`stackplan_geom::plate::merges_exactly`]; a plate against a component none of whose slices fits into its

@@ -238,7 +238,7 @@ pub fn lowest_release(
         }
         for (mi, component) in part.components.iter().enumerate() {
             let raw = stack_obstacle(cache, mi, component, rotation, sc)?;
-            let derived = DerivedObstacle::from_obstacle(&raw, 0, mi, fi, clearance, true, insertion);
+            let derived = DerivedObstacle::from_obstacle(&raw, mi, fi, clearance, true, insertion);
             if let Some(interval) = line_interval(&derived.planes, rest, tol) {
                 intervals.push(interval);
             }

@@ -13,7 +13,7 @@
 //!    never searched for); with `insertion` every candidate can be lowered straight down into place (insertion
 //!    obstacles). The searches of a plan carry their open cells to the next part's search with the same floor
 //!    (or a floor that grew: stage 1's footprint), [`crate::search::SearchCaches::carrying_frontiers`];
-//! 3. the candidates are settled ([`crate::settle`]) and tested in cost order on the stack placed so far
+//! 3. the candidates are settled (`settle.rs`) and tested in cost order on the stack placed so far
 //!    ([`stackplan_stability::growing::GrowingStack`]: the verdicts of [`stackplan_stability::check_added_part`],
 //!    the new part's report of [`stackplan_stability::check::check_stack`], without re-checking the parts that
 //!    passed before, up to the first that fails, with the placed parts' contacts and the memos kept from candidate
@@ -25,7 +25,7 @@
 //! 4. the seed's two stages: stage 1 searches within the stack's current floor footprint (its bounding rectangle
 //!    grown by `nest_allowance`, clipped to the floor), so the stack's bounding box is not enlarged, or only
 //!    slightly to nest; stage 2 searches the whole floor, and when stage 1 accepted a part it searches only outside
-//!    stage 1's region ([`PlacementRequest::searched_elsewhere`]: the positions at which the part lies inside that
+//!    stage 1's region ([`crate::PlacementRequest::searched_elsewhere`]: the positions at which the part lies inside that
 //!    region were stage 1's, whose candidates cheaper than its part all failed the checks, so stage 2 does not search
 //!    the stack's footprint a second time). Stage 1's part is taken unless stage 2's is strictly
 //!    cheaper (the seed takes stage 1 whenever it succeeds; with `w = 0` that would stack parts on top of each other
@@ -33,24 +33,34 @@
 //!    near-ties of cost (1) in favour of a compact stack, and never overrides the cost). So that it never does,
 //!    stage 2 after an accepted stage 1 tests every candidate cheaper than stage 1's part (up to
 //!    [`PlanOptions::max_candidates`]), not only [`PlanOptions::candidates`]: with 8, Complex at `w 0.1` put its
-//!    9th part on top of the stack at cost 134 304 while a floor position at 45 758 passed.
+//!    9th part on top of the stack at cost 134 304 while a floor position at 45 758 passed;
+//! 5. the floor as a bound: when the last stage's first [`PlanOptions::candidates`] candidates have all failed, the
+//!    cheapest position on the floor itself that passes is searched (per resting pose a 2-D search at the height
+//!    where the pose rests on the floor, \[A\] VII-A-2, its first candidates tested; `part.rs`, `FloorSearch`). A
+//!    part resting on the floor in a stable pose is stable by itself, so this position bounds the rest of the stage:
+//!    the stage tests only candidates strictly cheaper than it, and takes it when none of them passes or
+//!    [`PlanOptions::max_candidates`] is reached. On a stack of bent parts most of the cheapest 3-D positions are
+//!    perched on rims and edges and fail the stability test, thousands in a row, while the floor beside the stack is
+//!    free (and a cell whose optimum is perched can hold floor positions that its optimum hides): without the bound,
+//!    15-part plans of the real parts `bendfm_0` and `bendfm_1` (`fixtures/realparts/`) ended after 8 and 9 parts.
 //!
 //! A part that fits nowhere ends the plan with the reason; the plan keeps the parts placed so far.
 //! Cost: O(n) placements, each the search of [`crate::search`] plus at most `candidates` stack checks.
 
-use crate::detect::StackScene;
-use crate::orientation::Orientation;
-use crate::request::{Cost, FloorVolume, PlacementError, PlacementRequest, StackPart, thetas_with_step};
-use crate::search::{Contact, NoPlacement, Placement, PlacementSearch, SearchCaches};
-use crate::settle::{lowest_release, settle};
+mod candidate;
+pub(crate) mod floor;
+mod part;
+
+use crate::request::{FloorVolume, PlacementError, thetas_with_step};
+use crate::search::{Contact, SearchCaches};
 use glam::{DMat3, DVec2, DVec3};
+use part::Planner;
 use serde::{Deserialize, Serialize};
 use stackplan_cspace::cache::ObstacleCache;
-use stackplan_geom::{Part, Pose, Tolerance};
+use stackplan_geom::{Part, Tolerance};
 use stackplan_stability::check::{CheckOptions, check_stack};
-use stackplan_stability::equilibrium::Verdict;
 use stackplan_stability::grasp::{GraspOptions, grasp_faces, is_graspable};
-use stackplan_stability::growing::{GrowingStack, Rejection, ToleranceScale};
+use stackplan_stability::growing::{GrowingStack, ToleranceScale};
 use stackplan_stability::world::PlacedPart;
 
 /// Options of a stacking plan.
@@ -174,7 +184,7 @@ pub struct PlannedPart {
     /// What it touches: the active constraints at the search's optimum or, after a drop, what stopped the drop.
     pub contacts: Vec<Contact>,
     /// How far the part drops after the robot releases it (mm): the search's position with the horizontal clearance
-    /// floats this far above an inclined support ([`crate::settle`]); `position` is where it comes to rest and the
+    /// floats this far above an inclined support (`settle.rs`); `position` is where it comes to rest and the
     /// robot releases it at `position + release_drop z`. 0 for a part that rests where it is released.
     #[serde(default)]
     pub release_drop: f64,
@@ -224,7 +234,7 @@ pub struct PlanStats {
     pub pairs_evaluated: u64,
     /// Obstacles constructed (cache misses).
     pub obstacles_constructed: u64,
-    /// Obstacles extrapolated within a constant-topology interval ([`crate::interval_obstacles`]).
+    /// Obstacles extrapolated within a constant-topology interval (`interval_obstacles.rs`).
     #[serde(default)]
     pub obstacles_extrapolated: u64,
     /// Free-space cells whose QP no solver could solve, skipped ([`crate::search::PlacementStats::cells_unsolved`]):
@@ -298,37 +308,6 @@ fn rows(m: DMat3) -> [[f64; 3]; 3] {
     m.transpose().to_cols_array_2d()
 }
 
-/// The floor polygon clipped to a rectangle (Sutherland-Hodgman; both convex, so the result is convex).
-pub(crate) fn clip_to_rectangle(poly: &[DVec2], lo: DVec2, hi: DVec2) -> Vec<DVec2> {
-    let mut out = poly.to_vec();
-    let edges: [(DVec2, f64); 4] = [(DVec2::X, hi.x), (DVec2::NEG_X, -lo.x), (DVec2::Y, hi.y), (DVec2::NEG_Y, -lo.y)];
-    for (n, d) in edges {
-        if out.is_empty() {
-            break;
-        }
-        let input = std::mem::take(&mut out);
-        for k in 0..input.len() {
-            let (a, b) = (input[k], input[(k + 1) % input.len()]);
-            let (da, db) = (n.dot(a) - d, n.dot(b) - d);
-            if da <= 0.0 {
-                out.push(a);
-            }
-            if (da < 0.0) != (db < 0.0) && da != db {
-                // on the rectangle's side exactly (`d n` is `lo` or `hi`): interpolation leaves it an ulp off, and a
-                // footprint that only grew must contain the last one (the carried stage-1 frontier's test)
-                let mut cut = a + (b - a) * (da / (da - db));
-                if n.x != 0.0 {
-                    cut.x = d * n.x;
-                } else {
-                    cut.y = d * n.y;
-                }
-                out.push(cut);
-            }
-        }
-    }
-    out
-}
-
 /// Plans a stack of `options.count` copies of `part`. See the module documentation.
 pub fn plan_stack(part: &Part, options: &PlanOptions) -> Result<Plan, PlanError> {
     plan_stack_with_progress(part, options, &mut |_, _| {})
@@ -348,12 +327,71 @@ pub fn plan_stack_with_progress(
     rayon::scope(|_| plan_stack_here(part, options, progress))
 }
 
-/// [`plan_stack_with_progress`] on the calling thread.
+/// [`plan_stack_with_progress`] on the calling thread: the options checked, the graspable resting poses, then the
+/// parts one at a time ([`part`]) and the finished stack checked once with robustness margins.
 fn plan_stack_here(
     part: &Part,
     options: &PlanOptions,
     progress: &mut (dyn FnMut(usize, usize) + Send),
 ) -> Result<Plan, PlanError> {
+    validate(options)?;
+    let thetas = thetas_with_step(options.dtheta).map_err(|e| PlanError::BadOption(format!("dtheta: {e}")))?;
+    let grasp =
+        GraspOptions { cup_diameter: options.cup_diameter, max_tilt: options.grasp_tilt, ..GraspOptions::default() };
+    let rests = graspable_rests(part, options, &grasp)?;
+    let rests_count = rests.len();
+    let check_options = CheckOptions {
+        mu: options.mu,
+        clearance: 0.0,
+        grasp,
+        margin_directions: 0,
+        contact_tolerance: None,
+        prefix_stability: false,
+        release_drops: Vec::new(),
+    };
+    // the candidates' tolerance: the box diagonal rounded up to a power of two, so that candidates widening the box
+    // share the placed parts' contact analysis (ToleranceScale::PowerOfTwo)
+    let growing = GrowingStack::new(&check_options)
+        .map_err(|e| PlanError::Check(e.to_string()))?
+        .with_tolerance_scale(ToleranceScale::PowerOfTwo);
+    let started = std::time::Instant::now();
+    let mut planner = Planner {
+        part,
+        options,
+        rests,
+        thetas,
+        origin: options.origin.unwrap_or_else(|| options.floor.centre()),
+        // the searches' tolerance (every part of the stack is this part, so the scale is its diagonal)
+        tol: {
+            let (lo, hi) = part.aabb();
+            Tolerance::for_scale((hi - lo).length()).linear
+        },
+        cache: ObstacleCache::new(),
+        caches: SearchCaches::carrying_frontiers(),
+        floor_caches: (0..rests_count).map(|_| SearchCaches::carrying_frontiers()).collect(),
+        growing,
+        placed: Vec::new(),
+        planned: Vec::new(),
+        stats: PlanStats::default(),
+        started,
+        deadline: options
+            .time_limit
+            .filter(|t| t.is_finite() && *t >= 0.0)
+            .map(|t| started + std::time::Duration::from_secs_f64(t.min(1e9))),
+    };
+    let mut stopped = None;
+    for index in 0..options.count {
+        stopped = planner.place_part(index)?;
+        if stopped.is_some() {
+            break;
+        }
+        progress(planner.planned.len(), options.count);
+    }
+    finish(planner, &check_options, stopped)
+}
+
+/// Every option a plan needs in range, else [`PlanError::BadOption`] naming it.
+fn validate(options: &PlanOptions) -> Result<(), PlanError> {
     if options.count == 0 {
         return Err(PlanError::BadOption("the number of parts must be at least 1".into()));
     }
@@ -382,23 +420,26 @@ fn plan_stack_here(
             options.partitions
         )));
     }
-    let thetas = thetas_with_step(options.dtheta).map_err(|e| PlanError::BadOption(format!("dtheta: {e}")))?;
+    Ok(())
+}
+
+/// The candidate orientations' resting poses: the stable ones that present a suction face for the cup (\[A\] II-B
+/// condition 3), lowest c.g. first, at most `max_resting_poses`; none is [`PlanError::NoGraspablePose`] with each
+/// pose tried and why it failed.
+fn graspable_rests(part: &Part, options: &PlanOptions, grasp: &GraspOptions) -> Result<Vec<DMat3>, PlanError> {
     let poses =
         stackplan_stability::resting_poses::resting_poses(part).map_err(|e| PlanError::NoRestingPose(e.to_string()))?;
     if poses.is_empty() {
         return Err(PlanError::NoRestingPose("no face of the hull holds the c.g. strictly inside".into()));
     }
-    // candidate orientations: resting poses that present a suction face for the cup ([A] II-B condition 3)
-    let grasp =
-        GraspOptions { cup_diameter: options.cup_diameter, max_tilt: options.grasp_tilt, ..GraspOptions::default() };
     let rests: Vec<DMat3> = poses
         .iter()
-        .filter(|p| is_graspable(&grasp_faces(part, p.rotation, p.position, &grasp), &grasp))
+        .filter(|p| is_graspable(&grasp_faces(part, p.rotation, p.position, grasp), grasp))
         .take(options.max_resting_poses)
         .map(|p| p.rotation)
         .collect();
     if rests.is_empty() {
-        let tried = poses.iter().enumerate().map(|(k, p)| why_not_graspable(part, k, p, &grasp)).collect();
+        let tried = poses.iter().enumerate().map(|(k, p)| why_not_graspable(part, k, p, grasp)).collect();
         return Err(PlanError::NoGraspablePose {
             poses: poses.len(),
             cup_diameter: options.cup_diameter,
@@ -406,285 +447,18 @@ fn plan_stack_here(
             tried,
         });
     }
-    let origin = options.origin.unwrap_or_else(|| options.floor.centre());
-    let check_options = CheckOptions {
-        mu: options.mu,
-        clearance: 0.0,
-        grasp: grasp.clone(),
-        margin_directions: 0,
-        contact_tolerance: None,
-        prefix_stability: false,
-        release_drops: Vec::new(),
-    };
-    // shared by every search of the plan: the stack only grows and its parts never move
-    let cache = ObstacleCache::new();
-    // the searches' tolerance (every part of the stack is this part, so the scale is its diagonal)
-    let tol = {
-        let (lo, hi) = part.aabb();
-        Tolerance::for_scale((hi - lo).length()).linear
-    };
-    let mut caches = SearchCaches::carrying_frontiers();
-    // the stack as the candidate tests see it: its parts in world coordinates, their contacts and the memos of the
-    // tests, kept from candidate to candidate and from part to part
-    // the candidates' tolerance: the box diagonal rounded up to a power of two, so that candidates widening the box
-    // share the placed parts' contact analysis (ToleranceScale::PowerOfTwo)
-    let mut growing = GrowingStack::new(&check_options)
-        .map_err(|e| PlanError::Check(e.to_string()))?
-        .with_tolerance_scale(ToleranceScale::PowerOfTwo);
-    let mut placed: Vec<Pose> = Vec::new();
-    let mut planned: Vec<PlannedPart> = Vec::new();
-    let mut stats = PlanStats::default();
-    let mut stopped = None;
-    let started_plan = std::time::Instant::now();
-    let deadline = options
-        .time_limit
-        .filter(|t| t.is_finite() && *t >= 0.0)
-        .map(|t| started_plan + std::time::Duration::from_secs_f64(t.min(1e9)));
-    'parts: for index in 0..options.count {
-        if deadline.is_some_and(|d| std::time::Instant::now() >= d) {
-            stopped = Some(format!(
-                "the time limit of {} s was reached after {index} of {} parts",
-                options.time_limit.unwrap_or(0.0),
-                options.count
-            ));
-            break;
-        }
-        let stack: Vec<StackPart<'_>> = placed.iter().map(|&pose| StackPart { part, pose }).collect();
-        // stage 1: within the stack's footprint (grown by the nesting allowance); stage 2: the whole floor
-        let mut stages: Vec<(u8, FloorVolume)> = Vec::new();
-        if !placed.is_empty() {
-            let (lo, hi) = footprint(part, &placed);
-            let a = DVec2::splat(options.nest_allowance);
-            let polygon = clip_to_rectangle(&options.floor.polygon, lo - a, hi + a);
-            if polygon.len() >= 3 {
-                stages.push((1, FloorVolume { polygon, height: options.floor.height }));
-            }
-        }
-        stages.push((2, options.floor.clone()));
-        let mut last_reason = String::from("no interference-free position");
-        // the first acceptable candidate of each stage: (stage, candidate, rejected before it, grasp radius)
-        let mut accepted: Vec<(u8, (Placement, f64), usize, f64)> = Vec::new();
-        let last_stage = stages.last().map_or(2, |s| s.0);
-        let mut stage_one_region: Option<Vec<DVec2>> = None;
-        for (stage, floor) in stages {
-            let polygon = (stage == 1).then(|| floor.polygon.clone());
-            let mut request = PlacementRequest::new(part, stack.clone(), floor);
-            // stage 1 accepted a part: its region holds nothing cheaper that passes, so stage 2 searches outside it
-            if stage == 2 && !accepted.is_empty() {
-                request.searched_elsewhere = stage_one_region.take();
-            }
-            request.resting_rotations = rests.clone();
-            request.thetas = thetas.clone();
-            request.clearance = options.clearance;
-            request.horizontal_clearance = true;
-            request.cost = Cost::Stacking { w: options.w, origin };
-            request.insertion = options.insertion;
-            request.partitions = options.partitions;
-            // a stage tests `candidates` candidates; the last one, when nothing at all was accepted, continues the
-            // same search up to `max_candidates`; a stage after one that accepted a part tests every candidate cheaper
-            // than that part (up to `max_candidates`; the cost limit ends the search), so no cheaper stage-2
-            // candidate that passes is left behind a budget of failed ones (`beaten_at` is set iff a part was
-            // accepted, so both cases are "last stage, or beaten")
-            let beaten_at = accepted.iter().map(|a| a.1.0.cost).reduce(f64::min);
-            let limit =
-                if stage == last_stage || beaten_at.is_some() { options.max_candidates } else { options.candidates };
-            let started = std::time::Instant::now();
-            request.node_budget = options.node_budget;
-            request.deadline = deadline;
-            let mut search = match PlacementSearch::new(&request, &cache, &mut caches) {
-                Ok(search) => search,
-                // stage 1's clipped floor may be malformed (a sliver): fall through to stage 2
-                Err(PlacementError::BadFloor(msg)) if stage == 1 => {
-                    tracing::debug!(index, "stage 1 floor rejected: {msg}");
-                    continue;
-                }
-                Err(e @ (PlacementError::NodeBudget { .. } | PlacementError::TimeLimit { .. })) => {
-                    stopped = Some(limit_reason(index, options, &e, started_plan));
-                    break 'parts;
-                }
-                Err(e) => return Err(e.into()),
-            };
-            stats.seconds_search += started.elapsed().as_secs_f64();
-            stats.searches += 1;
-            // candidates one at a time: the search stops at the first that passes
-            for tested in 0..limit {
-                // the checks of many rejected candidates can take longer than the searches
-                if deadline.is_some_and(|d| std::time::Instant::now() >= d) {
-                    stopped =
-                        Some(limit_reason(index, options, &PlacementError::TimeLimit { found: tested }, started_plan));
-                    break 'parts;
-                }
-                if tested == options.candidates {
-                    stats.repeated_searches += 1;
-                    tracing::debug!(index, "every candidate failed the checks: searching for more");
-                }
-                let started = std::time::Instant::now();
-                // a later stage's part is taken only when strictly cheaper than an earlier stage's (below): past the
-                // cheapest accepted cost the search has nothing left that could be taken
-                let next = match search.next_placements_within(1, beaten_at.unwrap_or(f64::INFINITY)) {
-                    Ok(next) => next,
-                    Err(e @ (PlacementError::NodeBudget { .. } | PlacementError::TimeLimit { .. })) => {
-                        stopped = Some(limit_reason(index, options, &e, started_plan));
-                        break 'parts;
-                    }
-                    Err(e) => return Err(e.into()),
-                };
-                stats.seconds_search += started.elapsed().as_secs_f64();
-                let Some(candidate) =
-                    next.placements.first().filter(|c| beaten_at.is_none_or(|at| cheaper(c.cost, at)))
-                else {
-                    if tested == 0 {
-                        last_reason = match next.exhausted {
-                            Some(NoPlacement::EmptyOmega) => "the floor volume is too small for the part".into(),
-                            _ => "no interference-free position inside the floor volume".into(),
-                        };
-                    }
-                    break;
-                };
-                let started = std::time::Instant::now();
-                stats.candidates_checked += 1;
-                let mut candidate = settled(part, &rests, candidate, search.scene(), &cache, tol, &request.cost)?;
-                // stage 1's floor is the clipped footprint: its sides are walls only where they lie on the plan's
-                if polygon.is_some() {
-                    candidate.0.contacts = sides_of_floor(&candidate.0.contacts, &request.floor, &options.floor, tol);
-                }
-                let mut verdict = accept(&mut growing, part, &candidate.0, &mut stats)?;
-                // the lowest release above the rest that keeps the clearance (the search's may float far above it),
-                // for a candidate the checks accepted (most rejected ones fail the stability test, which does not
-                // depend on the release)
-                let search_drop = candidate.1;
-                let pose = candidate.0.pose();
-                if verdict.is_ok() {
-                    candidate.1 = lowest_release(
-                        part,
-                        pose.rotation,
-                        pose.position,
-                        search_drop,
-                        search.scene(),
-                        &cache,
-                        options.clearance,
-                        options.insertion,
-                        tol,
-                    )?;
-                }
-                // the clearance at the release position as the plan's check measures it: at the lowered release, else
-                // (should the check's measure and the search's obstacles disagree within their tolerances) at the
-                // search's own
-                if verdict.is_ok() && options.clearance > 0.0 {
-                    let placed = PlacedPart { part, rotation: pose.rotation, position: pose.position };
-                    let mut keeps = growing
-                        .keeps_clearance(placed, candidate.1, options.clearance)
-                        .map_err(|e| PlanError::Check(e.to_string()))?;
-                    if !keeps && candidate.1 < search_drop {
-                        tracing::debug!(
-                            index,
-                            lowered = candidate.1,
-                            search_drop,
-                            "lowered release rejected by the check"
-                        );
-                        candidate.1 = search_drop;
-                        keeps = growing
-                            .keeps_clearance(placed, candidate.1, options.clearance)
-                            .map_err(|e| PlanError::Check(e.to_string()))?;
-                    }
-                    if !keeps {
-                        stats.rejected_clearance += 1;
-                        verdict = Err("the best interference-free positions were rejected (last: closer to a placed \
-                                       part than the clearance)"
-                            .into());
-                    }
-                }
-                stats.seconds_checks += started.elapsed().as_secs_f64();
-                tracing::trace!(
-                    index,
-                    stage,
-                    tested,
-                    cost = candidate.0.cost,
-                    theta_deg = candidate.0.theta_deg,
-                    resting_pose = candidate.0.resting_pose,
-                    position = ?candidate.0.position,
-                    nodes = search.stats().nodes_expanded,
-                    verdict = ?verdict,
-                    "candidate tested"
-                );
-                match verdict {
-                    Ok(grasp_radius) => {
-                        accepted.push((stage, candidate, tested, grasp_radius));
-                        break;
-                    }
-                    Err(reason) => last_reason = reason,
-                }
-            }
-            if polygon.is_some() {
-                stage_one_region = polygon;
-            }
-            let searched = search.stats();
-            stats.pairs_evaluated += searched.pairs_evaluated;
-            stats.obstacles_constructed += searched.obstacles_constructed;
-            stats.obstacles_extrapolated += searched.obstacles_extrapolated;
-            stats.cells_unsolved += searched.cells_unsolved;
-            tracing::debug!(
-                index,
-                stage,
-                nodes = searched.nodes_expanded,
-                pairs = searched.pairs_evaluated,
-                known_cuts = searched.known_obstacle_cuts,
-                detections = searched.interference_tests,
-                pushed = searched.nodes_pushed,
-                qps = searched.qp_solves,
-                orientations = searched.orientations_considered,
-                ms_detect = searched.time_interference_ms,
-                ms_obstacles = searched.time_obstacles_ms,
-                ms_cells = searched.time_cells_ms,
-                ms = searched.time_total_ms,
-                "stage searched"
-            );
-        }
-        // stage 1 (compact) wins unless stage 2 is strictly cheaper: ties and near-ties keep the stack compact
-        let best = accepted.iter().min_by(|a, b| {
-            let (ca, cb) = (a.1.0.cost, b.1.0.cost);
-            if cheaper(ca, cb) {
-                std::cmp::Ordering::Less
-            } else if cheaper(cb, ca) {
-                std::cmp::Ordering::Greater
-            } else {
-                a.0.cmp(&b.0)
-            }
-        });
-        if let Some((stage, (candidate, release_drop), rejected, grasp_radius)) = best.cloned() {
-            let pose = candidate.pose();
-            placed.push(pose);
-            growing
-                .push(PlacedPart { part, rotation: pose.rotation, position: pose.position })
-                .map_err(|e| PlanError::Check(e.to_string()))?;
-            planned.push(PlannedPart {
-                position: candidate.position,
-                rotation: candidate.rotation,
-                index,
-                theta_deg: candidate.theta_deg,
-                resting_pose: candidate.resting_pose,
-                stage,
-                cost: candidate.cost,
-                contacts: candidate.contacts.clone(),
-                release_drop,
-                rejected_candidates: rejected,
-                cg_height: pose.apply(part.mass.center_of_gravity).z,
-                stability_margin: None,
-                grasp_radius,
-            });
-            progress(planned.len(), options.count);
-            tracing::info!(index, stage, cost = candidate.cost, "placed part");
-            continue 'parts;
-        }
-        stopped = Some(format!("part {} of {} could not be placed: {last_reason}", index + 1, options.count));
-        break;
-    }
-    // the finished stack, checked once with robustness margins
+    Ok(rests)
+}
+
+/// The plan: the finished stack checked once with robustness margins (each part's margin), its footprint, height
+/// and total cost.
+fn finish(planner: Planner<'_>, check_options: &CheckOptions, stopped: Option<String>) -> Result<Plan, PlanError> {
+    let Planner { part, options, rests, cache, caches, floor_caches, placed, mut planned, mut stats, .. } = planner;
     let started = std::time::Instant::now();
     let world: Vec<PlacedPart<'_>> =
         placed.iter().map(|p| PlacedPart { part, rotation: p.rotation, position: p.position }).collect();
     let final_check =
-        check_stack(&world, &CheckOptions { margin_directions: 8, prefix_stability: true, ..check_options })
+        check_stack(&world, &CheckOptions { margin_directions: 8, prefix_stability: true, ..check_options.clone() })
             .map_err(|e| PlanError::Check(e.to_string()))?;
     stats.seconds_checks += started.elapsed().as_secs_f64();
     tracing::debug!(ms = started.elapsed().as_secs_f64() * 1e3, "final stack check (with margins)");
@@ -693,8 +467,8 @@ fn plan_stack_here(
     }
     // the searches' carried frontiers and obstacles (about 200 MB for the 15-part Complex plan) are freed on a thread
     // of the pool while the plan is returned and used: freeing them here took about a tenth of that plan's time
-    rayon::spawn(move || drop((caches, cache)));
-    let (lo, hi) = if placed.is_empty() { (DVec2::ZERO, DVec2::ZERO) } else { footprint(part, &placed) };
+    rayon::spawn(move || drop((caches, floor_caches, cache)));
+    let (lo, hi) = if placed.is_empty() { (DVec2::ZERO, DVec2::ZERO) } else { floor::footprint(part, &placed) };
     let height = placed.iter().flat_map(|p| part.all_vertices().map(move |v| p.apply(v).z)).fold(0.0f64, f64::max);
     Ok(Plan {
         options: options.clone(),
@@ -707,110 +481,6 @@ fn plan_stack_here(
         stack_stable: final_check.stack.verdict.is_stable(),
         stats,
     })
-}
-
-/// Whether cost `a` beats cost `b` outright: cheaper by more than a near-tie (`1e-9` relative), which keeps the
-/// earlier (more compact) stage's part.
-fn cheaper(a: f64, b: f64) -> bool {
-    b - a > 1e-9 * (1.0 + a.abs().max(b.abs()))
-}
-
-/// `contacts` found on the floor `searched` (stage 1's clipped region) with their `floor_side` contacts renumbered
-/// as sides of `floor`, the plan's: a side of `searched` on the line of a side of `floor` (parallel outward normals,
-/// offsets within `tol`) is that side; any other side of `searched` is no wall, and its contact is dropped. O(contacts
-/// x sides).
-fn sides_of_floor(contacts: &[Contact], searched: &FloorVolume, floor: &FloorVolume, tol: f64) -> Vec<Contact> {
-    let (searched_sides, floor_sides) = (searched.side_planes(), floor.side_planes());
-    let mut out: Vec<Contact> = Vec::with_capacity(contacts.len());
-    for contact in contacts {
-        let contact = match *contact {
-            Contact::FloorSide { side } => {
-                let Some(&(n, d)) = searched_sides.get(side as usize) else { continue };
-                let on_line = floor_sides.iter().position(|&(m, e)| (n - m).length() <= 1e-9 && (d - e).abs() <= tol);
-                match on_line {
-                    Some(k) => Contact::FloorSide { side: k as u32 },
-                    None => continue,
-                }
-            }
-            ref other => other.clone(),
-        };
-        if !out.contains(&contact) {
-            out.push(contact);
-        }
-    }
-    out
-}
-
-/// The xy bounding rectangle of the placed parts.
-fn footprint(part: &Part, placed: &[Pose]) -> (DVec2, DVec2) {
-    let mut lo = DVec2::splat(f64::INFINITY);
-    let mut hi = DVec2::splat(f64::NEG_INFINITY);
-    for p in placed {
-        for v in part.all_vertices() {
-            let w = p.apply(v).truncate();
-            lo = lo.min(w);
-            hi = hi.max(w);
-        }
-    }
-    (lo, hi)
-}
-
-/// The candidate settled ([`crate::settle`]): at its resting position, with its cost there and what stopped it, and
-/// the drop from the release position.
-fn settled(
-    part: &Part,
-    rests: &[DMat3],
-    candidate: &Placement,
-    scene: &StackScene,
-    cache: &ObstacleCache,
-    tol: f64,
-    cost: &Cost,
-) -> Result<(Placement, f64), PlanError> {
-    let pose = candidate.pose();
-    let s = settle(part, pose.rotation, pose.position, scene, cache, tol)?;
-    let Some(contacts) = s.contacts else {
-        return Ok((candidate.clone(), 0.0));
-    };
-    let rest = rests.get(candidate.resting_pose).copied().unwrap_or(DMat3::IDENTITY);
-    let quadratic =
-        Orientation::without_components(part, 0, candidate.resting_pose, 0, candidate.theta, rest, cost).quadratic;
-    let settled =
-        Placement { position: s.position.to_array(), cost: quadratic.value(s.position), contacts, ..candidate.clone() };
-    Ok((settled, s.drop))
-}
-
-/// Tests one candidate on the stack placed so far: `Ok(Ok(grasp radius))` when it passes, `Ok(Err(reason))` when it
-/// does not. The stack passed these tests when its parts were added, so only the new part is tested
-/// ([`GrowingStack::check_candidate`]: the verdicts of [`stackplan_stability::check_added_part`]'s report that
-/// matter here, in this order, up to the first that fails).
-fn accept(
-    growing: &mut GrowingStack<'_>,
-    part: &Part,
-    candidate: &Placement,
-    stats: &mut PlanStats,
-) -> Result<Result<f64, String>, PlanError> {
-    let pose = candidate.pose();
-    let tested = growing
-        .check_candidate(PlacedPart { part, rotation: pose.rotation, position: pose.position })
-        .map_err(|e| PlanError::Check(e.to_string()))?;
-    if let Err(Rejection::NotStable(Verdict::Unknown(status)) | Rejection::StackNotStable(Verdict::Unknown(status))) =
-        &tested
-    {
-        // never read as stable, but not a proof either: counted apart so the plan says so
-        stats.undecided_verdicts += 1;
-        tracing::warn!(status, position = ?pose.position, "equilibrium undecided for a candidate: rejected as not stable");
-    }
-    let (reason, count) = match tested {
-        Ok(accepted) => return Ok(Ok(accepted.grasp_radius)),
-        Err(Rejection::NotStable(_)) => ("not stable on its supports", &mut stats.rejected_not_stable),
-        Err(Rejection::StackNotStable(_)) => ("the stack would not be stable", &mut stats.rejected_stack_not_stable),
-        Err(Rejection::NotGraspable) => ("no suction face for the cup", &mut stats.rejected_not_graspable),
-        Err(Rejection::NotInsertable(_)) => {
-            ("cannot be lowered straight down into place", &mut stats.rejected_not_insertable)
-        }
-    };
-    *count += 1;
-    Ok(Err(format!("the best interference-free positions were rejected (last: {reason})")))
 }
 
 /// Why resting pose `k` offers no grasp: no upward face within the grasp tilt of level (and how far the most level
@@ -841,27 +511,11 @@ fn why_not_graspable(
     }
 }
 
-/// Why a plan ended at part `index` on a search limit (node budget or time), with the parts it keeps.
-fn limit_reason(index: usize, options: &PlanOptions, e: &PlacementError, started: std::time::Instant) -> String {
-    let limit = match e {
-        PlacementError::TimeLimit { .. } => {
-            format!("the time limit of {} s was reached", options.time_limit.unwrap_or(0.0))
-        }
-        _ => format!("the search exceeded its node budget of {} nodes", options.node_budget),
-    };
-    format!(
-        "part {} of {} could not be placed: {limit} after {:.1} s; the {index} parts placed before it are kept",
-        index + 1,
-        options.count,
-        started.elapsed().as_secs_f64()
-    )
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use stackplan_geom::convex_hull;
     use stackplan_geom::part::PartOrigin;
+    use stackplan_geom::{Pose, convex_hull};
 
     fn block(x: f64, y: f64, z: f64) -> Part {
         let pts: Vec<DVec3> = (0..8)
@@ -875,56 +529,6 @@ mod tests {
             .collect();
         let hull = convex_hull(&pts).expect("box").polytope;
         Part::from_components("block", vec![hull], 1.0, PartOrigin::ConvexPieces).expect("part")
-    }
-
-    /// The Complex plan's footprint at parts 9 and 10 (`w 0.9`): interpolated cuts left corners an ulp off the
-    /// rectangle (-270.99999999999994 beside -271), so the grown footprint did not contain the last one exactly and
-    /// the carried stage-1 frontier was dropped (6 800 nodes searched again from the roots).
-    #[test]
-    fn clipped_footprints_have_their_corners_on_the_rectangle_and_contain_the_smaller_ones() {
-        let floor = FloorVolume::rectangle(-501.5, -501.5, 501.5, 501.5, 1212.0).polygon;
-        let lo = DVec2::new(-271.0, -237.00000000000006);
-        let small = clip_to_rectangle(&floor, lo, DVec2::new(262.0, 274.00000000000006));
-        let grown = clip_to_rectangle(&floor, lo, DVec2::new(271.0, 274.00000000000006));
-        for (poly, hi) in [(&small, 262.0), (&grown, 271.0)] {
-            assert_eq!(poly.len(), 4);
-            for c in poly.iter() {
-                assert!(c.x == lo.x || c.x == hi, "{c:?}");
-                assert!(c.y == lo.y || c.y == 274.00000000000006, "{c:?}");
-            }
-        }
-        let sides = crate::request::polygon_side_planes(&grown);
-        assert!(small.iter().all(|&c| sides.iter().all(|&(n, d)| n.dot(c) <= d)), "{small:?} not inside {grown:?}");
-        // a floor that is no rectangle: the cuts lie on the rectangle's sides, its own corners stay
-        let hexagon: Vec<DVec2> = (0..6)
-            .map(|k| {
-                let a = std::f64::consts::PI / 3.0 * k as f64 + 0.1;
-                DVec2::new(500.0 * a.cos(), 500.0 * a.sin())
-            })
-            .collect();
-        let cut = clip_to_rectangle(&hexagon, DVec2::new(-301.3, -299.7), DVec2::new(299.9, 300.1));
-        for c in &cut {
-            let on_side = c.x == -301.3 || c.x == 299.9 || c.y == -299.7 || c.y == 300.1;
-            assert!(on_side || hexagon.contains(c), "{c:?}");
-        }
-    }
-
-    #[test]
-    fn stage_one_floor_sides_are_renumbered_or_dropped() {
-        let floor = FloorVolume::rectangle(0.0, 0.0, 100.0, 50.0, 10.0);
-        // the footprint clipped at x <= 40: its sides 0 (y = 0), 2 (y = 50) and 3 (x = 0) lie on the floor's sides 0,
-        // 2 and 3; its side 1 (x = 40) is no wall
-        let searched = FloorVolume {
-            polygon: clip_to_rectangle(&floor.polygon, DVec2::new(-5.0, -5.0), DVec2::new(40.0, 60.0)),
-            height: 10.0,
-        };
-        assert_eq!(searched.polygon.len(), 4);
-        let side = |side: u32| Contact::FloorSide { side };
-        let stack = Contact::Stack { our_component: 0, stack_part: 0, stack_component: 1, face_kind: "x".into() };
-        let found = [Contact::Floor, side(1), stack.clone(), side(0), side(3)];
-        assert_eq!(searched.polygon, [(0.0, 0.0), (40.0, 0.0), (40.0, 50.0), (0.0, 50.0)].map(DVec2::from));
-        let expected = [Contact::Floor, stack, side(0), side(3)];
-        assert_eq!(sides_of_floor(&found, &searched, &floor, 1e-9), expected);
     }
 
     fn options(count: usize, w: f64, floor: FloorVolume) -> PlanOptions {
@@ -1015,6 +619,36 @@ mod tests {
         // the rejections are proofs of instability, not solver failures
         assert!(repeated.stats.rejected_not_stable + repeated.stats.rejected_stack_not_stable >= 1);
         assert_eq!(repeated.stats.undecided_verdicts, 0);
+    }
+
+    /// L-corner at w = 0.9 (columns) with a limit of two candidates: from the fourth part on, the two cheapest
+    /// candidates (on the column) fail the checks, and with `max_candidates = 1` the plan ends at part 4. The
+    /// cheapest floor position that passes bounds the search and places each of them on the floor: the plan is
+    /// complete, those parts rest on the floor at their pose's resting height, and the finished stack passes the
+    /// whole-stack check.
+    #[test]
+    fn the_floor_places_a_part_whose_cheaper_candidates_all_fail() {
+        let part =
+            stackplan_geom::examples::part_by_name("l-corner", stackplan_geom::sheet_metal::Decomposition::ConvexMerge)
+                .expect("example");
+        let floor = FloorVolume::rectangle(-300.0, -300.0, 300.0, 300.0, 400.0);
+        let mut options = PlanOptions { w: 0.9, dtheta: 15f64.to_radians(), ..PlanOptions::new(8, floor) };
+        options.candidates = 1;
+        options.max_candidates = 1;
+        let cut = plan_stack(&part, &options).expect("plan");
+        assert!(cut.stopped.as_deref().is_some_and(|r| r.contains("part 4 of 8")), "{:?}", cut.stopped);
+        options.max_candidates = 2;
+        let plan = plan_stack(&part, &options).expect("plan");
+        assert!(plan.stopped.is_none() && plan.parts.len() == 8 && plan.stack_stable, "{:?}", plan.stopped);
+        assert_eq!(&plan.parts[..3], &cut.parts[..3]);
+        let on_floor: Vec<&PlannedPart> = plan.parts.iter().filter(|p| p.rejected_candidates == 2).collect();
+        assert!(on_floor.len() >= 3, "{:?}", plan.parts.iter().map(|p| p.rejected_candidates).collect::<Vec<_>>());
+        for p in on_floor {
+            assert!(p.contacts.contains(&Contact::Floor), "part {}: {:?}", p.index, p.contacts);
+            let pose = Pose::from_rows(p.rotation, DVec3::from_array(p.position)).expect("a proper rotation");
+            let lowest = part.all_vertices().map(|v| pose.apply(v).z).fold(f64::INFINITY, f64::min);
+            assert!(lowest.abs() < 1e-9, "part {} rests {lowest} mm above the floor", p.index);
+        }
     }
 
     /// Channel at w = 0.9 with one candidate per stage: the seventh part's stage 1 accepts a position on the stack
@@ -1109,14 +743,5 @@ mod tests {
         assert!(message.contains("6 stable resting poses") && message.contains("10 mm"), "{message}");
         let plan = plan_stack(&part, &PlanOptions { cup_diameter: 3.0, ..options(2, 0.5, floor) }).expect("plan");
         assert_eq!(plan.parts.len(), 2);
-    }
-
-    #[test]
-    fn clipping_keeps_the_convex_intersection() {
-        let square = [DVec2::ZERO, DVec2::new(4.0, 0.0), DVec2::new(4.0, 4.0), DVec2::new(0.0, 4.0)];
-        let c = clip_to_rectangle(&square, DVec2::new(1.0, -1.0), DVec2::new(2.0, 5.0));
-        let area: f64 = (0..c.len()).map(|k| c[k].perp_dot(c[(k + 1) % c.len()])).sum::<f64>() / 2.0;
-        assert!((area - 4.0).abs() < 1e-12);
-        assert!(clip_to_rectangle(&square, DVec2::new(5.0, 5.0), DVec2::new(6.0, 6.0)).is_empty());
     }
 }
