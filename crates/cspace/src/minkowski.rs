@@ -23,16 +23,8 @@
 //! produce all the time). A face polygon is built from the generating features: a face of `B` translated by a vertex
 //! keeps `B`'s vertex cycle, a face of `A` keeps `A`'s (reversed by the point reflection), an edge pair gives a
 //! parallelogram; only the degenerate merged faces need a 2-D convex sum `F + G` of the two generating polygons (a face,
-//! or an edge as a 2-gon). It is the classic O(|F| + |G|) merge of the two edge sequences by angle (the edges of a sum
-//! of convex polygons are the summands' edges in angular order), on vertex labels, without coordinates: an edge of `F`
-//! and an edge of `G` are ONE edge of the sum (their middle corner is not a corner) when the faces across them are
-//! merged too, or when their unit directions point the same way within half the tolerance (`|c_a x c_b| <= tol / 2`,
-//! the threshold of merged face normals, so that a rotation about a face normal by less than it merges the faces and
-//! their edges alike). Every other decision of the merge is the sign of `(v x w) . u` for two edge directions that
-//! are not parallel, which rounding cannot flip; a face plus an edge (most merged faces of sheet metal rotated about
-//! `z`) takes a one-pass form of the same rule (`face_plus_segment`). A labelled 2-D hull of the `|F| |G|` rounded sum
-//! points, with duplicates and corners within a *length* tolerance removed, gives the same faces on every input away
-//! from the tolerance band, but within it its length rule can contradict the angle rule of the unmerged side faces.
+//! or an edge as a 2-gon): the O(|F| + |G|) merge of their edge sequences by angle, on vertex labels, with the same
+//! angular tolerance for parallel edges (`planar.rs`).
 //!
 //! Why a tolerance and not exact predicates: the input to this step is a *rotated* polytope whose coordinates are
 //! already rounded (`cos(pi / 2)` is not 0 in `f64`), so exact parallelism of a rotated face with a fixed one cannot be
@@ -52,256 +44,21 @@
 //! `Gaussian_map`); each merged face costs O(|F| + |G|). The face count is at most `4 m n - 9 m - 9 n + 26` for `m`
 //! and `n` facets.
 //!
-//! Two z-prisms turned about `z` (sheet-metal plates under the planner's rotations) skip the sign tables and the
-//! crossing pass: for them those numbers are exact zeros by the data, and `z_prism.rs` builds the same face list
-//! (bit for bit the same obstacle) in O(FA FB + FB EA + FA EB) with far fewer products; for a *tame* such pair (the
-//! usual one, away from quarter turns) it builds the obstacle in one pass over the merged pole chains of the two
-//! cross-sections (`prism_merge.rs`: face cycles, numbering, offsets and edge table from the chain positions) instead
-//! of merging polygons and the general assembly's half-edge table, with the same result; when that pass refuses, it
-//! reads every face cycle off the features (`z_prism::derived_cycles`) and numbers, offsets and links them from the
-//! prism structure (`prism_assembly.rs`).
+//! Two z-prisms turned about `z` (sheet-metal plates under the planner's rotations) take one fast path, with the same
+//! result bit for bit: for them the sign tables and the crossing pass are exact zeros by the data, and `z_prism.rs`
+//! builds the same face list in O(FA FB + FB EA + FA EB) with far fewer products; for a *tame* such pair (the usual
+//! one, away from quarter turns) it also reads every face cycle off the features (`z_prism::derived_cycles`) instead
+//! of merging polygons. Both go through the same assembly.
 
 use glam::{DMat3, DVec3};
-use serde::{Deserialize, Serialize};
-use stackplan_geom::polytope::{Containment, ConvexPolytope, Face, Plane, PolytopeError};
-use stackplan_geom::tolerance::{RELATIVE, Tolerance};
-use stackplan_geom::{HullError, VertexCycle, convex_hull};
+use stackplan_geom::polytope::{ConvexPolytope, Face, Plane};
+use stackplan_geom::{VertexCycle, convex_hull};
 
 use crate::edge_table::{self, EdgeScratch};
-use crate::{prism_assembly, prism_merge, z_prism};
-
-/// Angular tolerance (radians) of the Gauss-map decisions: a face normal within this of an arc's circle lies on it;
-/// two face normals within half of it are the same direction.
-pub const ANGULAR_TOLERANCE: f64 = RELATIVE;
-
-/// A feature (vertex, edge or face index) of one of the two polytopes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(tag = "feature", content = "index", rename_all = "snake_case")]
-pub enum Feature {
-    /// A vertex index.
-    Vertex(usize),
-    /// An edge index (into [`ConvexPolytope::edges`]).
-    Edge(usize),
-    /// A face index.
-    Face(usize),
-}
-
-/// What generated a face of the obstacle. Indices refer to the moving polytope `A` (vertices, edges, faces of `A` in
-/// its own coordinates) and the fixed polytope `B`.
-///
-/// The first three kinds are the generic ones (\[A\] App. B; `docs/algorithms.md`, "C-space obstacle of a convex
-/// pair"). The last three are the merged faces of degenerate configurations (parallel faces, a face parallel to an
-/// edge): they are exactly one face of the sum and name both generating features.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-pub enum FaceKind {
-    /// Face `face_b` of `B` translated by vertex `vertex_a` of `-RA`: normal = that face's normal.
-    FixedFace {
-        /// Face of `B`.
-        face_b: usize,
-        /// Vertex of `A`.
-        vertex_a: usize,
-    },
-    /// Face `face_a` of `-RA` translated by vertex `vertex_b` of `B`: normal = `-R n_A`.
-    MovingFace {
-        /// Face of `A`.
-        face_a: usize,
-        /// Vertex of `B`.
-        vertex_b: usize,
-    },
-    /// Parallelogram spanned by edge `edge_a` of `-RA` and edge `edge_b` of `B`: normal orthogonal to both.
-    EdgeEdge {
-        /// Edge of `A`.
-        edge_a: usize,
-        /// Edge of `B`.
-        edge_b: usize,
-    },
-    /// Degenerate: face `face_b` of `B` plus a parallel edge `edge_a` of `-RA`.
-    FixedFaceMovingEdge {
-        /// Face of `B`.
-        face_b: usize,
-        /// Edge of `A`.
-        edge_a: usize,
-    },
-    /// Degenerate: face `face_a` of `-RA` plus a parallel edge `edge_b` of `B`.
-    MovingFaceFixedEdge {
-        /// Face of `A`.
-        face_a: usize,
-        /// Edge of `B`.
-        edge_b: usize,
-    },
-    /// Degenerate: face `face_b` of `B` and the parallel face `face_a` of `-RA` (opposite normals in `A`'s frame).
-    FaceFace {
-        /// Face of `A`.
-        face_a: usize,
-        /// Face of `B`.
-        face_b: usize,
-    },
-    /// Only from the hull route on input within rounding of a degenerate configuration: the face's vertex provenance
-    /// does not name a pair of features that can generate a face.
-    Unclassified,
-}
-
-impl FaceKind {
-    /// The kind from the two generating features (`None` if they cannot generate a face).
-    pub fn from_features(fixed: Feature, moving: Feature) -> Option<Self> {
-        Some(match (fixed, moving) {
-            (Feature::Face(face_b), Feature::Vertex(vertex_a)) => Self::FixedFace { face_b, vertex_a },
-            (Feature::Vertex(vertex_b), Feature::Face(face_a)) => Self::MovingFace { face_a, vertex_b },
-            (Feature::Edge(edge_b), Feature::Edge(edge_a)) => Self::EdgeEdge { edge_a, edge_b },
-            (Feature::Face(face_b), Feature::Edge(edge_a)) => Self::FixedFaceMovingEdge { face_b, edge_a },
-            (Feature::Edge(edge_b), Feature::Face(face_a)) => Self::MovingFaceFixedEdge { face_a, edge_b },
-            (Feature::Face(face_b), Feature::Face(face_a)) => Self::FaceFace { face_a, face_b },
-            _ => return None,
-        })
-    }
-
-    /// The generating feature of `B` (`None` for [`FaceKind::Unclassified`]).
-    pub fn fixed_feature(&self) -> Option<Feature> {
-        Some(match *self {
-            Self::FixedFace { face_b, .. }
-            | Self::FixedFaceMovingEdge { face_b, .. }
-            | Self::FaceFace { face_b, .. } => Feature::Face(face_b),
-            Self::MovingFace { vertex_b, .. } => Feature::Vertex(vertex_b),
-            Self::EdgeEdge { edge_b, .. } | Self::MovingFaceFixedEdge { edge_b, .. } => Feature::Edge(edge_b),
-            Self::Unclassified => return None,
-        })
-    }
-
-    /// The generating feature of `A` (`None` for [`FaceKind::Unclassified`]).
-    pub fn moving_feature(&self) -> Option<Feature> {
-        Some(match *self {
-            Self::FixedFace { vertex_a, .. } => Feature::Vertex(vertex_a),
-            Self::MovingFace { face_a, .. }
-            | Self::MovingFaceFixedEdge { face_a, .. }
-            | Self::FaceFace { face_a, .. } => Feature::Face(face_a),
-            Self::EdgeEdge { edge_a, .. } | Self::FixedFaceMovingEdge { edge_a, .. } => Feature::Edge(edge_a),
-            Self::Unclassified => return None,
-        })
-    }
-
-    /// The snake-case name used in JSON (`fixed_face`, `moving_face`, `edge_edge`, ...).
-    pub fn name(&self) -> &'static str {
-        match self {
-            Self::FixedFace { .. } => "fixed_face",
-            Self::MovingFace { .. } => "moving_face",
-            Self::EdgeEdge { .. } => "edge_edge",
-            Self::FixedFaceMovingEdge { .. } => "fixed_face_moving_edge",
-            Self::MovingFaceFixedEdge { .. } => "moving_face_fixed_edge",
-            Self::FaceFace { .. } => "face_face",
-            Self::Unclassified => "unclassified",
-        }
-    }
-}
-
-/// How an obstacle was built.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Route {
-    /// Gauss-map overlay (the normal route).
-    GaussMap,
-    /// Exact-predicate hull of the difference points (fallback on inconsistent near-degenerate overlays).
-    Hull,
-}
-
-/// Why an obstacle could not be built.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum ObstacleError {
-    /// The rotation has a non-finite entry.
-    #[error("the rotation matrix has a non-finite entry")]
-    NonFiniteRotation,
-    /// The difference points have no 3-D hull (a flat or empty component).
-    #[error("the difference points have no 3-D hull: {0}")]
-    Hull(#[from] HullError),
-    /// The assembled boundary is not a polytope (a bug or non-convex input).
-    #[error("the assembled obstacle is not a polytope: {0}")]
-    Polytope(#[from] PolytopeError),
-}
-
-/// The c-space obstacle of a convex pair with provenance. See the module documentation.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Obstacle {
-    polytope: ConvexPolytope,
-    vertex_pairs: Vec<[usize; 2]>,
-    face_kinds: Vec<FaceKind>,
-    rotation: DMat3,
-    route: Route,
-}
-
-impl Obstacle {
-    /// The obstacle as a polytope: vertices, faces (counter-clockwise from outside, unit-normal planes
-    /// `n . p <= d` inside), edges.
-    pub fn polytope(&self) -> &ConvexPolytope {
-        &self.polytope
-    }
-
-    /// `vertex_pairs()[v] = [i, j]`: vertex `v` is `V_j^B - R V_i^A` (`i` a vertex of the moving `A`, `j` of `B`),
-    /// computed as `b[j] - (R * a[i])`.
-    pub fn vertex_pairs(&self) -> &[[usize; 2]] {
-        &self.vertex_pairs
-    }
-
-    /// `face_kinds()[f]`: what generated face `f`.
-    pub fn face_kinds(&self) -> &[FaceKind] {
-        &self.face_kinds
-    }
-
-    /// The structure of the obstacle: per face its kind (with the generating features, as `Debug` text) and its cycle
-    /// of vertex provenances `[i, j]` rotated to start at the smallest, as a set. Two obstacles with equal structures
-    /// have the same faces from the same features (what orientation intervals and extrapolation rely on; the
-    /// coordinates may differ). O(size log size).
-    pub fn structure(&self) -> std::collections::BTreeSet<(String, Vec<[usize; 2]>)> {
-        self.polytope
-            .faces()
-            .iter()
-            .zip(&self.face_kinds)
-            .map(|(f, k)| {
-                let cycle: Vec<[usize; 2]> = f.vertices.iter().map(|&v| self.vertex_pairs[v]).collect();
-                let start = (0..cycle.len()).min_by_key(|&s| cycle[s]).unwrap_or(0);
-                let mut canonical = cycle[start..].to_vec();
-                canonical.extend_from_slice(&cycle[..start]);
-                (format!("{k:?}"), canonical)
-            })
-            .collect()
-    }
-
-    /// The rotation `R` of the moving component.
-    pub fn rotation(&self) -> DMat3 {
-        self.rotation
-    }
-
-    /// How it was built.
-    pub fn route(&self) -> Route {
-        self.route
-    }
-
-    /// The H-representation: `p` is in the obstacle iff `plane.normal . p <= plane.offset` for every plane.
-    pub fn planes(&self) -> impl ExactSizeIterator<Item = &Plane> + '_ {
-        self.polytope.planes()
-    }
-
-    /// Where `p` is: interior = interference, boundary = touching, exterior = free.
-    pub fn classify(&self, p: DVec3, tol: Tolerance) -> Containment {
-        self.polytope.containment(p, tol)
-    }
-
-    /// Whether `p` interferes (strictly inside by more than `tol`).
-    pub fn interferes(&self, p: DVec3, tol: Tolerance) -> bool {
-        self.classify(p, tol) == Containment::Interior
-    }
-
-    /// Assembles an obstacle from parts (used by extrapolation in later crates; checks nothing beyond lengths).
-    pub fn from_parts(
-        polytope: ConvexPolytope,
-        vertex_pairs: Vec<[usize; 2]>,
-        face_kinds: Vec<FaceKind>,
-        rotation: DMat3,
-        route: Route,
-    ) -> Option<Self> {
-        (polytope.vertices().len() == vertex_pairs.len() && polytope.faces().len() == face_kinds.len())
-            .then_some(Self { polytope, vertex_pairs, face_kinds, rotation, route })
-    }
-}
+use crate::planar::{PlanarScratch, face_plus_segment, planar_merge};
+pub use crate::types::{ANGULAR_TOLERANCE, FaceKind, Feature, Obstacle, ObstacleError, OverlayFailure, Route};
+use crate::types::{FaceSpec, PARALLEL_SQ, argmax};
+use crate::z_prism;
 
 /// The facet bound `4 m n - 9 m - 9 n + 26` of a Minkowski sum of 3-polytopes with `m` and `n` facets.
 pub fn facet_bound(m: usize, n: usize) -> usize {
@@ -380,23 +137,6 @@ fn identify_feature(p: &ConvexPolytope, ids: &mut Vec<usize>) -> Option<Feature>
     }
 }
 
-/// Why the overlay could not be assembled (then [`obstacle`] takes the hull route).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum OverlayFailure {
-    /// A face normal lies on more than one arc interior of the other polytope.
-    #[error("a face normal lies inside two arcs of the other Gauss map")]
-    AmbiguousSupport,
-    /// A face polygon has fewer than 3 corners.
-    #[error("a face of the sum has fewer than three corners")]
-    FlatFace,
-    /// The faces do not close up into a polytope.
-    #[error("the faces do not close up: {0}")]
-    Assembly(PolytopeError),
-    /// Euler's formula fails.
-    #[error("Euler's formula fails")]
-    Euler,
-}
-
 #[derive(Clone, Copy)]
 struct Arc {
     /// Unit circle normal, oriented so that the arc runs counter-clockwise about it from `from` to `to`.
@@ -467,42 +207,33 @@ struct Scratch {
     planar: PlanarScratch,
     edges: EdgeScratch,
     prism: z_prism::Scratch,
-    direct: prism_assembly::Scratch,
-    merge: prism_merge::Scratch,
+}
+
+impl Scratch {
+    /// The summands as the overlay sums them: the vertices `R a` and `-R a` of the moving polytope, the unit face
+    /// normals `-R n` of `-RA` and the face normals of `B`; no parallel faces and no face specs yet. O(VA + FA + FB).
+    fn prepare(&mut self, moving: &ConvexPolytope, rotation: DMat3, fixed: &ConvexPolytope) {
+        let Self { ra, neg_ra, am, bn, merged_with_b, merged_with_a, specs, .. } = self;
+        ra.clear();
+        ra.extend(moving.vertices().iter().map(|a| rotation * *a));
+        // -RA: vertices -ra, normals -R n; edge arcs computed from -ra.
+        neg_ra.clear();
+        neg_ra.extend(ra.iter().map(|r| -*r));
+        am.clear();
+        am.extend(moving.faces().iter().map(|f| -(rotation * f.plane.normal).normalize()));
+        bn.clear();
+        bn.extend(fixed.faces().iter().map(|f| f.plane.normal));
+        // parallel faces: merged_with_b[f] = Some(g) when -R n_f == n_g within half the tolerance.
+        merged_with_b.clear();
+        merged_with_b.resize(am.len(), None);
+        merged_with_a.clear();
+        merged_with_a.resize(bn.len(), None);
+        specs.clear();
+    }
 }
 
 thread_local! {
     static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
-}
-
-#[cfg(test)]
-thread_local! {
-    /// Tests: take the one-by-one crossing test even for at most 64 B arcs.
-    static ONE_BY_ONE_CROSSINGS: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-    /// Tests: take the general overlay even for a z-prism pair (`z_prism.rs`).
-    pub(crate) static GENERAL_ROUTE_ONLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-    /// Tests: assemble a tame z-prism pair by the polygon merges too (`z_prism::derived_cycles`).
-    pub(crate) static NO_DERIVED_CYCLES: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-    /// Tests: search the support of every side normal of a z-prism pair through all arcs (`z_prism::face_specs`).
-    pub(crate) static ALL_ARCS: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-    /// Tests: find the parallel faces of a z-prism pair by `z_prism::parallel_faces` first (not the poles alone).
-    pub(crate) static NO_POLE_MERGES_FIRST: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-    /// Tests: assemble the derived cycles of a tame z-prism pair by the general assembly (`prism_assembly.rs`).
-    pub(crate) static NO_DIRECT_ASSEMBLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-    /// Tests: build a tame z-prism pair from its derived cycles (`z_prism::derived_cycles`, `prism_assembly.rs`), not
-    /// from the merged chains (`prism_merge.rs`).
-    pub(crate) static NO_MERGED_CHAINS: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-}
-
-/// Whether the test switch `$switch` (a thread-local above) is on; always `false` outside the tests.
-macro_rules! test_switch {
-    ($switch:ident) => {{
-        #[cfg(test)]
-        let on = $switch.with(std::cell::Cell::get);
-        #[cfg(not(test))]
-        let on = false;
-        on
-    }};
 }
 
 /// The Gauss-map route alone, without the hull fallback (for tests and benchmarks).
@@ -522,7 +253,89 @@ pub fn gauss_map_obstacle(
         .unwrap_or_else(|| overlay(moving, rotation, fixed, &mut Scratch::default()))
 }
 
+/// The overlay of `-RA` and `B`: the z-prism route for two z-prisms turned about `z` (sheet metal, `z_prism.rs`),
+/// else the general one; the same obstacle either way, bit for bit.
 fn overlay(
+    moving: &ConvexPolytope,
+    rotation: DMat3,
+    fixed: &ConvexPolytope,
+    scratch: &mut Scratch,
+) -> Result<Obstacle, OverlayFailure> {
+    scratch.prepare(moving, rotation, fixed);
+    let Scratch { neg_ra, am, bn, prism, .. } = scratch;
+    let z_prisms = z_prism::vertical_arcs(moving, neg_ra, am, &mut prism.a_classes, &mut prism.a)
+        && z_prism::vertical_arcs(fixed, fixed.vertices(), bn, &mut prism.b_classes, &mut prism.b);
+    if z_prisms {
+        prism_overlay(moving, rotation, fixed, scratch)
+    } else {
+        general_overlay(moving, rotation, fixed, scratch)
+    }
+}
+
+/// The overlay of two z-prisms turned about `z` (vertical arcs from `z_prism::vertical_arcs` in `scratch.prism`): the
+/// general route's face specs without sign tables or arc crossings ([`prism_specs`]), and for a *tame* pair its face
+/// cycles read off the features (`z_prism::derived_cycles`) instead of the polygon merges; the general assembly.
+fn prism_overlay(
+    moving: &ConvexPolytope,
+    rotation: DMat3,
+    fixed: &ConvexPolytope,
+    scratch: &mut Scratch,
+) -> Result<Obstacle, OverlayFailure> {
+    let pair = prism_specs(fixed, scratch)?;
+    let Scratch { neg_ra, am, bn, specs, prism, .. } = scratch;
+    let derived = pair.tame && z_prism::derived_cycles(moving, fixed, neg_ra, am, bn, specs, prism);
+    prism_assemble(moving, rotation, fixed, scratch, pair, derived)
+}
+
+/// What [`prism_specs`] found out about a z-prism pair.
+#[derive(Clone, Copy)]
+struct PrismPair {
+    /// The merged pole faces need no faces across their edges: faces merged only within a class, and no side face
+    /// merged (`z_prism::no_side_merged`).
+    pole_faces_alone: bool,
+    /// Tame so far: faces merged only within a class, and every side normal inside the arc that supports it by more
+    /// than `z_prism::MARGIN` (what `z_prism::derived_cycles` requires of its caller).
+    tame: bool,
+}
+
+/// The face specs of a z-prism pair into `scratch.specs` (`z_prism::face_specs`: the general route's steps 1 and 2
+/// from exact zeros of the data; step 3 is empty). O(FA FB + FB EA_v + FA EB_v).
+fn prism_specs(fixed: &ConvexPolytope, scratch: &mut Scratch) -> Result<PrismPair, OverlayFailure> {
+    let Scratch { neg_ra, am, bn, merged_with_a, merged_with_b, specs, prism, .. } = scratch;
+    // as the general route: all parallel pairs (within a class when the poles are far from the sides)
+    let by_class = z_prism::parallel_faces(am, bn, &prism.a_classes, &prism.b_classes, merged_with_a, merged_with_b);
+    if !by_class {
+        all_parallel_faces(am, bn, merged_with_a, merged_with_b);
+    }
+    let mut margin = f64::INFINITY;
+    let (arcs, bv) = ((prism.a.as_slice(), prism.b.as_slice()), fixed.vertices());
+    z_prism::face_specs(am, bn, arcs, neg_ra, bv, merged_with_a, merged_with_b, specs, &mut margin)?;
+    Ok(PrismPair {
+        pole_faces_alone: by_class && z_prism::no_side_merged(&prism.a_classes, merged_with_b),
+        tame: by_class && margin > z_prism::MARGIN,
+    })
+}
+
+/// The obstacle of a z-prism pair from its face specs ([`prism_specs`]): from the cycles of `z_prism::derived_cycles`
+/// when `derived` (it accepted the pair), else by the general assembly's polygon merges.
+fn prism_assemble(
+    moving: &ConvexPolytope,
+    rotation: DMat3,
+    fixed: &ConvexPolytope,
+    scratch: &mut Scratch,
+    pair: PrismPair,
+    derived: bool,
+) -> Result<Obstacle, OverlayFailure> {
+    let Scratch { ra, neg_ra, merged_with_b, specs, index_of, cycle, planar, edges, prism, .. } = scratch;
+    let plain = if pair.pole_faces_alone { Some(prism.b_classes.as_slice()) } else { None };
+    let cycles = if derived { Some((prism.cycles.as_slice(), prism.starts.as_slice())) } else { None };
+    let buffers = AssemblyBuffers { index_of, cycle, planar, merged_with_b, neg_ra, edges, plain, cycles };
+    assemble(moving, fixed, rotation, ra, specs, buffers)
+}
+
+/// The general overlay of `-RA` and `B` (`scratch` prepared): steps 1-3 of the module documentation from the sign
+/// tables, then the general assembly. O(FA FB + EA EB + (FA + FB)(EA + EB) + output).
+fn general_overlay(
     moving: &ConvexPolytope,
     rotation: DMat3,
     fixed: &ConvexPolytope,
@@ -546,123 +359,10 @@ fn overlay(
         cycle,
         planar,
         edges,
-        prism,
-        direct,
-        merge,
+        ..
     } = scratch;
-    ra.clear();
-    ra.extend(moving.vertices().iter().map(|a| rotation * *a));
-    // -RA: vertices -ra, normals -R n; edge arcs computed from -ra.
-    neg_ra.clear();
-    neg_ra.extend(ra.iter().map(|r| -*r));
-    am.clear();
-    am.extend(moving.faces().iter().map(|f| -(rotation * f.plane.normal).normalize()));
     let bv = fixed.vertices();
-    bn.clear();
-    bn.extend(fixed.faces().iter().map(|f| f.plane.normal));
     let (fa, fb) = (am.len(), bn.len());
-
-    // two z-prisms turned about z (sheet metal): the same faces without sign tables or crossings (`z_prism.rs`)
-    let z_prisms = !test_switch!(GENERAL_ROUTE_ONLY)
-        && z_prism::vertical_arcs(moving, neg_ra, am, &mut prism.a_classes, &mut prism.a, &mut prism.wide[0])
-        && z_prism::vertical_arcs(fixed, bv, bn, &mut prism.b_classes, &mut prism.b, &mut prism.wide[1]);
-    // (tests: the supports searched through all arcs)
-    let wide = if test_switch!(ALL_ARCS) { [false; 2] } else { prism.wide };
-
-    // parallel faces: merged_with_b[f] = Some(g) when -R n_f == n_g within half the tolerance.
-    merged_with_b.clear();
-    merged_with_b.resize(fa, None);
-    merged_with_a.clear();
-    merged_with_a.resize(fb, None);
-    faces.clear();
-
-    if z_prisms {
-        #[cfg(test)]
-        z_prism::TAKEN.with(|c| c.set(c.get() + 1));
-        // a tame pair merges only its poles: take that for granted, and confirm it by the supports' margin (every side
-        // normal well inside an arc of the other summand is far from all its side normals, `z_prism::pole_merges`)
-        let mut margin = f64::INFINITY;
-        let mut by_class = !test_switch!(NO_POLE_MERGES_FIRST)
-            && z_prism::pole_merges(am, bn, &prism.a_classes, &prism.b_classes, merged_with_a, merged_with_b)
-            && z_prism::face_specs(
-                am,
-                bn,
-                &prism.a,
-                &prism.b,
-                wide,
-                neg_ra,
-                bv,
-                merged_with_a,
-                merged_with_b,
-                faces,
-                &mut margin,
-                true,
-            )
-            .is_ok()
-            && margin > z_prism::MARGIN;
-        if !by_class {
-            // else as the general route: all parallel pairs (within a class when the poles are far from the sides)
-            merged_with_b.fill(None);
-            merged_with_a.fill(None);
-            by_class =
-                z_prism::parallel_faces(am, bn, &prism.a_classes, &prism.b_classes, merged_with_a, merged_with_b);
-            if !by_class {
-                all_parallel_faces(am, bn, merged_with_a, merged_with_b);
-            }
-            faces.clear();
-            margin = f64::INFINITY;
-            z_prism::face_specs(
-                am,
-                bn,
-                &prism.a,
-                &prism.b,
-                wide,
-                neg_ra,
-                bv,
-                merged_with_a,
-                merged_with_b,
-                faces,
-                &mut margin,
-                false,
-            )?;
-        }
-        // a tame pair: every cycle without the polygon merges, in one pass over the merged pole chains
-        // (`prism_merge.rs`), else from the derived cycles (`z_prism::derived_cycles`)
-        let tame = by_class && margin > z_prism::MARGIN && !test_switch!(NO_DERIVED_CYCLES);
-        if tame
-            && !test_switch!(NO_MERGED_CHAINS)
-            && let Some(result) =
-                prism_merge::obstacle(moving, fixed, rotation, ra, neg_ra, am, bn, faces, prism, merge)
-        {
-            #[cfg(test)]
-            z_prism::MERGED.with(|c| c.set(c.get() + 1));
-            return result;
-        }
-        let derived = tame && z_prism::derived_cycles(moving, fixed, neg_ra, am, bn, faces, prism);
-        #[cfg(test)]
-        if derived {
-            z_prism::DERIVED.with(|c| c.set(c.get() + 1));
-        }
-        // their vertex numbering, offsets and edge table from the prism structure (`prism_assembly.rs`)
-        if derived && !test_switch!(NO_DIRECT_ASSEMBLY) {
-            let (cycles, starts) = (prism.cycles.as_slice(), prism.starts.as_slice());
-            let b_levels = prism.b_levels.as_slice();
-            if let Some(result) =
-                prism_assembly::assemble(fixed, rotation, ra, faces, cycles, starts, b_levels, index_of, direct)
-            {
-                #[cfg(test)]
-                z_prism::DIRECT.with(|c| c.set(c.get() + 1));
-                return result;
-            }
-        }
-        // the merged pole faces need no faces across their edges when no side face of -RA is merged (`z_prism.rs`)
-        let pole_faces_alone = by_class && z_prism::no_side_merged(&prism.a_classes, merged_with_b);
-        let plain = if pole_faces_alone { Some(prism.b_classes.as_slice()) } else { None };
-        let cycles = if derived { Some((prism.cycles.as_slice(), prism.starts.as_slice())) } else { None };
-        let buffers = AssemblyBuffers { index_of, cycle, planar, merged_with_b, neg_ra, edges, plain, cycles };
-        return assemble(moving, fixed, rotation, ra, faces, buffers);
-    }
-
     all_parallel_faces(am, bn, merged_with_a, merged_with_b);
     arcs(moving, neg_ra, am, a_arcs);
     arcs(fixed, bv, bn, b_arcs);
@@ -714,66 +414,98 @@ fn overlay(
         };
         faces.push(FaceSpec { normal: u, fixed: fixed_feature, moving: Feature::Face(f) });
     }
-    // 3. proper arc crossings, in (A arc, B arc) order. The B arcs whose end normals lie strictly on opposite sides of
-    // an A arc's circle: all B arcs tested one by one, or (at most 64 B arcs) as bit sets: with `from_mask[g]` /
-    // `to_mask[g]` the B arcs starting / ending at B's face g, the arcs from a face on the positive side to one on the
-    // negative side are `(OR of from_mask over positive g) & (OR of to_mask over negative g)`, and vice versa; the
-    // same pairs as the one-by-one test (the same signs), visited in the same order.
-    let small = b_arcs.len() <= 64 && !test_switch!(ONE_BY_ONE_CROSSINGS);
-    if small {
-        from_mask.clear();
-        from_mask.resize(fb, 0);
-        to_mask.clear();
-        to_mask.resize(fb, 0);
-        for (eb, b_arc) in b_arcs.iter().enumerate() {
-            from_mask[b_arc.from] |= 1 << eb;
-            to_mask[b_arc.to] |= 1 << eb;
-        }
-    }
-    for (ea, a_arc) in a_arcs.iter().enumerate() {
-        let row = &s_ab[ea * fb..(ea + 1) * fb];
-        let mut crossing = |eb: usize, b_arc: &Arc| {
-            let (sa0, sa1) = (s_ba[eb * fa + a_arc.from], s_ba[eb * fa + a_arc.to]);
-            if sa0 == 0 || sa0 != -sa1 {
-                return;
-            }
-            let mut x = a_arc.circle.cross(b_arc.circle);
-            if x.dot(am[a_arc.from] + am[a_arc.to]) < 0.0 {
-                x = -x;
-            }
-            if x.dot(bn[b_arc.from] + bn[b_arc.to]) <= 0.0 {
-                return;
-            }
-            faces.push(FaceSpec { normal: x.normalize(), fixed: Feature::Edge(eb), moving: Feature::Edge(ea) });
-        };
-        if small {
-            let (mut from_pos, mut from_neg, mut to_pos, mut to_neg) = (0u64, 0u64, 0u64, 0u64);
-            for ((&sign, &from), &to) in row.iter().zip(from_mask.iter()).zip(to_mask.iter()) {
-                // all ones where the sign is +1 (resp. -1), else zero
-                let (pos, neg) = (0u64.wrapping_sub(u64::from(sign == 1)), 0u64.wrapping_sub(u64::from(sign == -1)));
-                from_pos |= from & pos;
-                from_neg |= from & neg;
-                to_pos |= to & pos;
-                to_neg |= to & neg;
-            }
-            let mut candidates = (from_pos & to_neg) | (from_neg & to_pos);
-            while candidates != 0 {
-                let eb = candidates.trailing_zeros() as usize;
-                candidates &= candidates - 1;
-                crossing(eb, &b_arcs[eb]);
-            }
-        } else {
-            for (eb, b_arc) in b_arcs.iter().enumerate() {
-                let (sb0, sb1) = (row[b_arc.from], row[b_arc.to]);
-                if sb0 == 0 || sb0 != -sb1 {
-                    continue;
-                }
-                crossing(eb, b_arc);
-            }
-        }
+    // 3. proper arc crossings, in (A arc, B arc) order
+    let sums = Sums { am, bn, a_arcs, b_arcs, s_ab, s_ba };
+    if b_arcs.len() <= 64 {
+        crossings_by_bit_sets(&sums, from_mask, to_mask, faces);
+    } else {
+        crossings_one_by_one(&sums, faces);
     }
     let buffers = AssemblyBuffers { index_of, cycle, planar, merged_with_b, neg_ra, edges, plain: None, cycles: None };
     assemble(moving, fixed, rotation, ra, faces, buffers)
+}
+
+/// The two Gauss maps as the arc crossings read them: the face normals of `-RA` and `B`, their arcs, and the sign
+/// tables (`s_ab[e * FB + g]`: the side of `B`'s normal `g` of the circle of `-RA`'s arc `e`; `s_ba` likewise).
+struct Sums<'a> {
+    am: &'a [DVec3],
+    bn: &'a [DVec3],
+    a_arcs: &'a [Arc],
+    b_arcs: &'a [Arc],
+    s_ab: &'a [i8],
+    s_ba: &'a [i8],
+}
+
+/// The edge-edge face of the arc `ea` of `-RA` and the arc `eb` of `B`, whose end normals lie strictly on opposite
+/// sides of the circle of `ea` (checked by the caller), when they cross properly: the ends of `ea` strictly on
+/// opposite sides of the circle of `eb`, and the crossing point the one on both arcs (not its antipode).
+#[inline]
+fn push_crossing(sums: &Sums<'_>, (ea, a_arc): (usize, &Arc), (eb, b_arc): (usize, &Arc), faces: &mut Vec<FaceSpec>) {
+    let Sums { am, bn, s_ba, .. } = *sums;
+    let fa = am.len();
+    let (sa0, sa1) = (s_ba[eb * fa + a_arc.from], s_ba[eb * fa + a_arc.to]);
+    if sa0 == 0 || sa0 != -sa1 {
+        return;
+    }
+    let mut x = a_arc.circle.cross(b_arc.circle);
+    if x.dot(am[a_arc.from] + am[a_arc.to]) < 0.0 {
+        x = -x;
+    }
+    if x.dot(bn[b_arc.from] + bn[b_arc.to]) <= 0.0 {
+        return;
+    }
+    faces.push(FaceSpec { normal: x.normalize(), fixed: Feature::Edge(eb), moving: Feature::Edge(ea) });
+}
+
+/// Step 3 by the definition: for every arc of `-RA`, every arc of `B` whose end normals lie strictly on opposite sides
+/// of its circle ([`push_crossing`] tests the rest). O(EA EB).
+fn crossings_one_by_one(sums: &Sums<'_>, faces: &mut Vec<FaceSpec>) {
+    let fb = sums.bn.len();
+    for (ea, a_arc) in sums.a_arcs.iter().enumerate() {
+        let row = &sums.s_ab[ea * fb..(ea + 1) * fb];
+        for (eb, b_arc) in sums.b_arcs.iter().enumerate() {
+            let (sb0, sb1) = (row[b_arc.from], row[b_arc.to]);
+            if sb0 == 0 || sb0 != -sb1 {
+                continue;
+            }
+            push_crossing(sums, (ea, a_arc), (eb, b_arc), faces);
+        }
+    }
+}
+
+/// [`crossings_one_by_one`] for at most 64 arcs of `B`, as bit sets: with `from_mask[g]` / `to_mask[g]` the arcs of
+/// `B` starting / ending at `B`'s face `g`, the arcs from a face on the positive side of an arc's circle to one on the
+/// negative side are `(OR of from_mask over positive g) & (OR of to_mask over negative g)`, and vice versa: the same
+/// pairs (the same signs), visited in the same order. O(EA (FB + crossings)).
+fn crossings_by_bit_sets(sums: &Sums<'_>, from_mask: &mut Vec<u64>, to_mask: &mut Vec<u64>, faces: &mut Vec<FaceSpec>) {
+    let fb = sums.bn.len();
+    debug_assert!(sums.b_arcs.len() <= 64);
+    from_mask.clear();
+    from_mask.resize(fb, 0);
+    to_mask.clear();
+    to_mask.resize(fb, 0);
+    for (eb, b_arc) in sums.b_arcs.iter().enumerate() {
+        from_mask[b_arc.from] |= 1 << eb;
+        to_mask[b_arc.to] |= 1 << eb;
+    }
+    for (ea, a_arc) in sums.a_arcs.iter().enumerate() {
+        let row = &sums.s_ab[ea * fb..(ea + 1) * fb];
+        let (mut from_pos, mut from_neg, mut to_pos, mut to_neg) = (0u64, 0u64, 0u64, 0u64);
+        for ((&sign, &from), &to) in row.iter().zip(from_mask.iter()).zip(to_mask.iter()) {
+            // all ones where the sign is +1 (resp. -1), else zero
+            let (pos, neg) = (0u64.wrapping_sub(u64::from(sign == 1)), 0u64.wrapping_sub(u64::from(sign == -1)));
+            from_pos |= from & pos;
+            from_neg |= from & neg;
+            to_pos |= to & pos;
+            to_neg |= to & neg;
+        }
+        let mut candidates = (from_pos & to_neg) | (from_neg & to_pos);
+        while candidates != 0 {
+            let eb = candidates.trailing_zeros() as usize;
+            candidates &= candidates - 1;
+            push_crossing(sums, (ea, a_arc), (eb, &sums.b_arcs[eb]), faces);
+        }
+    }
 }
 
 /// The parallel faces of `-RA` (normals `am`) and `B` (normals `bn`): every pair whose unit normals are within half
@@ -792,110 +524,6 @@ fn all_parallel_faces(
             }
         }
     }
-}
-
-pub(crate) struct FaceSpec {
-    pub(crate) normal: DVec3,
-    pub(crate) fixed: Feature,
-    pub(crate) moving: Feature,
-}
-
-pub(crate) fn argmax(points: &[DVec3], u: DVec3) -> usize {
-    let mut best = 0;
-    let mut best_value = f64::NEG_INFINITY;
-    for (i, p) in points.iter().enumerate() {
-        let v = u.dot(*p);
-        if v > best_value {
-            best_value = v;
-            best = i;
-        }
-    }
-    best
-}
-
-/// One polygon of a merged face: its corners (vertex indices of its polytope), and per edge `k` (corner `k` to `k + 1`)
-/// the direction, its squared length and its half-plane relative to the reference direction (see [`planar_merge`]),
-/// and the face of the polytope across that edge (`usize::MAX` for an edge feature).
-#[derive(Default)]
-struct Polygon {
-    corners: Vec<usize>,
-    edges: Vec<(DVec3, f64, u8)>,
-    across: Vec<usize>,
-}
-
-impl Polygon {
-    /// The polygon of `feature` of `p` (whose vertices, as summed, are `points`): a face's vertex cycle,
-    /// counter-clockwise about its outward normal (reversed when `reflect`, for `-RA`, whose faces are the point
-    /// reflections of `A`'s); an edge as the 2-gon `[v0, v1]`. The half-planes are taken relative to `reference`, or
-    /// to this polygon's edge 0 when `None`; returns the reference. The faces across the edges only `with_across`.
-    /// Not called for vertices.
-    #[allow(clippy::too_many_arguments)]
-    fn build(
-        &mut self,
-        p: &ConvexPolytope,
-        feature: Feature,
-        reflect: bool,
-        points: &[DVec3],
-        normal: DVec3,
-        reference: Option<DVec3>,
-        with_across: bool,
-    ) -> DVec3 {
-        let Self { corners, edges, across } = self;
-        corners.clear();
-        edges.clear();
-        across.clear();
-        match feature {
-            Feature::Vertex(v) => corners.push(v),
-            Feature::Edge(e) => corners.extend_from_slice(&p.edges()[e].vertices),
-            Feature::Face(f) => {
-                let cycle = &p.faces()[f].vertices;
-                if reflect {
-                    corners.extend(cycle.iter().rev());
-                } else {
-                    corners.extend_from_slice(cycle);
-                }
-                if with_across {
-                    let face_edges = p.face_edges(f);
-                    let other = |e: usize| {
-                        let [f0, f1] = p.edges()[e].faces;
-                        if f0 == f { f1 } else { f0 }
-                    };
-                    if reflect {
-                        // reversed cycle: corner k is cycle[n - 1 - k]; the edge to corner k + 1 joins cycle[n - 1 - k]
-                        // and cycle[n - 2 - k], i.e. face_edges[n - 2 - k]; the closing edge is face_edges[n - 1]
-                        let n = cycle.len();
-                        across.extend(face_edges[..n - 1].iter().rev().map(|&e| other(e)));
-                        across.push(other(face_edges[n - 1]));
-                    } else {
-                        across.extend(face_edges.iter().map(|&e| other(e)));
-                    }
-                }
-            }
-        }
-        let n = corners.len();
-        let first = points[corners[0]];
-        let r = reference.unwrap_or_else(|| points[corners[1]] - first);
-        let mut current = first;
-        edges.reserve(n);
-        for k in 1..=n {
-            let next = if k == n { first } else { points[corners[k]] };
-            let d = next - current;
-            current = next;
-            // 0 for angles in [0, pi) from r about the normal, 1 for [pi, 2 pi)
-            let s = r.cross(d).dot(normal);
-            edges.push((d, d.length_squared(), u8::from(!(s > 0.0 || (s == 0.0 && r.dot(d) > 0.0)))));
-        }
-        r
-    }
-}
-
-/// Buffers reused by every merged face (no allocation per face): `B`'s polygon and `-RA`'s.
-#[derive(Default)]
-struct PlanarScratch {
-    b: Polygon,
-    a: Polygon,
-    /// The edge classes of [`face_plus_segment`].
-    classes: Vec<u8>,
 }
 
 /// The scratch buffers [`assemble`] works in.
@@ -1057,147 +685,10 @@ fn face_cycle(
     }
 }
 
-/// `(ANGULAR_TOLERANCE / 2)^2`: the squared sine below which two edge directions are parallel, and the squared
-/// distance below which two unit face normals are the same direction.
-pub(crate) const PARALLEL_SQ: f64 = (0.5 * ANGULAR_TOLERANCE) * (0.5 * ANGULAR_TOLERANCE);
-
-/// The convex polygon `F + G` of a merged face with outward normal `normal`, where `F` is `B`'s polygon
-/// (`scratch.pj`/`pe`) and `G` is `-RA`'s (`scratch.qi`/`qe`), both counter-clockwise about `normal` (a face, or an
-/// edge as a 2-gon), as the vertex-pair cycle of its corners into `out`, counter-clockwise about `normal`.
-///
-/// The classic O(|F| + |G|) merge of the two edge sequences by angle (the sum's edges are the summands' edges in
-/// angular order): starting at `F`'s edge 0 and the corner of `G` whose outgoing edge comes first at or after it, the
-/// walk advances in the polygon whose next edge turns first. An edge `p` of `F` and an edge `q` of `G` that point the
-/// same way (`p . q > 0`) are one edge of the sum (both advance; their middle corner is not a corner) when the sine of
-/// their angle is at most half the tolerance (`|p x q|^2 <= (tol / 2)^2 |p|^2 |q|^2`), or when the faces of `B` and
-/// `A` across them are merged. Both tests see the same vectors (up to an exact sign) for the same pair of edges in
-/// every face, so neighbouring faces agree. All other order decisions are signs of `(v x w) . normal` for
-/// non-parallel `v`, `w`, which the rounding of the inputs cannot flip. No coordinates are sorted or compared, so no
-/// length tolerance enters. O(|F| + |G|), no allocation (the scratch buffers are reused).
-fn planar_merge(
-    merged_with_b: &[Option<usize>],
-    normal: DVec3,
-    faces: bool,
-    scratch: &PlanarScratch,
-    out: &mut Vec<[usize; 2]>,
-) {
-    let (pj, pd, pn) = (&scratch.b.corners, &scratch.b.edges, &scratch.b.across);
-    let (qi, qd, qn) = (&scratch.a.corners, &scratch.a.edges, &scratch.a.across);
-    let (m, n) = (pj.len(), qi.len());
-    let r = pd[0].0;
-    // one edge of the sum: pointing the same way, and the faces across both edges are merged (then so are the edges,
-    // whatever their rounded directions say: the neighbouring merged face decides the same way) or the sine of their
-    // angle is at most half the tolerance (`c = p x q`; the same vectors up to sign in every face, so the same answer)
-    let same = |k: usize, l: usize, c: DVec3| {
-        let ((p, p2, _), (q, q2, _)) = (pd[k], qd[l]);
-        p.dot(q) > 0.0
-            && (c.length_squared() <= PARALLEL_SQ * p2 * q2 || (faces && merged_with_b[qn[l]] == Some(pn[k])))
-    };
-    // G's first edge: the one parallel to r, else the first in angular order
-    let mut l0 = 0;
-    if !same(0, 0, r.cross(qd[0].0)) {
-        for l in 1..n {
-            if same(0, l, r.cross(qd[l].0)) {
-                l0 = l;
-                break;
-            }
-            let ((v, _, hv), (w, _, hw)) = (qd[l], qd[l0]);
-            if hv < hw || (hv == hw && v.cross(w).dot(normal) > 0.0) {
-                l0 = l;
-            }
-        }
-    }
-    let (mut k, mut l) = (0, 0);
-    while k < m || l < n {
-        let lq = if l0 + l >= n { l0 + l - n } else { l0 + l };
-        out.push([qi[lq], pj[if k == m { 0 } else { k }]]);
-        if k == m {
-            l += 1;
-        } else if l == n {
-            k += 1;
-        } else {
-            let ((p, _, hp), (q, _, hq)) = (pd[k], qd[lq]);
-            let c = p.cross(q);
-            if same(k, lq, c) {
-                k += 1;
-                l += 1;
-            } else if hp < hq || (hp == hq && c.dot(normal) > 0.0) {
-                k += 1;
-            } else {
-                l += 1;
-            }
-        }
-    }
-}
-
-/// [`planar_merge`] for a face plus a parallel edge (a 2-gon), in one pass: the face polygon `corners` (points
-/// `points`, counter-clockwise about `normal`) plus the segment `segment` (points `segment_points`); `FACE_IS_B` says
-/// whether the face is `B`'s (the corner labels are then `[segment vertex, corner]`, else `[corner, segment vertex]`).
-///
-/// With `d` the segment's direction, every face edge `e` is *parallel* (`e . d > 0`), *antiparallel* (`e . d < 0`)
-/// when the sine of their angle is at most half the tolerance (the test of [`planar_merge`], evaluated with the same
-/// operands in the same order: `B`'s edge first), else *after* `d` (`(d x e) . normal > 0`) or *before* it. The sum
-/// translates the face edges before `d` by the segment's start `s0`, those after it by its end `s1`; a parallel edge
-/// runs from `s0` to `s1`, an antiparallel one from `s1` to `s0`. Each corner of the face is one corner of the sum
-/// when the edges on both sides translate it alike, else two (the segment's edge `d` or `-d` joins them). Exactly the
-/// cycle [`planar_merge`] gives for the 2-gon (up to where it starts), in O(|F|) with one cross product per edge.
-#[allow(clippy::too_many_arguments)]
-fn face_plus_segment<const FACE_IS_B: bool>(
-    corners: &[usize],
-    points: &[DVec3],
-    segment: [usize; 2],
-    segment_points: &[DVec3],
-    normal: DVec3,
-    classes: &mut Vec<u8>,
-    out: &mut Vec<[usize; 2]>,
-) {
-    const BEFORE: u8 = 0;
-    const AFTER: u8 = 1;
-    const PARALLEL: u8 = 2;
-    const ANTIPARALLEL: u8 = 3;
-    let d = segment_points[segment[1]] - segment_points[segment[0]];
-    let m = corners.len();
-    classes.clear();
-    let first = points[corners[0]];
-    let mut current = first;
-    for k in 1..=m {
-        let next = if k == m { first } else { points[corners[k]] };
-        let e = next - current;
-        current = next;
-        // the parallel test with B's edge first, as in `planar_merge` (bit for bit: the same products in the same
-        // order); `|c . normal| <= |c|`, so a turn clearly above the tolerance skips the length (the margin 2 covers
-        // the rounding of the unit normal)
-        let (p, q) = if FACE_IS_B { (e, d) } else { (d, e) };
-        let c = p.cross(q);
-        let turn = c.dot(normal);
-        let tolerance = PARALLEL_SQ * p.length_squared() * q.length_squared();
-        let parallel = turn * turn <= 2.0 * tolerance && c.length_squared() <= tolerance;
-        // (d x e) . normal is `turn` for an A face and `-turn` for a B face
-        classes.push(if parallel {
-            if e.dot(d) > 0.0 { PARALLEL } else { ANTIPARALLEL }
-        } else if (if FACE_IS_B { -turn } else { turn }) > 0.0 {
-            AFTER
-        } else {
-            BEFORE
-        });
-    }
-    let label = |corner: usize, end: usize| if FACE_IS_B { [segment[end], corner] } else { [corner, segment[end]] };
-    for k in 0..m {
-        let (incoming, outgoing) = (classes[if k == 0 { m - 1 } else { k - 1 }], classes[k]);
-        // the end of the segment by which corner k is translated as the end of the incoming edge, and as the start
-        // of the outgoing one
-        let end = usize::from(incoming == AFTER || incoming == PARALLEL);
-        let start = usize::from(!(outgoing == BEFORE || outgoing == PARALLEL));
-        out.push(label(corners[k], end));
-        if start != end {
-            out.push(label(corners[k], start));
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::z_prism::tests::{prism, scaled};
 
     fn cuboid(lo: DVec3, hi: DVec3) -> ConvexPolytope {
         ConvexPolytope::cuboid(lo, hi).expect("box")
@@ -1233,83 +724,6 @@ mod tests {
         assert!((h.polytope().volume() - o.polytope().volume()).abs() < 1e-9);
     }
 
-    /// A polygon for [`planar_merge`] from raw points (what `Polygon::build` computes for a feature).
-    fn raw_polygon(points: &[DVec3], corners: &[usize], normal: DVec3, reference: Option<DVec3>) -> (Polygon, DVec3) {
-        let n = corners.len();
-        let r = reference.unwrap_or(points[corners[1]] - points[corners[0]]);
-        let edges = (0..n)
-            .map(|k| {
-                let d = points[corners[(k + 1) % n]] - points[corners[k]];
-                let s = r.cross(d).dot(normal);
-                (d, d.length_squared(), u8::from(!(s > 0.0 || (s == 0.0 && r.dot(d) > 0.0))))
-            })
-            .collect();
-        (Polygon { corners: corners.to_vec(), edges, across: vec![usize::MAX; n] }, r)
-    }
-
-    fn same_cycle(a: &[[usize; 2]], b: &[[usize; 2]]) -> bool {
-        a.len() == b.len() && (0..a.len()).any(|s| (0..a.len()).all(|k| a[(s + k) % a.len()] == b[k]))
-    }
-
-    #[test]
-    fn face_plus_segment_is_the_general_merge_of_a_2_gon() {
-        // convex polygons (regular, rotated, scaled) plus segments in every direction: exactly along an edge, within
-        // 0.3 and 0.7 of the tolerance of it, and generic; the face as B's and as A's
-        let normal = DVec3::Z;
-        let mut cases = 0;
-        for sides in 3..9 {
-            for turn in [0.0, 0.1, 1.0] {
-                let points: Vec<DVec3> = (0..sides)
-                    .map(|k| {
-                        let t = turn + k as f64 * std::f64::consts::TAU / sides as f64;
-                        DVec3::new(3.0 * t.cos() + 1.0, 2.0 * t.sin() - 0.5, 0.25)
-                    })
-                    .collect();
-                let corners: Vec<usize> = (0..sides).collect();
-                let mut directions = Vec::new();
-                for k in 0..sides {
-                    let e = points[(k + 1) % sides] - points[k];
-                    let angle = e.y.atan2(e.x);
-                    for offset in [0.0, 0.3, -0.3, 0.7, -0.7, 3.0] {
-                        let a = angle + offset * ANGULAR_TOLERANCE;
-                        directions.push(DVec3::new(a.cos(), a.sin(), 0.0) * 1.5);
-                    }
-                    directions.push(DVec3::new((angle + 0.4).cos(), (angle + 0.4).sin(), 0.0));
-                }
-                for d in directions {
-                    for face_is_b in [true, false] {
-                        // the segment's points: [p, p + d]
-                        let seg_points = vec![DVec3::new(0.5, 0.25, 0.0), DVec3::new(0.5, 0.25, 0.0) + d];
-                        let mut got = Vec::new();
-                        let mut classes = Vec::new();
-                        let (c, p, sp) = (&corners, &points, &seg_points);
-                        if face_is_b {
-                            face_plus_segment::<true>(c, p, [0, 1], sp, normal, &mut classes, &mut got);
-                        } else {
-                            face_plus_segment::<false>(c, p, [0, 1], sp, normal, &mut classes, &mut got);
-                        }
-                        let (b_points, b_corners, a_points, a_corners) = if face_is_b {
-                            (&points, corners.clone(), &seg_points, vec![0, 1])
-                        } else {
-                            (&seg_points, vec![0, 1], &points, corners.clone())
-                        };
-                        let (b, r) = raw_polygon(b_points, &b_corners, normal, None);
-                        let (a, _) = raw_polygon(a_points, &a_corners, normal, Some(r));
-                        let scratch = PlanarScratch { b, a, classes: Vec::new() };
-                        let mut expected = Vec::new();
-                        planar_merge(&[], normal, false, &scratch, &mut expected);
-                        assert!(
-                            same_cycle(&got, &expected),
-                            "{sides} sides, d {d}, face_is_b {face_is_b}: {got:?} vs {expected:?}"
-                        );
-                        cases += 1;
-                    }
-                }
-            }
-        }
-        assert!(cases > 500);
-    }
-
     #[test]
     fn crossing_bit_sets_equal_the_one_by_one_test() {
         // pairs with edge-edge faces (general rotations, point clouds) and without (boxes and prisms about z)
@@ -1338,22 +752,131 @@ mod tests {
             DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7),
             DMat3::from_axis_angle(DVec3::new(-0.3, 0.2, 1.0).normalize(), 2.1),
         ];
-        let mut edge_edge = 0;
+        let mut s = Scratch::default();
+        let (mut pairs, mut crossings) = (0, 0);
         for a in &shapes {
             for b in &shapes {
                 for r in rotations {
-                    let bits = gauss_map_obstacle(a, r, b);
-                    ONE_BY_ONE_CROSSINGS.with(|c| c.set(true));
-                    let one_by_one = gauss_map_obstacle(a, r, b);
-                    ONE_BY_ONE_CROSSINGS.with(|c| c.set(false));
-                    assert_eq!(format!("{bits:?}"), format!("{one_by_one:?}"));
-                    if let Ok(o) = bits {
-                        edge_edge += o.face_kinds().iter().filter(|k| matches!(k, FaceKind::EdgeEdge { .. })).count();
+                    s.prepare(a, r, b);
+                    let Scratch { neg_ra, am, bn, a_arcs, b_arcs, s_ab, s_ba, from_mask, to_mask, .. } = &mut s;
+                    arcs(a, neg_ra, am, a_arcs);
+                    arcs(b, b.vertices(), bn, b_arcs);
+                    if b_arcs.len() > 64 {
+                        continue;
+                    }
+                    sign_table(a_arcs, bn, s_ab);
+                    sign_table(b_arcs, am, s_ba);
+                    let sums = Sums { am, bn, a_arcs, b_arcs, s_ab, s_ba };
+                    let (mut bits, mut one_by_one) = (Vec::new(), Vec::new());
+                    crossings_by_bit_sets(&sums, from_mask, to_mask, &mut bits);
+                    crossings_one_by_one(&sums, &mut one_by_one);
+                    let key = |f: &FaceSpec| (f.normal.to_array().map(f64::to_bits), f.fixed, f.moving);
+                    assert_eq!(
+                        bits.iter().map(key).collect::<Vec<_>>(),
+                        one_by_one.iter().map(key).collect::<Vec<_>>()
+                    );
+                    pairs += 1;
+                    crossings += bits.len();
+                }
+            }
+        }
+        assert!(pairs >= 80 && crossings > 100, "{pairs} pairs, {crossings} crossings");
+    }
+
+    #[test]
+    fn z_prism_route_equals_the_general_overlay() {
+        // boxes, the bench's hexagons, regular and irregular outlines (some sharing edge directions), extruded along
+        // z (the z-prism route) or x (the general one); rotations about z at generic angles, quarter turns (rounded
+        // and exact), angles around the angular tolerance, and one general rotation
+        let hex = [(0.0, 0.0), (60.0, 0.0), (90.0, 30.0), (80.0, 70.0), (20.0, 80.0), (-10.0, 40.0)];
+        let mut shapes = vec![
+            ConvexPolytope::cuboid(DVec3::ZERO, DVec3::new(100.0, 50.0, 2.0)).expect("box"),
+            ConvexPolytope::cuboid(DVec3::new(-1.0, 0.5, 0.0), DVec3::new(4.0, 5.0, 6.0)).expect("box"),
+            prism(&hex, 0.0, 2.0, 2),
+            prism(&hex.map(|(x, y)| (x * 0.7, y * 0.7)), 0.0, 2.0, 2),
+            prism(&[(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 2.0)], -0.5, 0.25, 2),
+            prism(&[(0.0, 0.0), (1.5, 0.5), (0.5, 1.5)], 0.0, 0.75, 2),
+            prism(&[(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 2.0)], -0.5, 0.25, 0),
+            // squared lengths that overflow and underflow (circles of zero length, or refused)
+            scaled(1e160),
+            scaled(1e-170),
+        ];
+        for (n, turn) in [(5, 0.1), (8, 0.0), (7, 1.3)] {
+            let outline: Vec<(f64, f64)> = (0..n)
+                .map(|k| {
+                    let t = turn + k as f64 * std::f64::consts::TAU / n as f64;
+                    (3.0 * t.cos(), 2.0 * t.sin())
+                })
+                .collect();
+            shapes.push(prism(&outline, -1.0, 1.0, 2));
+        }
+        let mut rotations: Vec<DMat3> = (0..52).map(|k| DMat3::from_rotation_z(k as f64 * 0.1234)).collect();
+        for t in [1e-12, 3e-10, 5e-10, 7e-10, 1e-9, 2e-9, 1e-6] {
+            rotations.push(DMat3::from_rotation_z(t));
+            rotations.push(DMat3::from_rotation_z(-t));
+            rotations.push(DMat3::from_rotation_z(std::f64::consts::FRAC_PI_2 + t));
+        }
+        for k in 1..8 {
+            rotations.push(DMat3::from_rotation_z(k as f64 * std::f64::consts::FRAC_PI_4));
+        }
+        rotations.push(DMat3::from_cols(DVec3::Y, -DVec3::X, DVec3::Z));
+        rotations.push(DMat3::from_cols(-DVec3::X, -DVec3::Y, DVec3::Z));
+        rotations.push(DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7));
+        // the z-prisms among them (not the x-extruded one; not the tiny box, whose vertical edges' squared lengths
+        // underflow; the 7-gon is one because the hull computes its face planes accurately: a plainly computed top
+        // normal has a rounded x of 3e-17)
+        let z_prisms = shapes
+            .iter()
+            .filter(|s| {
+                let n: Vec<DVec3> = s.faces().iter().map(|f| f.plane.normal).collect();
+                z_prism::vertical_arcs(s, s.vertices(), &n, &mut Vec::new(), &mut Vec::new())
+            })
+            .count();
+        assert_eq!(z_prisms, 10);
+        let mut s = Scratch::default();
+        let (mut cases, mut prism_pairs, mut tame_pairs) = (0, 0, 0);
+        for a in &shapes {
+            for b in &shapes {
+                for &r in &rotations {
+                    // the obstacle (the z-prism route where it applies) against the general overlay
+                    let fast = format!("{:?}", gauss_map_obstacle(a, r, b));
+                    s.prepare(a, r, b);
+                    let general = format!("{:?}", general_overlay(a, r, b, &mut s));
+                    assert_eq!(fast, general, "{a:?} {r:?} {b:?}");
+                    cases += 1;
+                    // the z-prism route's two assemblies, each against the general overlay: by the polygon merges
+                    // (every z-prism pair) and from the derived cycles (the tame pairs)
+                    s.prepare(a, r, b);
+                    let Scratch { neg_ra, am, bn, prism, .. } = &mut s;
+                    if !(z_prism::vertical_arcs(a, neg_ra, am, &mut prism.a_classes, &mut prism.a)
+                        && z_prism::vertical_arcs(b, b.vertices(), bn, &mut prism.b_classes, &mut prism.b))
+                    {
+                        continue;
+                    }
+                    prism_pairs += 1;
+                    let pair = match prism_specs(b, &mut s) {
+                        Ok(pair) => pair,
+                        Err(e) => {
+                            assert_eq!(format!("{:?}", Err::<Obstacle, _>(e)), general);
+                            continue;
+                        }
+                    };
+                    let merged = format!("{:?}", prism_assemble(a, r, b, &mut s, pair, false));
+                    assert_eq!(merged, general, "{a:?} {r:?} {b:?}");
+                    let Scratch { neg_ra, am, bn, specs, prism, .. } = &mut s;
+                    if pair.tame && z_prism::derived_cycles(a, b, neg_ra, am, bn, specs, prism) {
+                        tame_pairs += 1;
+                        let derived = format!("{:?}", prism_assemble(a, r, b, &mut s, pair, true));
+                        assert_eq!(derived, general, "{a:?} {r:?} {b:?}");
                     }
                 }
             }
         }
-        assert!(edge_edge > 100, "{edge_edge} edge-edge faces");
+        // every pair of z-prisms under every rotation about z (all but the last rotation), and no other
+        assert_eq!(prism_pairs, z_prisms * z_prisms * (rotations.len() - 1), "{prism_pairs} of {cases}");
+        // the tame pairs (most pairs at generic angles; not the quarter turns, not within 1e-6 of one, not the huge
+        // box) assembled from their derived cycles
+        assert!(tame_pairs * 2 > prism_pairs && tame_pairs < prism_pairs, "{tame_pairs} of {prism_pairs} tame");
     }
 
     #[test]

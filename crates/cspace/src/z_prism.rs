@@ -26,7 +26,7 @@
 //! product, the only term computed here), a pole that is not merged with a face of the other summand is supported by a
 //! vertex, and the face list is the general route's steps 1 and 2 with step 3 empty: the same `FaceSpec`s in the same
 //! order, handed to the same assembly, so the obstacle is bit for bit the general route's (checked by
-//! `examples/obstacle_identity.rs dump` and by the unit test below on pairs of prisms at many angles).
+//! `examples/obstacle_identity.rs dump` and by `minkowski.rs`'s unit test on pairs of prisms at many angles).
 //! What is saved: both sign tables (`EA FB + EB FA` products), the arc-crossing pass, the circles of the horizontal
 //! arcs and most of the support tests' arithmetic.
 //!
@@ -38,7 +38,8 @@
 //! a wide margin. The face cycles are then read off the features: a side face of one summand plus a vertical edge of
 //! the other is its quadrilateral with the top corners translated by the edge's top end and the bottom ones by its
 //! bottom end; a pole of the obstacle is the chain of the side faces' edges on that pole, started where the merge
-//! starts. Same cycles, same order, same assembly (numbering, offsets, edge table): bit for bit the general route's.
+//! starts. Same cycles, same order, same assembly (numbering, offsets, edge table): bit for bit the general route's
+//! (`minkowski.rs`'s unit test compares both assemblies of every tame pair with the general overlay).
 //! Pairs that are not tame (quarter turns and rotations within 1e-6 rad of one, where side faces merge; a side face
 //! supported by a vertex; huge or tiny coordinates) keep the polygon merges.
 //!
@@ -49,7 +50,7 @@
 use glam::DVec3;
 use stackplan_geom::polytope::ConvexPolytope;
 
-use crate::minkowski::{FaceSpec, Feature, OverlayFailure, PARALLEL_SQ, argmax};
+use crate::types::{FaceSpec, Feature, OverlayFailure, PARALLEL_SQ, argmax};
 
 /// A vertical arc: its edge, the `x`, `y` of the normals at its start and end, and the `z` of its circle (the general
 /// route's circle is `(±0, ±0, cz)`).
@@ -65,21 +66,19 @@ pub(crate) struct VerticalArc {
 #[derive(Default)]
 pub(crate) struct Scratch {
     /// [`derived_cycles`]: per vertex pair `i * nB + j` on a pole, the next corner of its pole face.
-    pub(crate) next: Vec<u32>,
+    next: Vec<u32>,
     /// [`derived_cycles`]: the faces' vertex-pair cycles, face `s` at `cycles[starts[s]..starts[s + 1]]`.
     pub(crate) cycles: Vec<[usize; 2]>,
     pub(crate) starts: Vec<usize>,
     /// [`derived_cycles`]: the pole (`BOTTOM`, `TOP`) of every vertex of `-RA` and of `B`.
-    pub(crate) a_levels: Vec<u8>,
-    pub(crate) b_levels: Vec<u8>,
+    a_levels: Vec<u8>,
+    b_levels: Vec<u8>,
     /// The kind of every face normal of `-RA` and of `B`: 0 side, 1 pole.
     pub(crate) a_classes: Vec<u8>,
     pub(crate) b_classes: Vec<u8>,
     /// The vertical arcs of `-RA` and of `B`.
     pub(crate) a: Vec<VerticalArc>,
     pub(crate) b: Vec<VerticalArc>,
-    /// Whether every arc of `-RA`, of `B` is at least [`WIDE`] wide ([`vertical_arcs`]).
-    pub(crate) wide: [bool; 2],
 }
 
 const SIDE: u8 = 0;
@@ -101,28 +100,19 @@ const TAME_HI: f64 = 1e60;
 /// two orders of magnitude above the angular tolerance, nine above rounding.
 pub(crate) const MARGIN: f64 = 1e-7;
 
-/// The least sine of the angle between the end normals of every vertical arc of a summand for [`face_specs`] to stop
-/// searching the support of a side normal of the other summand at the first arc that holds it with margin.
-pub(crate) const WIDE: f64 = 1e-12;
-
 /// The vertical arcs of `p` (vertices `vertices`, face normals `normals`) into `out`, in edge order, when `p` is a
 /// z-prism (see the module documentation), else `false` (the buffers then hold garbage). The circle is the general
 /// route's (`minkowski::arcs`, the same operations); a vertical arc's must come out as `(±0, ±0, cz)` (it does unless
 /// the normalisation divides by an underflowed length), a horizontal arc's is `d * s` for an edge vector `d` with
 /// `d.z == 0` and some `s`: its `z` is `±0` or NaN, and either way its product with a pole is not a sign, and no test
 /// with it is positive (NaN compares false), which is all the module documentation uses.
-///
-/// `wide` is set to whether every vertical arc is at least [`WIDE`] wide (the sine of the angle between its end
-/// normals; what lets [`face_specs`] stop at a support found with margin).
 pub(crate) fn vertical_arcs(
     p: &ConvexPolytope,
     vertices: &[DVec3],
     normals: &[DVec3],
     classes: &mut Vec<u8>,
     out: &mut Vec<VerticalArc>,
-    wide: &mut bool,
 ) -> bool {
-    *wide = true;
     classes.clear();
     for n in normals {
         classes.push(if n.z == 0.0 && n.x.is_finite() && n.y.is_finite() {
@@ -164,7 +154,6 @@ pub(crate) fn vertical_arcs(
                 let cz = d.z * s;
                 let w = n0.x * n1.y - n1.x * n0.y;
                 let cz = if w * cz >= 0.0 { cz } else { -cz };
-                *wide &= w.abs() >= WIDE;
                 out.push(VerticalArc { edge: k, from: [n0.x, n0.y], to: [n1.x, n1.y], cz });
             }
             1 => {
@@ -208,52 +197,6 @@ pub(crate) fn parallel_faces(
     true
 }
 
-/// The parallel faces among the poles only, exactly as [`parallel_faces`] finds them (the same pairs in the same
-/// order) when no side normal of one summand is parallel to one of the other; `false` (nothing written) when some pole
-/// is not far from the sides (as [`parallel_faces`]) or a summand has more than two poles. The caller confirms that
-/// no side normals are parallel by [`face_specs`] run on these merges: when every side normal of `B` lies strictly
-/// inside a vertical arc of `-RA` with both its support tests above [`MARGIN`] (the sines of its angles to the arc's
-/// two end normals, up to the circle's `|cz|`, 1 within rounding), it is at least about `MARGIN` away from the arc's
-/// ends, and the ends are the side normals of `-RA` angularly next to it (the arcs of a convex prism's vertical edges
-/// lie between angularly adjacent side normals), so farther still from all others: no pair of side normals is within
-/// `sqrt(PARALLEL_SQ)` (half the angular tolerance, 5e-10) of each other, and [`parallel_faces`] would merge the poles
-/// alone. O(FA + FB).
-pub(crate) fn pole_merges(
-    am: &[DVec3],
-    bn: &[DVec3],
-    a_classes: &[u8],
-    b_classes: &[u8],
-    merged_with_a: &mut [Option<usize>],
-    merged_with_b: &mut [Option<usize>],
-) -> bool {
-    // the poles of a summand (at most two here, else `false`), each far from the sides
-    let poles = |normals: &[DVec3], classes: &[u8]| {
-        let (mut out, mut count) = ([0; 2], 0);
-        for (f, (n, &c)) in normals.iter().zip(classes).enumerate() {
-            if c == POLE {
-                if count == 2 || n.z * n.z <= PARALLEL_SQ {
-                    return None;
-                }
-                out[count] = f;
-                count += 1;
-            }
-        }
-        Some((out, count))
-    };
-    let (Some((a_poles, na)), Some((b_poles, nb))) = (poles(am, a_classes), poles(bn, b_classes)) else {
-        return false;
-    };
-    for &f in &a_poles[..na] {
-        for &g in &b_poles[..nb] {
-            if (am[f] - bn[g]).length_squared() <= PARALLEL_SQ {
-                merged_with_b[f] = Some(g);
-                merged_with_a[g] = Some(f);
-            }
-        }
-    }
-    true
-}
-
 /// Whether the class is a pole's.
 #[inline]
 pub(crate) fn is_pole(class: u8) -> bool {
@@ -271,23 +214,11 @@ pub(crate) fn no_side_merged(a_classes: &[u8], merged_with_b: &[Option<usize>]) 
 }
 
 /// The support feature of the other summand for the face normal `u` that is merged with none of its faces: an edge
-/// whose (vertical) arc holds `u` strictly inside, else the vertex `argmax(points, u)`; as the general route decides.
-///
-/// When the arcs are `wide` (every one at least [`WIDE`], from [`vertical_arcs`]) the search stops at the first arc
-/// holding `u` with both tests above [`MARGIN`]: no other arc can pass both tests then (the general route's
-/// ambiguity check), because the arcs of a convex prism's vertical edges are disjoint wedges between angularly
-/// adjacent side normals (each narrower than a half-turn). `u` lies at least about `MARGIN` from the found wedge's
-/// ends and so from every side normal of the other summand; for another wedge of width `w`, `u` outside it, one of
-/// the two sines is then at most `-min(MARGIN, sin(w / 2))` (the worst case is `u` opposite the wedge's middle), far
-/// below the tests' rounding error (about 1e-16 for unit normals) when `sin w >= WIDE`.
+/// whose (vertical) arc holds `u` strictly inside, else the vertex `argmax(points, u)`; as the general route decides
+/// (every arc tested, two holding `u` are ambiguous). The least of the two support tests of the arc found goes into
+/// `margin` (`-inf` for a side normal supported by a vertex). O(arcs + points).
 #[inline]
-fn support(
-    u: DVec3,
-    arcs: &[VerticalArc],
-    wide: bool,
-    points: &[DVec3],
-    margin: &mut f64,
-) -> Result<Feature, OverlayFailure> {
+fn support(u: DVec3, arcs: &[VerticalArc], points: &[DVec3], margin: &mut f64) -> Result<Feature, OverlayFailure> {
     if u.z != 0.0 {
         // a pole lies strictly inside no arc
         return Ok(Feature::Vertex(argmax(points, u)));
@@ -303,11 +234,7 @@ fn support(
                 return Err(OverlayFailure::AmbiguousSupport);
             }
             found = Some(arc.edge);
-            let least = before.min(after);
-            *margin = margin.min(least);
-            if wide && least > MARGIN {
-                break;
-            }
+            *margin = margin.min(before.min(after));
         }
     }
     Ok(match found {
@@ -320,57 +247,49 @@ fn support(
     })
 }
 
-/// Steps 1 and 2 of the overlay (step 3, the arc crossings, is empty) for a z-prism pair whose vertical arcs came
-/// from [`vertical_arcs`]: the faces of `B`, then those of `-RA` not parallel to a face of `B`, into `faces`; the least
-/// support test value of the side normals into `margin`. With `tame_only`, it stops (with the face list incomplete)
-/// at the first face of `B` that leaves `margin` at most [`MARGIN`] (a side face of `B` parallel to one of `-RA`, as
-/// at quarter turns, lies on an arc's end and fails there).
+/// Steps 1 and 2 of the overlay (step 3, the arc crossings, is empty) for a z-prism pair whose vertical arcs
+/// `(a_arcs, b_arcs)` came from [`vertical_arcs`]: the faces of `B`, then those of `-RA` not parallel to a face of
+/// `B`, into `faces`; the least support test value of the side normals into `margin`. O(FB EA_v + FA EB_v + V).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn face_specs(
     am: &[DVec3],
     bn: &[DVec3],
-    a_arcs: &[VerticalArc],
-    b_arcs: &[VerticalArc],
-    [a_wide, b_wide]: [bool; 2],
+    (a_arcs, b_arcs): (&[VerticalArc], &[VerticalArc]),
     neg_ra: &[DVec3],
     bv: &[DVec3],
     merged_with_a: &[Option<usize>],
     merged_with_b: &[Option<usize>],
     faces: &mut Vec<FaceSpec>,
     margin: &mut f64,
-    tame_only: bool,
 ) -> Result<(), OverlayFailure> {
     for (g, &u) in bn.iter().enumerate() {
         let moving = match merged_with_a[g] {
             Some(f) => Feature::Face(f),
-            None => support(u, a_arcs, a_wide, neg_ra, margin)?,
+            None => support(u, a_arcs, neg_ra, margin)?,
         };
         faces.push(FaceSpec { normal: u, fixed: Feature::Face(g), moving });
-        if tame_only && *margin <= MARGIN {
-            return Ok(());
-        }
     }
     for (f, &u) in am.iter().enumerate() {
         if merged_with_b[f].is_some() {
             continue;
         }
-        let fixed = support(u, b_arcs, b_wide, bv, margin)?;
+        let fixed = support(u, b_arcs, bv, margin)?;
         faces.push(FaceSpec { normal: u, fixed, moving: Feature::Face(f) });
     }
     Ok(())
 }
 
 /// The two poles of each summand of a z-prism pair, indexed by level (`[bottom, top]`, faces of `-RA` and of `B`).
-pub(crate) struct Poles {
-    pub(crate) a: [usize; 2],
-    pub(crate) b: [usize; 2],
+struct Poles {
+    a: [usize; 2],
+    b: [usize; 2],
 }
 
-/// The first conditions of [`derived_cycles`] (and of `prism_merge.rs`): each summand has exactly two poles, a top
+/// The first conditions of [`derived_cycles`]: each summand has exactly two poles, a top
 /// (`+z`) and a bottom one, every vertex on one of them (its level into `scratch.a_levels` / `b_levels`), fewer than
 /// `2^16` vertices, and a height (the length of every vertical edge) whose square is in `[TAME_LO, TAME_HI]`. `None`
 /// (levels garbage) otherwise. O(V + F).
-pub(crate) fn poles(
+fn poles(
     moving: &ConvexPolytope,
     fixed: &ConvexPolytope,
     neg_ra: &[DVec3],
@@ -430,7 +349,7 @@ pub(crate) fn poles(
 /// Tame (see [`derived_cycles`]): a side face's horizontal edge `p -> q` far from under- and overflow, its normal
 /// `n` a unit vector orthogonal to the edge within 1e-12 rad.
 #[inline(always)]
-pub(crate) fn tame_side(n: DVec3, p: DVec3, q: DVec3) -> bool {
+fn tame_side(n: DVec3, p: DVec3, q: DVec3) -> bool {
     let d = q - p;
     let (len2, nn, dot) = (d.x * d.x + d.y * d.y, n.x * n.x + n.y * n.y, n.x * d.x + n.y * d.y);
     (TAME_LO..=TAME_HI).contains(&len2) && (nn - 1.0).abs() <= 1e-9 && dot * dot <= 1e-24 * len2
@@ -438,7 +357,7 @@ pub(crate) fn tame_side(n: DVec3, p: DVec3, q: DVec3) -> bool {
 
 /// The two ends of a vertical edge as `[bottom, top]` (indexed by the level), else `None`.
 #[inline]
-pub(crate) fn ends([v0, v1]: [usize; 2], levels: &[u8]) -> Option<[usize; 2]> {
+fn ends([v0, v1]: [usize; 2], levels: &[u8]) -> Option<[usize; 2]> {
     match (levels[v0], levels[v1]) {
         (BOTTOM, TOP) => Some([v0, v1]),
         (TOP, BOTTOM) => Some([v1, v0]),
@@ -623,28 +542,12 @@ pub(crate) fn derived_cycles(
 }
 
 #[cfg(test)]
-thread_local! {
-    /// Tests: how many overlays took this route.
-    pub(crate) static TAKEN: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
-    /// Tests: how many of those were assembled from [`derived_cycles`].
-    pub(crate) static DERIVED: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
-    /// Tests: how many of those were assembled directly (`prism_assembly.rs`).
-    pub(crate) static DIRECT: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
-    /// Tests: how many overlays were built from the merged pole chains (`prism_merge.rs`).
-    pub(crate) static MERGED: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
-}
-
-#[cfg(test)]
-mod tests {
-    use crate::minkowski::{
-        ALL_ARCS, GENERAL_ROUTE_ONLY, NO_DERIVED_CYCLES, NO_DIRECT_ASSEMBLY, NO_MERGED_CHAINS, NO_POLE_MERGES_FIRST,
-        gauss_map_obstacle,
-    };
+pub(crate) mod tests {
     use glam::{DMat3, DVec3};
     use stackplan_geom::{ConvexPolytope, convex_hull};
 
     /// The outline `(x, y)` extruded over `[z0, z1]` along `z` (`axis` 2) or along `x` (`axis` 0).
-    fn prism(outline: &[(f64, f64)], z0: f64, z1: f64, axis: usize) -> ConvexPolytope {
+    pub(crate) fn prism(outline: &[(f64, f64)], z0: f64, z1: f64, axis: usize) -> ConvexPolytope {
         let pts: Vec<DVec3> = outline
             .iter()
             .flat_map(|&(x, y)| [z0, z1].map(|z| if axis == 0 { DVec3::new(z, x, y) } else { DVec3::new(x, y, z) }))
@@ -653,7 +556,7 @@ mod tests {
     }
 
     /// A box with corners scaled by `s` and unit face normals (the planes of a box of ordinary size).
-    fn scaled(s: f64) -> ConvexPolytope {
+    pub(crate) fn scaled(s: f64) -> ConvexPolytope {
         let unit = ConvexPolytope::cuboid(DVec3::new(-1.0, 0.0, -1.0), DVec3::new(2.0, 1.0, 3.0)).expect("box");
         let vertices = unit.vertices().iter().map(|v| *v * s).collect();
         let planes = unit.planes().map(|p| stackplan_geom::Plane { normal: p.normal, offset: p.offset * s }).collect();
@@ -677,8 +580,8 @@ mod tests {
             for p in &shapes {
                 let points: Vec<DVec3> = p.vertices().iter().map(|v| -(r * *v)).collect();
                 let normals: Vec<DVec3> = p.faces().iter().map(|f| -(r * f.plane.normal).normalize()).collect();
-                let (mut classes, mut arcs, mut wide) = (Vec::new(), Vec::new(), false);
-                assert!(super::vertical_arcs(p, &points, &normals, &mut classes, &mut arcs, &mut wide));
+                let (mut classes, mut arcs) = (Vec::new(), Vec::new());
+                assert!(super::vertical_arcs(p, &points, &normals, &mut classes, &mut arcs));
                 assert!(arcs.len() >= 4);
                 for arc in &arcs {
                     let [v0, v1] = p.edges()[arc.edge].vertices;
@@ -688,121 +591,5 @@ mod tests {
                 }
             }
         }
-    }
-
-    #[test]
-    fn z_prism_route_equals_the_general_overlay() {
-        // boxes, the bench's hexagons, regular and irregular outlines (some sharing edge directions), extruded along
-        // z (this route) or x (the general one); rotations about z at generic angles, quarter turns (rounded and
-        // exact), angles around the angular tolerance, and one general rotation
-        let hex = [(0.0, 0.0), (60.0, 0.0), (90.0, 30.0), (80.0, 70.0), (20.0, 80.0), (-10.0, 40.0)];
-        let mut shapes = vec![
-            ConvexPolytope::cuboid(DVec3::ZERO, DVec3::new(100.0, 50.0, 2.0)).expect("box"),
-            ConvexPolytope::cuboid(DVec3::new(-1.0, 0.5, 0.0), DVec3::new(4.0, 5.0, 6.0)).expect("box"),
-            prism(&hex, 0.0, 2.0, 2),
-            prism(&hex.map(|(x, y)| (x * 0.7, y * 0.7)), 0.0, 2.0, 2),
-            prism(&[(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 2.0)], -0.5, 0.25, 2),
-            prism(&[(0.0, 0.0), (1.5, 0.5), (0.5, 1.5)], 0.0, 0.75, 2),
-            prism(&[(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 2.0)], -0.5, 0.25, 0),
-            // squared lengths that overflow and underflow (circles of zero length, or refused)
-            scaled(1e160),
-            scaled(1e-170),
-        ];
-        for (n, turn) in [(5, 0.1), (8, 0.0), (7, 1.3)] {
-            let outline: Vec<(f64, f64)> = (0..n)
-                .map(|k| {
-                    let t = turn + k as f64 * std::f64::consts::TAU / n as f64;
-                    (3.0 * t.cos(), 2.0 * t.sin())
-                })
-                .collect();
-            shapes.push(prism(&outline, -1.0, 1.0, 2));
-        }
-        let mut rotations: Vec<DMat3> = (0..52).map(|k| DMat3::from_rotation_z(k as f64 * 0.1234)).collect();
-        for t in [1e-12, 3e-10, 5e-10, 7e-10, 1e-9, 2e-9, 1e-6] {
-            rotations.push(DMat3::from_rotation_z(t));
-            rotations.push(DMat3::from_rotation_z(-t));
-            rotations.push(DMat3::from_rotation_z(std::f64::consts::FRAC_PI_2 + t));
-        }
-        for k in 1..8 {
-            rotations.push(DMat3::from_rotation_z(k as f64 * std::f64::consts::FRAC_PI_4));
-        }
-        rotations.push(DMat3::from_cols(DVec3::Y, -DVec3::X, DVec3::Z));
-        rotations.push(DMat3::from_cols(-DVec3::X, -DVec3::Y, DVec3::Z));
-        rotations.push(DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7));
-        // the z-prisms among them (not the x-extruded one; not the tiny box, whose vertical edges' squared lengths
-        // underflow; the 7-gon is one because the hull computes its face planes accurately: a plainly computed top
-        // normal has a rounded x of 3e-17)
-        let z_prisms = shapes
-            .iter()
-            .filter(|s| {
-                let n: Vec<DVec3> = s.faces().iter().map(|f| f.plane.normal).collect();
-                super::vertical_arcs(s, s.vertices(), &n, &mut Vec::new(), &mut Vec::new(), &mut false)
-            })
-            .count();
-        assert_eq!(z_prisms, 10);
-        let taken_before = super::TAKEN.with(std::cell::Cell::get);
-        let derived_before = super::DERIVED.with(std::cell::Cell::get);
-        let direct_before = super::DIRECT.with(std::cell::Cell::get);
-        let merged_before = super::MERGED.with(std::cell::Cell::get);
-        let (mut cases, mut merged) = (0, 0);
-        for a in &shapes {
-            for b in &shapes {
-                for &r in &rotations {
-                    let fast = format!("{:?}", gauss_map_obstacle(a, r, b));
-                    // the derived cycles assembled directly (`prism_assembly.rs`), not the merged chains (`prism_merge.rs`)
-                    NO_MERGED_CHAINS.with(|c| c.set(true));
-                    let derived_direct = format!("{:?}", gauss_map_obstacle(a, r, b));
-                    NO_MERGED_CHAINS.with(|c| c.set(false));
-                    assert_eq!(fast, derived_direct, "{a:?} {r:?} {b:?}");
-                    // the derived cycles through the general assembly (no direct assembly, `prism_assembly.rs`)
-                    NO_DIRECT_ASSEMBLY.with(|c| c.set(true));
-                    NO_MERGED_CHAINS.with(|c| c.set(true));
-                    let assembled = format!("{:?}", gauss_map_obstacle(a, r, b));
-                    NO_MERGED_CHAINS.with(|c| c.set(false));
-                    NO_DIRECT_ASSEMBLY.with(|c| c.set(false));
-                    assert_eq!(fast, assembled, "{a:?} {r:?} {b:?}");
-                    // all parallel pairs first (not the poles alone, confirmed by the supports' margin)
-                    NO_POLE_MERGES_FIRST.with(|c| c.set(true));
-                    let all_pairs = format!("{:?}", gauss_map_obstacle(a, r, b));
-                    NO_POLE_MERGES_FIRST.with(|c| c.set(false));
-                    assert_eq!(fast, all_pairs, "{a:?} {r:?} {b:?}");
-                    // every support searched through all arcs (no stop at one found with margin)
-                    ALL_ARCS.with(|c| c.set(true));
-                    let all_arcs = format!("{:?}", gauss_map_obstacle(a, r, b));
-                    ALL_ARCS.with(|c| c.set(false));
-                    assert_eq!(fast, all_arcs, "{a:?} {r:?} {b:?}");
-                    // the z-prism route with the general polygon merges (no derived cycles), and the general route
-                    NO_DERIVED_CYCLES.with(|c| c.set(true));
-                    let merged_cycles = format!("{:?}", gauss_map_obstacle(a, r, b));
-                    NO_DERIVED_CYCLES.with(|c| c.set(false));
-                    GENERAL_ROUTE_ONLY.with(|c| c.set(true));
-                    let general = gauss_map_obstacle(a, r, b);
-                    GENERAL_ROUTE_ONLY.with(|c| c.set(false));
-                    assert_eq!(fast, merged_cycles, "{a:?} {r:?} {b:?}");
-                    assert_eq!(fast, format!("{general:?}"), "{a:?} {r:?} {b:?}");
-                    cases += 1;
-                    if let Ok(o) = general {
-                        merged += o.polytope().faces().len();
-                    }
-                }
-            }
-        }
-        // (each z-prism case ran the z-prism route six times: with everything, without the merged chains, without the
-        // direct assembly, without the poles merged first, with all arcs searched, without the derived cycles; a tame
-        // pair is built from the merged chains in the first and the fourth and fifth, from its derived cycles assembled
-        // directly in the second, from its derived cycles through the general assembly in the third)
-        let taken = (super::TAKEN.with(std::cell::Cell::get) - taken_before) / 6;
-        let chains = (super::MERGED.with(std::cell::Cell::get) - merged_before) / 3;
-        let derived = (super::DERIVED.with(std::cell::Cell::get) - derived_before) / 2;
-        let direct = super::DIRECT.with(std::cell::Cell::get) - direct_before;
-        // every tame pair built from the merged chains, and assembled directly from its derived cycles
-        assert_eq!(chains, derived, "{chains} of {derived} derived pairs built from the merged chains");
-        assert_eq!(direct, derived, "{direct} of {derived} derived pairs assembled directly");
-        // the tame pairs (most pairs at generic angles; not the quarter turns, not within 1e-6 of one, not the huge
-        // box) assembled without the polygon merges, bit for bit as the general route
-        assert!(derived * 2 > taken && derived < taken, "{derived} of {taken} derived");
-        // every pair of z-prisms under every rotation about z (all but the last rotation), and no other
-        assert_eq!(taken, z_prisms * z_prisms * (rotations.len() - 1), "{taken} of {cases}");
-        assert!(merged > 0);
     }
 }
