@@ -31,7 +31,9 @@
 //!
 //! Cost: O(S^2) to build the boundary (S polygon edges), O(N^2 S) for the grid.
 
-use crate::polygon2d::{area, contains as polygon_contains, convex_hull_2d, point_segment_distance};
+use crate::polygon2d::{
+    area, contains as polygon_contains, convex_hull_2d, point_segment_distance, signed_boundary_distance,
+};
 use crate::world::WorldComponent;
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus};
@@ -139,11 +141,21 @@ impl Region {
     /// `d(p)`: distance to the boundary when inside, 0 outside. A region without boundary has no area (a bounded
     /// region with interior has a boundary): material above covers its pieces exactly, and `contains` holds only
     /// within the tolerance of their edges, so every point gets 0.
+    ///
+    /// `d(p)` is also at most the distance from `p` to the nearest obstacle (the segment from `p` to it leaves the
+    /// region, so this changes nothing where the boundary is complete). The assembled boundary leaves out the edges
+    /// of parts of the region thinner than its side test's offset, and of parts without area: a face whose edge
+    /// material above covers exactly keeps that edge's points (in the closed face, not inside the open obstacle),
+    /// with no boundary near them. Measured to the boundary alone, such a point, which the grid hits where the edge
+    /// lies on a grid line (a face's edge on the box's side), got the distance to the nearest boundary elsewhere:
+    /// a 214 mm disc on a 4 mm strip of an STL part.
     pub fn clearance(&self, p: DVec2) -> f64 {
         if self.boundary.is_empty() || !self.contains(p) {
             return 0.0;
         }
-        self.boundary.iter().map(|&(a, b)| point_segment_distance(p, a, b)).fold(f64::INFINITY, f64::min)
+        let to_boundary =
+            self.boundary.iter().map(|&(a, b)| point_segment_distance(p, a, b)).fold(f64::INFINITY, f64::min);
+        self.obstacles.iter().map(|o| (-signed_boundary_distance(p, o)).max(0.0)).fold(to_boundary, f64::min)
     }
 
     fn bbox(&self) -> (DVec2, DVec2) {
@@ -213,8 +225,10 @@ impl Region {
     }
 
     /// Largest inscribed disc by grid sampling and compass refinement: `(centre, radius found, upper bound)`. The
-    /// grid's columns and the eight refinements run in parallel; the samples and the refinements are taken in the
-    /// sequential order, so the result does not depend on the threads.
+    /// refinements start from the eight best samples and from the centroid of each piece: a part of the region
+    /// narrower than the grid's spacing may hold no sample (a strip of a face beside material above), and is found
+    /// from its piece's centroid. The grid's columns and the refinements run in parallel; the samples and the
+    /// refinements are taken in the sequential order, so the result does not depend on the threads.
     pub fn largest_disc_sampled(&self, grid: usize) -> (DVec2, f64, f64) {
         let (lo, hi) = self.bbox();
         let n = grid.max(4);
@@ -237,10 +251,13 @@ impl Region {
         if let Some(first) = samples.first() {
             best = (first.1, first.0);
         }
-        let refined: Vec<(DVec2, f64)> = samples[..samples.len().min(8)]
-            .par_iter()
-            .map(|&(_, start)| compass(|q| self.clearance(q), start, h, h * 1e-6))
+        let starts: Vec<DVec2> = samples[..samples.len().min(8)]
+            .iter()
+            .map(|s| s.1)
+            .chain(self.pieces.iter().map(|p| p.iter().copied().sum::<DVec2>() / p.len() as f64))
             .collect();
+        let refined: Vec<(DVec2, f64)> =
+            starts.par_iter().map(|&start| compass(|q| self.clearance(q), start, h, h * 1e-6)).collect();
         for (p, d) in refined {
             if d > best.1 {
                 best = (p, d);
@@ -301,50 +318,62 @@ impl Region {
     }
 }
 
-/// Maximises `f` by compass search from `start` with initial step `step` down to `min_step`.
+/// The least gain of a compass move per unit of its length: a move that gains less follows a ridge of the clearance
+/// too flat to be worth following (along it the clearance grows by less than 1e-6 of the ridge's length), and the
+/// search goes on at a smaller step instead. Such ridges are strips whose edges are nearly, not exactly, parallel to
+/// an axis (a face read from single-precision data, or turned into a tilted face's frame): no search direction
+/// follows the ridge, and a move along an axis gains the step times the edges' slope (1e-8 in an STL part) until it
+/// crosses the ridge, which at the smallest steps took 20 million moves and 20 s for a strip 1.4 mm wide.
+const COMPASS_MIN_SLOPE: f64 = 1e-6;
+
+/// The most evaluations of one compass search ([`compass`], [`compass3`]): a search reaches its smallest step in a
+/// few hundred. The bound holds where a ridge steeper than [`COMPASS_MIN_SLOPE`] still leads nowhere fast; the
+/// value found is a clearance that was evaluated, so still a lower bound.
+const COMPASS_EVALUATIONS: usize = 4096;
+
+/// Maximises `f` by compass search from `start` with initial step `step` down to `min_step`, within
+/// [`COMPASS_EVALUATIONS`] evaluations of `f`.
 fn compass(f: impl Fn(DVec2) -> f64, start: DVec2, step: f64, min_step: f64) -> (DVec2, f64) {
-    let mut p = start;
-    let mut value = f(p);
-    let mut h = step;
-    while h > min_step {
-        let mut improved = false;
-        for d in [
-            DVec2::X,
-            DVec2::NEG_X,
-            DVec2::Y,
-            DVec2::NEG_Y,
-            DVec2::ONE,
-            -DVec2::ONE,
-            DVec2::new(1.0, -1.0),
-            DVec2::new(-1.0, 1.0),
-        ] {
-            let q = p + d * h;
-            let v = f(q);
-            if v > value {
-                p = q;
-                value = v;
-                improved = true;
-                break;
-            }
-        }
-        if !improved {
-            h *= 0.5;
-        }
-    }
-    (p, value)
+    let dirs = [
+        DVec2::X,
+        DVec2::NEG_X,
+        DVec2::Y,
+        DVec2::NEG_Y,
+        DVec2::ONE,
+        -DVec2::ONE,
+        DVec2::new(1.0, -1.0),
+        DVec2::new(-1.0, 1.0),
+    ];
+    pattern_search(f, start, &dirs, step, min_step)
 }
 
+/// [`compass`] in three dimensions (the axis directions).
 fn compass3(f: impl Fn(DVec3) -> f64, start: DVec3, step: f64, min_step: f64) -> (DVec3, f64) {
+    pattern_search(f, start, &[DVec3::X, DVec3::NEG_X, DVec3::Y, DVec3::NEG_Y, DVec3::Z, DVec3::NEG_Z], step, min_step)
+}
+
+/// Compass search over the directions `dirs`: the first direction that improves `f` by more than
+/// [`COMPASS_MIN_SLOPE`] times the current step is taken, and the step is halved when none does, until it is at most
+/// `min_step` or [`COMPASS_EVALUATIONS`] are spent.
+fn pattern_search<V>(f: impl Fn(V) -> f64, start: V, dirs: &[V], step: f64, min_step: f64) -> (V, f64)
+where
+    V: Copy + std::ops::Add<Output = V> + std::ops::Mul<f64, Output = V> + std::fmt::Debug,
+{
     let mut p = start;
     let mut value = f(p);
+    let mut evaluations = 1;
     let mut h = step;
-    let dirs = [DVec3::X, DVec3::NEG_X, DVec3::Y, DVec3::NEG_Y, DVec3::Z, DVec3::NEG_Z];
-    while h > min_step {
+    'search: while h > min_step {
         let mut improved = false;
-        for d in dirs {
+        for &d in dirs {
+            if evaluations >= COMPASS_EVALUATIONS {
+                tracing::debug!(?p, value, step = h, "compass search stopped after {COMPASS_EVALUATIONS} evaluations");
+                break 'search;
+            }
+            evaluations += 1;
             let q = p + d * h;
             let v = f(q);
-            if v > value {
+            if v > value + COMPASS_MIN_SLOPE * h {
                 p = q;
                 value = v;
                 improved = true;
@@ -422,55 +451,109 @@ pub fn grasp_faces(part: &Part, rotation: DMat3, position: DVec3, options: &Gras
 /// [`GraspOptions::max_tilt`] the faces tilted up to it, each family of parallel faces analysed with the part turned
 /// so that they are level (the minimal rotation taking their normal to +z), then turned back. A tilted family whose
 /// faces add up to less area than one cup is left out: no cup fits on it.
+///
+/// Parallel means parallel to the tolerance of the level test ([`UP_COS_TOLERANCE`], about 4.5e-5 rad): a face whose
+/// normal is that close to a family's normal is level in the family's turned frame, and is analysed there with the
+/// family's faces, so a family of its own would only repeat it. Faces of one plane read from single-precision data
+/// (STL) have normals that differ by rounding (1e-8 to 1e-5 rad); they are one family, whose normal is that of its
+/// largest face ([`tilted_families`]).
 pub fn grasp_faces_of_components(components: &[WorldComponent], tol: f64, options: &GraspOptions) -> Vec<GraspFace> {
     let mut out = level_faces(components, tol, options);
     if options.max_tilt > 0.0 {
-        let min_z = options.max_tilt.min(std::f64::consts::FRAC_PI_2 - 1e-6).cos();
-        // families of parallel tilted faces with their total area: a family with less area than the cup cannot
-        // hold it (nor a pattern of cups), and is not analysed
-        let mut normals: Vec<(DVec3, f64)> = Vec::new();
-        for c in components {
-            let v = c.polytope.vertices();
-            for f in c.polytope.faces() {
-                let n = f.plane.normal;
-                if n.z < min_z || n.z >= 1.0 - UP_COS_TOLERANCE {
-                    continue;
-                }
-                let face_area =
-                    stackplan_geom::polytope::newell_normal(f.vertices.iter().map(|&i| v[i])).length() / 2.0;
-                match normals.iter_mut().find(|(m, _)| (*m - n).length() <= 1e-9) {
-                    Some((_, a)) => *a += face_area,
-                    None => normals.push((n, face_area)),
-                }
-            }
-        }
         let cup_area = std::f64::consts::PI * (0.5 * options.cup_diameter).powi(2);
-        for n in normals.into_iter().filter(|(_, a)| *a >= cup_area).map(|(n, _)| n) {
-            let turn = DMat3::from_quat(glam::DQuat::from_rotation_arc(n, DVec3::Z));
-            let back = turn.transpose();
-            let turned: Vec<WorldComponent> =
-                components.iter().map(|c| WorldComponent::new(c.polytope.transformed(turn, DVec3::ZERO))).collect();
-            let tilt = n.z.clamp(-1.0, 1.0).acos();
-            out.extend(level_faces(&turned, tol, options).into_iter().map(|mut f| {
-                f.polygons = f.polygons.iter().map(|p| p.iter().map(|q| back * *q).collect()).collect();
-                f.center = back * f.center;
-                f.height = f.center.z;
-                if let Some(fit) = &mut f.pattern_fit {
-                    fit.point = back * fit.point;
-                }
-                f.tilt = tilt;
-                f
-            }));
+        // a family with less area than the cup cannot hold it (nor a pattern of cups), and is not analysed
+        for family in tilted_families(components, options.max_tilt).into_iter().filter(|f| f.area >= cup_area) {
+            out.extend(tilted_faces(components, family.normal, tol, options));
         }
         out.sort_by(|a, b| b.inscribed_radius.total_cmp(&a.inscribed_radius).then(b.height.total_cmp(&a.height)));
     }
     out
 }
 
-/// The level grasp faces of world-coordinate components.
-fn level_faces(components: &[WorldComponent], tol: f64, options: &GraspOptions) -> Vec<GraspFace> {
-    // upward faces grouped by height
-    let mut groups: Vec<(f64, Vec<Vec<DVec3>>)> = Vec::new();
+/// A family of parallel upward faces tilted from level: see [`tilted_families`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TiltedFamily {
+    /// The family's unit normal (world): the normal of its largest face.
+    pub normal: DVec3,
+    /// The faces' total area (mm^2).
+    pub area: f64,
+    /// How many component faces it has.
+    pub faces: usize,
+}
+
+/// The families of upward component faces tilted from level by at most `max_tilt` (and not level: `n.z < 1 -`
+/// [`UP_COS_TOLERANCE`]), largest face first. A face joins the first family (of those started by larger faces) whose
+/// normal `m` has `n . m >= 1 - UP_COS_TOLERANCE`, the level test of the family's turned frame; otherwise it starts a
+/// family. Families of distinct faces of a part are degrees apart; faces of one plane read from single-precision data
+/// are 1e-8 to 1e-5 rad apart. O(F G) for F tilted faces in G families.
+pub fn tilted_families(components: &[WorldComponent], max_tilt: f64) -> Vec<TiltedFamily> {
+    let min_z = max_tilt.min(std::f64::consts::FRAC_PI_2 - 1e-6).cos();
+    let mut faces: Vec<(DVec3, f64)> = Vec::new();
+    for c in components {
+        let v = c.polytope.vertices();
+        for f in c.polytope.faces() {
+            let n = f.plane.normal;
+            if n.z < min_z || n.z >= 1.0 - UP_COS_TOLERANCE {
+                continue;
+            }
+            let face_area = stackplan_geom::polytope::newell_normal(f.vertices.iter().map(|&i| v[i])).length() / 2.0;
+            faces.push((n, face_area));
+        }
+    }
+    // largest first (stable: equal areas keep the components' order), so that a family's normal is that of its
+    // largest face, the one that rounding turns least
+    faces.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let mut families: Vec<TiltedFamily> = Vec::new();
+    for (n, face_area) in faces {
+        match families.iter_mut().find(|g| g.normal.dot(n) >= 1.0 - UP_COS_TOLERANCE) {
+            Some(g) => {
+                g.area += face_area;
+                g.faces += 1;
+            }
+            None => families.push(TiltedFamily { normal: n, area: face_area, faces: 1 }),
+        }
+    }
+    families
+}
+
+/// The grasp faces of the family of faces with unit normal `normal`: the part turned so that they are level (the
+/// minimal rotation taking `normal` to +z), its level faces, turned back.
+fn tilted_faces(components: &[WorldComponent], normal: DVec3, tol: f64, options: &GraspOptions) -> Vec<GraspFace> {
+    let turn = DMat3::from_quat(glam::DQuat::from_rotation_arc(normal, DVec3::Z));
+    let back = turn.transpose();
+    let turned: Vec<WorldComponent> =
+        components.iter().map(|c| WorldComponent::new(c.polytope.transformed(turn, DVec3::ZERO))).collect();
+    let tilt = normal.z.clamp(-1.0, 1.0).acos();
+    level_faces(&turned, tol, options)
+        .into_iter()
+        .map(|mut f| {
+            f.polygons = f.polygons.iter().map(|p| p.iter().map(|q| back * *q).collect()).collect();
+            f.center = back * f.center;
+            f.height = f.center.z;
+            if let Some(fit) = &mut f.pattern_fit {
+                fit.point = back * fit.point;
+            }
+            f.tilt = tilt;
+            f
+        })
+        .collect()
+}
+
+/// Upward faces of one height: their polygons, the height of the first (the mean of its vertices' heights) and the
+/// lowest and highest vertex of all.
+struct HeightGroup {
+    height: f64,
+    low: f64,
+    high: f64,
+    polygons: Vec<Vec<DVec3>>,
+}
+
+/// The upward faces (`n.z >= 1 - UP_COS_TOLERANCE`) of world-coordinate components grouped by height: faces whose
+/// vertices' height ranges come within `tol` of each other are one group (transitively). A face that is level only
+/// to the tolerance of the level test, or whose vertices lie in its plane only to rounding (single-precision data),
+/// spans a range of heights; a range, not its mean, is what decides whether faces of one plane are one group.
+fn height_groups(components: &[WorldComponent], tol: f64) -> Vec<HeightGroup> {
+    let mut groups: Vec<HeightGroup> = Vec::new();
     for c in components {
         let v = c.polytope.vertices();
         for f in c.polytope.faces() {
@@ -478,16 +561,39 @@ fn level_faces(components: &[WorldComponent], tol: f64, options: &GraspOptions) 
                 continue;
             }
             let poly: Vec<DVec3> = f.vertices.iter().map(|&i| v[i]).collect();
-            let h = poly.iter().map(|p| p.z).sum::<f64>() / poly.len() as f64;
-            match groups.iter_mut().find(|g| (g.0 - h).abs() <= tol) {
-                Some(g) => g.1.push(poly),
-                None => groups.push((h, vec![poly])),
+            let height = poly.iter().map(|p| p.z).sum::<f64>() / poly.len() as f64;
+            let low = poly.iter().map(|p| p.z).fold(height, f64::min);
+            let high = poly.iter().map(|p| p.z).fold(height, f64::max);
+            let meets = |g: &HeightGroup| low <= g.high + tol && g.low <= high + tol;
+            let hits: Vec<usize> = (0..groups.len()).filter(|&i| meets(&groups[i])).collect();
+            let Some(&k) = hits.first() else {
+                groups.push(HeightGroup { height, low, high, polygons: vec![poly] });
+                continue;
+            };
+            // the face may bridge this group and later ones: they become one, in the order of their first faces
+            let later: Vec<HeightGroup> = hits[1..].iter().rev().map(|&i| groups.remove(i)).collect();
+            let group = &mut groups[k];
+            for g in later.into_iter().rev() {
+                group.low = group.low.min(g.low);
+                group.high = group.high.max(g.high);
+                group.polygons.extend(g.polygons);
             }
+            group.low = group.low.min(low);
+            group.high = group.high.max(high);
+            group.polygons.push(poly);
         }
     }
+    groups
+}
+
+/// The level grasp faces of world-coordinate components. Material above a group of faces is what lies higher than
+/// `tol` above its highest vertex: a face of the group is never material above the group, even where rounding tilts
+/// it (were its own component clipped at the group's mean height, the part of it above would be subtracted from it,
+/// leaving a region bounded by nearly coincident edges of a face and of its own shadow).
+fn level_faces(components: &[WorldComponent], tol: f64, options: &GraspOptions) -> Vec<GraspFace> {
     let cup_radius = 0.5 * options.cup_diameter;
     let mut out = Vec::new();
-    for (h, polys) in groups {
+    for HeightGroup { height: h, high, polygons: polys, .. } in height_groups(components, tol) {
         let pieces: Vec<Vec<DVec2>> = polys
             .iter()
             .map(|p| convex_hull_2d(&p.iter().map(|q| DVec2::new(q.x, q.y)).collect::<Vec<_>>(), tol))
@@ -497,10 +603,11 @@ fn level_faces(components: &[WorldComponent], tol: f64, options: &GraspOptions) 
             continue;
         }
         let total_area: f64 = pieces.iter().map(|p| area(p)).sum();
+        let above = high.max(h) + tol;
         let obstacles: Vec<Vec<DVec2>> = components
             .iter()
-            .filter(|c| c.aabb.1.z > h + tol)
-            .map(|c| projection_above(c, h + tol, tol))
+            .filter(|c| c.aabb.1.z > above)
+            .map(|c| projection_above(c, above, tol))
             .filter(|p| p.len() >= 3 && area(p) > tol * tol)
             .collect();
         let region = Region::new(pieces, obstacles, tol);

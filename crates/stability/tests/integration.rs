@@ -8,6 +8,7 @@ mod clearance_slice;
 mod common;
 mod contacts;
 mod grasp_poses;
+mod grasp_realparts;
 mod growing;
 mod insertion;
 mod instability;
