@@ -10,8 +10,11 @@
 //! the thickness), and [`bend`] turns each bend into convex segments that contain it.
 
 pub mod bend;
+pub mod geometry;
 pub mod mesh_faces;
+pub mod nurbs;
 pub mod recognise;
+pub mod trimmed;
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
