@@ -460,10 +460,11 @@ fn two_solids_need_a_choice() {
     assert!(matches!(e, IoError::SeveralSolids { count: 2, .. }), "{e:?}");
     assert!(e.to_string().contains("2 solids") && e.to_string().contains("--solid"), "{e}");
     for index in 0..2 {
-        let brep = parse(&two, &StepOptions { solid: Some(index) }).expect("a chosen solid reads");
+        let brep =
+            parse(&two, &StepOptions { solid: Some(index), ..Default::default() }).expect("a chosen solid reads");
         assert_eq!(brep.faces.len(), 6);
     }
-    let e = expect_err(&two, &StepOptions { solid: Some(2) });
+    let e = expect_err(&two, &StepOptions { solid: Some(2), ..Default::default() });
     assert!(matches!(e, IoError::NoSuchSolid { index: 2, count: 2, .. }), "{e:?}");
     // A closed shell that no solid uses is a solid of its own.
     let bare = text.replace(&format!("#{solid} = MANIFOLD_SOLID_BREP('box',#{shell});"), "");

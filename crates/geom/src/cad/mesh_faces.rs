@@ -179,7 +179,7 @@ pub(crate) fn mesh_faces(points: &[DVec3], triangles: &[MeshPolygon], tolerance:
         volume,
         "mesh faces"
     );
-    Ok(Brep { faces, volume: Some(volume) })
+    Ok(Brep { faces, volume: Some(volume), tessellation: None })
 }
 
 /// The validated mesh with triangle adjacency and per-triangle geometry.

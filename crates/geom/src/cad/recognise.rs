@@ -126,6 +126,11 @@ pub struct Recognition {
     pub max_deviation: f64,
     /// The bend tolerance the pieces were made with (mm).
     pub bend_tolerance: f64,
+    /// For a STEP solid with faces on other surfaces than planes and cylinders: how it was tessellated. The pieces
+    /// are then recognised from the mesh: they contain it, and the solid to within the chord tolerance; they stand
+    /// outside the solid by at most `max_deviation`, which includes the chord tolerance.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tessellation: Option<super::Tessellation>,
 }
 
 /// Why a solid is not recognised as sheet metal. Every message names the faces.
@@ -219,6 +224,16 @@ pub enum RecogniseError {
     /// A bad option.
     #[error("the bend tolerance must be positive and finite, got {0}")]
     BadTolerance(f64),
+    /// A tessellated solid whose chord tolerance leaves nothing of the bend tolerance for the pieces.
+    #[error(
+        "the bend tolerance ({bend_tolerance} mm) must exceed the chord tolerance of the tessellation ({chord} mm)"
+    )]
+    ChordTolerance {
+        /// The chord tolerance (mm).
+        chord: f64,
+        /// The bend tolerance (mm).
+        bend_tolerance: f64,
+    },
 }
 
 /// One planar face, prepared: its frame and its loops as 2-D polygons (arcs sampled) for overlap tests.
@@ -253,6 +268,12 @@ const ARC_STEP: f64 = std::f64::consts::PI / 36.0;
 pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<(Part, Recognition), RecogniseError> {
     if !(options.bend_tolerance > 0.0 && options.bend_tolerance.is_finite()) {
         return Err(RecogniseError::BadTolerance(options.bend_tolerance));
+    }
+    // a tessellated solid: the mesh stands up to its chord tolerance outside the solid, so the pieces get the rest
+    let chord = brep.tessellation.map_or(0.0, |t| t.chord_tolerance);
+    let bend_tolerance = options.bend_tolerance - chord;
+    if !(bend_tolerance > 0.0) {
+        return Err(RecogniseError::ChordTolerance { chord, bend_tolerance: options.bend_tolerance });
     }
     let tol = options.tolerance.max(1e-12);
     let planes: Vec<PlanarFace<'_>> = brep
@@ -313,7 +334,7 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
                 .or_else(|| partners.iter().find_map(|p| p.filter(|&(j, d)| j == i && at_thickness(d)).map(|(_, d)| d)))
                 .unwrap_or(thickness);
             let shift = -f.normal * (d / 2.0);
-            let (rings, deviation, arcs) = conservative_rings(f, options.bend_tolerance);
+            let (rings, deviation, arcs) = conservative_rings(f, bend_tolerance);
             max_deviation = max_deviation.max(deviation);
             let lift = |ring: &Vec<DVec3>| -> Vec<DVec3> {
                 ring.iter().map(|p| *p - f.normal * (*p - f.point).dot(f.normal) + shift).collect()
@@ -415,10 +436,10 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
             Some(points) => {
                 let angles: Vec<f64> =
                     points.iter().map(|p| angle_of(b.bend.axis, b.bend.start, b.bend.center, *p)).collect();
-                b.bend.cuts_among(&angles, options.bend_tolerance)
+                b.bend.cuts_among(&angles, bend_tolerance)
             }
             None => {
-                let n = b.bend.segments_within(options.bend_tolerance);
+                let n = b.bend.segments_within(bend_tolerance);
                 (0..=n).map(|k| b.bend.angle * k as f64 / n as f64).collect()
             }
         };
@@ -447,6 +468,7 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
     check_overlap(&components, &owners, 10.0 * sheet_tol)?;
     check_cover(brep, &components, tol.max(1e-9 * diagonal(&components)), thickness, &partners, &planes)?;
     let solid_volume = brep.volume.unwrap_or(exact_volume);
+    let max_deviation = max_deviation + chord;
     let origin = PartOrigin::RecognisedSheet {
         thickness,
         plates: plate_records.len(),
@@ -476,6 +498,7 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
         pieces_volume,
         max_deviation,
         bend_tolerance: options.bend_tolerance,
+        tessellation: brep.tessellation,
     };
     Ok((part, recognition))
 }
@@ -1099,7 +1122,7 @@ mod tests {
                 loops: vec![vec![circle(0.0)], vec![circle(t)]],
             });
         }
-        Brep { faces, volume: None }
+        Brep { faces, volume: None, tessellation: None }
     }
 
     fn exact_volume(hole: bool) -> f64 {
