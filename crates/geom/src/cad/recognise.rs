@@ -335,6 +335,7 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
                 .unwrap_or(thickness);
             let shift = -f.normal * (d / 2.0);
             let (rings, deviation, arcs) = conservative_rings(f, bend_tolerance);
+            let rings = narrowest_holes(f, rings, back.iter().map(|&j| &planes[j]), bend_tolerance);
             max_deviation = max_deviation.max(deviation);
             let lift = |ring: &Vec<DVec3>| -> Vec<DVec3> {
                 ring.iter().map(|p| *p - f.normal * (*p - f.point).dot(f.normal) + shift).collect()
@@ -694,6 +695,50 @@ fn conservative_rings(f: &PlanarFace<'_>, tolerance: f64) -> (Vec<Vec<DVec3>>, f
         out.push(ring);
     }
     (out, deviation, arcs)
+}
+
+/// The holes of a plate's front face narrowed to the other side's: a hole of a face on the other side whose
+/// projection lies inside a hole of the front face and is smaller replaces it (the smallest such), so that the
+/// plate's hole is the narrowest section of a countersunk or counterbored hole and never cuts into material. A hole
+/// of the other side that only overlaps one of the front's is left to the cover check.
+fn narrowest_holes<'a>(
+    f: &PlanarFace<'_>,
+    mut rings: Vec<Vec<DVec3>>,
+    back: impl Iterator<Item = &'a PlanarFace<'a>>,
+    tolerance: f64,
+) -> Vec<Vec<DVec3>> {
+    let to2 = |p: DVec3| DVec2::new((p - f.point).dot(f.u), (p - f.point).dot(f.v));
+    let area = |ring: &[DVec2]| {
+        let n = ring.len();
+        (0..n).map(|k| ring[k].perp_dot(ring[(k + 1) % n])).sum::<f64>().abs() / 2.0
+    };
+    let back_holes: Vec<Vec<DVec3>> = back.flat_map(|b| conservative_rings(b, tolerance).0.into_iter().skip(1)).collect();
+    for hole in rings.iter_mut().skip(1) {
+        let h2: Vec<DVec2> = hole.iter().map(|p| to2(*p)).collect();
+        let mut best = area(&h2) * (1.0 - 1e-9);
+        let mut narrower: Option<&Vec<DVec3>> = None;
+        for b in &back_holes {
+            let b2: Vec<DVec2> = b.iter().map(|p| to2(*p)).collect();
+            let a = area(&b2);
+            if a < best && b2.iter().all(|q| point_in_ring(*q, &h2) != PointInRing::Outside) {
+                best = a;
+                narrower = Some(b);
+            }
+        }
+        if let Some(b) = narrower {
+            // onto the front face's plane, in the front's hole orientation (clockwise about its normal)
+            let mut ring: Vec<DVec3> = b.iter().map(|p| *p - f.normal * (*p - f.point).dot(f.normal)).collect();
+            let signed = {
+                let o = ring[0];
+                (1..ring.len() - 1).map(|k| (ring[k] - o).cross(ring[k + 1] - o).dot(f.normal)).sum::<f64>()
+            };
+            if signed > 0.0 {
+                ring.reverse();
+            }
+            *hole = ring;
+        }
+    }
+    rings
 }
 
 /// Steps for an arc of radius `r` and sweep `phi` within `tolerance`: tangents deviate by `r (1/cos(d/2) - 1)`,
