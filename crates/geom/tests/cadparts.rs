@@ -220,5 +220,8 @@ fn damaged_surfaces_and_curves_give_errors_that_name_the_entity() {
     // a surface the reader does not know: still named
     let bad = cone.replacen("CONICAL_SURFACE('',#", "DEGENERATE_TOROIDAL_SURFACE('',#", 1);
     let e = parse_step(bad.as_bytes(), Path::new("cone.step"), &StepOptions::default()).expect_err("unknown");
-    assert!(matches!(&e, IoError::Unsupported { kind, role: "faces", .. } if kind == "DEGENERATE_TOROIDAL_SURFACE"), "{e}");
+    assert!(
+        matches!(&e, IoError::Unsupported { kind, role: "faces", .. } if kind == "DEGENERATE_TOROIDAL_SURFACE"),
+        "{e}"
+    );
 }

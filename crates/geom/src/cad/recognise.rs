@@ -335,7 +335,8 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
                 .unwrap_or(thickness);
             let shift = -f.normal * (d / 2.0);
             let (rings, deviation, arcs) = conservative_rings(f, bend_tolerance);
-            let rings = narrowest_holes(f, rings, back.iter().map(|&j| &planes[j]), bend_tolerance);
+            let (rings, gained) = narrowest_holes(f, rings, back.iter().map(|&j| &planes[j]), bend_tolerance);
+            let plate_area = f.area + gained;
             max_deviation = max_deviation.max(deviation);
             let lift = |ring: &Vec<DVec3>| -> Vec<DVec3> {
                 ring.iter().map(|p| *p - f.normal * (*p - f.point).dot(f.normal) + shift).collect()
@@ -347,12 +348,12 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
                 faces: vec![f.face.source.clone()],
                 other_side: back.iter().map(|&j| planes[j].face.source.clone()).collect(),
                 normal: f.normal,
-                area: f.area,
+                area: plate_area,
                 holes: rings3.len(),
                 arcs,
                 pieces: Vec::new(),
             });
-            exact_volume += f.area * thickness;
+            exact_volume += plate_area * thickness;
             sheet.faces.push(SheetFace { outline, holes: rings3 });
         }
     }
@@ -700,22 +701,26 @@ fn conservative_rings(f: &PlanarFace<'_>, tolerance: f64) -> (Vec<Vec<DVec3>>, f
 /// The holes of a plate's front face narrowed to the other side's: a hole of a face on the other side whose
 /// projection lies inside a hole of the front face and is smaller replaces it (the smallest such), so that the
 /// plate's hole is the narrowest section of a countersunk or counterbored hole and never cuts into material. A hole
-/// of the other side that only overlaps one of the front's is left to the cover check.
+/// of the other side that only overlaps one of the front's is left to the cover check. Returns the rings and the
+/// area the plate gains (mm^2).
 fn narrowest_holes<'a>(
     f: &PlanarFace<'_>,
     mut rings: Vec<Vec<DVec3>>,
     back: impl Iterator<Item = &'a PlanarFace<'a>>,
     tolerance: f64,
-) -> Vec<Vec<DVec3>> {
+) -> (Vec<Vec<DVec3>>, f64) {
+    let mut gained = 0.0;
     let to2 = |p: DVec3| DVec2::new((p - f.point).dot(f.u), (p - f.point).dot(f.v));
     let area = |ring: &[DVec2]| {
         let n = ring.len();
         (0..n).map(|k| ring[k].perp_dot(ring[(k + 1) % n])).sum::<f64>().abs() / 2.0
     };
-    let back_holes: Vec<Vec<DVec3>> = back.flat_map(|b| conservative_rings(b, tolerance).0.into_iter().skip(1)).collect();
+    let back_holes: Vec<Vec<DVec3>> =
+        back.flat_map(|b| conservative_rings(b, tolerance).0.into_iter().skip(1)).collect();
     for hole in rings.iter_mut().skip(1) {
         let h2: Vec<DVec2> = hole.iter().map(|p| to2(*p)).collect();
-        let mut best = area(&h2) * (1.0 - 1e-9);
+        let own = area(&h2);
+        let mut best = own * (1.0 - 1e-9);
         let mut narrower: Option<&Vec<DVec3>> = None;
         for b in &back_holes {
             let b2: Vec<DVec2> = b.iter().map(|p| to2(*p)).collect();
@@ -736,9 +741,10 @@ fn narrowest_holes<'a>(
                 ring.reverse();
             }
             *hole = ring;
+            gained += own - best;
         }
     }
-    rings
+    (rings, gained)
 }
 
 /// Steps for an arc of radius `r` and sweep `phi` within `tolerance`: tangents deviate by `r (1/cos(d/2) - 1)`,
