@@ -657,7 +657,7 @@ impl<'a> Mesh<'a> {
 
     /// The cylinder of an accepted run, its axis the mean direction of its lines; `None` if the refined fit fails.
     fn fit_bend(&self, regions: &Regions, lines: &[SharedLine], run: &Run) -> Option<Bend> {
-        let Some(&first) = run.lines.first() else { return None };
+        let &first = run.lines.first()?;
         let reference = lines[first].direction();
         let mut sum = DVec3::ZERO;
         for &l in &run.lines {
@@ -669,9 +669,7 @@ impl<'a> Mesh<'a> {
             return None;
         }
         let frame = Frame::new(self.centre, axis);
-        let Some((circle, residual)) = fit_run(regions, lines, run, &frame) else {
-            return None;
-        };
+        let (circle, residual) = fit_run(regions, lines, run, &frame)?;
         let tolerance = self.fit_tolerance(circle.radius);
         if residual > tolerance {
             tracing::debug!(residual, tolerance, "the refined fit of a run fails");

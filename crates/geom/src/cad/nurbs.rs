@@ -454,7 +454,8 @@ mod tests {
     #[test]
     fn inconsistent_knots_poles_and_weights_are_errors() {
         let poles: Vec<DVec3> = (0..4).map(|k| DVec3::new(k as f64, 0.0, 0.0)).collect();
-        let cases: [(i64, Vec<i64>, Vec<f64>, Option<Vec<f64>>); 7] = [
+        type Case = (i64, Vec<i64>, Vec<f64>, Option<Vec<f64>>);
+        let cases: [Case; 7] = [
             (0, vec![1, 1], vec![0.0, 1.0], None),
             (3, vec![4, 3], vec![0.0, 1.0], None),
             (3, vec![4, 4], vec![1.0, 0.0], None),

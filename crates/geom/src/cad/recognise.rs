@@ -272,7 +272,7 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
     // a tessellated solid: the mesh stands up to its chord tolerance outside the solid, so the pieces get the rest
     let chord = brep.tessellation.map_or(0.0, |t| t.chord_tolerance);
     let bend_tolerance = options.bend_tolerance - chord;
-    if !(bend_tolerance > 0.0) {
+    if bend_tolerance.is_nan() || bend_tolerance <= 0.0 {
         return Err(RecogniseError::ChordTolerance { chord, bend_tolerance: options.bend_tolerance });
     }
     let tol = options.tolerance.max(1e-12);

@@ -374,7 +374,7 @@ mod tests {
         let n = crate::cad::geometry::conic_steps(r, PI / 2.0, tol);
         let corners = [DVec2::new(0.0, 0.0), DVec2::new(PI / 2.0, 0.0), DVec2::new(PI / 2.0, w), DVec2::new(0.0, w)];
         let lp = rectangle(&cylinder, corners, &|a, b| if a.y == b.y { n } else { 1 });
-        let mesh = triangulate_trimmed(&cylinder, &[lp.clone()], tol, lp.len(), 1000).expect("mesh");
+        let mesh = triangulate_trimmed(&cylinder, std::slice::from_ref(&lp), tol, lp.len(), 1000).expect("mesh");
         assert!(mesh.points.is_empty(), "no interior point on a ruled strip");
         assert_eq!(mesh.triangles.len(), 2 * n);
         let p = |i: usize| lp[i].p;
@@ -401,7 +401,7 @@ mod tests {
             let r = if a.y == b.y { 8.0 + 3.0 * a.y.cos() } else { 3.0 };
             crate::cad::geometry::conic_steps(r, (b - a).length(), tol)
         });
-        let mesh = triangulate_trimmed(&torus, &[lp.clone()], tol, lp.len(), 100_000).expect("mesh");
+        let mesh = triangulate_trimmed(&torus, std::slice::from_ref(&lp), tol, lp.len(), 100_000).expect("mesh");
         assert!(!mesh.points.is_empty());
         let point = |i: usize| if i < lp.len() { lp[i].p } else { mesh.points[i - lp.len()] };
         let mut area = 0.0;

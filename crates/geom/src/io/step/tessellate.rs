@@ -133,7 +133,7 @@ impl Builder<'_, '_> {
                 let p = self.points[k];
                 let q = surface.inverse(p, hint);
                 let off = (surface.point(q) - p).length();
-                if !(off <= allowed) {
+                if off.is_nan() || off > allowed {
                     return Err(self.failure(
                         id,
                         format!(
