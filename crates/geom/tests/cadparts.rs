@@ -225,3 +225,88 @@ fn damaged_surfaces_and_curves_give_errors_that_name_the_entity() {
         "{e}"
     );
 }
+
+/// A conical ring as Parasolid writes periodic faces: a full cone and a full cylinder each between two circles,
+/// without seam edges. Bottom annulus r 5..10 at z = 0, top annulus r 5..12 at z = 2, a 45 degree cone outside.
+const SEAMLESS_RING: &str = "ISO-10303-21;
+HEADER;
+FILE_DESCRIPTION((''),'2;1');
+FILE_NAME('ring','',(''),(''),'','','');
+FILE_SCHEMA(('AUTOMOTIVE_DESIGN'));
+ENDSEC;
+DATA;
+#1=CARTESIAN_POINT('',(0.,0.,0.));
+#2=DIRECTION('',(0.,0.,1.));
+#3=DIRECTION('',(1.,0.,0.));
+#4=AXIS2_PLACEMENT_3D('',#1,#2,#3);
+#5=CARTESIAN_POINT('',(0.,0.,2.));
+#6=AXIS2_PLACEMENT_3D('',#5,#2,#3);
+#10=CIRCLE('',#4,10.);
+#11=CIRCLE('',#4,5.);
+#12=CIRCLE('',#6,12.);
+#13=CIRCLE('',#6,5.);
+#20=CARTESIAN_POINT('',(10.,0.,0.));
+#21=CARTESIAN_POINT('',(5.,0.,0.));
+#22=CARTESIAN_POINT('',(12.,0.,2.));
+#23=CARTESIAN_POINT('',(5.,0.,2.));
+#30=VERTEX_POINT('',#20);
+#31=VERTEX_POINT('',#21);
+#32=VERTEX_POINT('',#22);
+#33=VERTEX_POINT('',#23);
+#40=EDGE_CURVE('',#30,#30,#10,.T.);
+#41=EDGE_CURVE('',#31,#31,#11,.T.);
+#42=EDGE_CURVE('',#32,#32,#12,.T.);
+#43=EDGE_CURVE('',#33,#33,#13,.T.);
+#50=ORIENTED_EDGE('',*,*,#40,.T.);
+#51=ORIENTED_EDGE('',*,*,#40,.F.);
+#52=ORIENTED_EDGE('',*,*,#41,.T.);
+#53=ORIENTED_EDGE('',*,*,#41,.F.);
+#54=ORIENTED_EDGE('',*,*,#42,.T.);
+#55=ORIENTED_EDGE('',*,*,#42,.F.);
+#56=ORIENTED_EDGE('',*,*,#43,.T.);
+#57=ORIENTED_EDGE('',*,*,#43,.F.);
+#60=EDGE_LOOP('',(#51));
+#61=EDGE_LOOP('',(#52));
+#62=EDGE_LOOP('',(#54));
+#63=EDGE_LOOP('',(#57));
+#64=EDGE_LOOP('',(#50));
+#65=EDGE_LOOP('',(#55));
+#66=EDGE_LOOP('',(#53));
+#67=EDGE_LOOP('',(#56));
+#70=FACE_OUTER_BOUND('',#60,.T.);
+#71=FACE_BOUND('',#61,.T.);
+#72=FACE_OUTER_BOUND('',#62,.T.);
+#73=FACE_BOUND('',#63,.T.);
+#74=FACE_BOUND('',#64,.T.);
+#75=FACE_BOUND('',#65,.T.);
+#76=FACE_BOUND('',#66,.T.);
+#77=FACE_BOUND('',#67,.T.);
+#80=PLANE('',#4);
+#81=PLANE('',#6);
+#82=CONICAL_SURFACE('',#4,10.,0.785398163397448);
+#83=CYLINDRICAL_SURFACE('',#4,5.);
+#90=ADVANCED_FACE('',(#70,#71),#80,.F.);
+#91=ADVANCED_FACE('',(#72,#73),#81,.T.);
+#92=ADVANCED_FACE('',(#74,#75),#82,.T.);
+#93=ADVANCED_FACE('',(#76,#77),#83,.F.);
+#100=CLOSED_SHELL('',(#90,#91,#92,#93));
+#101=MANIFOLD_SOLID_BREP('',#100);
+ENDSEC;
+END-ISO-10303-21;
+";
+
+#[test]
+fn full_cones_and_cylinders_without_seam_edges_are_cut_along_a_seam_of_their_own() {
+    let exact = std::f64::consts::PI * (2.0 / 3.0 * (100.0 + 120.0 + 144.0) - 25.0 * 2.0);
+    // surface area: two annuli, the cone's lateral area (slant 2 sqrt 2) and the cylinder's
+    let area = std::f64::consts::PI
+        * ((100.0 - 25.0) + (144.0 - 25.0) + (10.0 + 12.0) * 2.0 * std::f64::consts::SQRT_2 + 10.0 * 2.0);
+    for chord in [DEFAULT_CHORD_TOLERANCE, 0.002] {
+        let options = StepOptions { chord_tolerance: Some(chord), ..StepOptions::default() };
+        let brep = parse_step(SEAMLESS_RING.as_bytes(), Path::new("ring.step"), &options).expect("reads");
+        let t = brep.tessellation.expect("tessellated");
+        assert_eq!((t.faces, t.curved_faces), (4, 1));
+        let volume = brep.volume.expect("volume");
+        assert!((volume - exact).abs() <= chord * area, "{volume} vs {exact}");
+    }
+}

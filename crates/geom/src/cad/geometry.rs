@@ -239,6 +239,14 @@ pub fn conic_steps(r: f64, sweep: f64, tol: f64) -> usize {
     if delta > 0.0 { (sweep / delta).ceil().clamp(1.0, 1e6) as usize } else { 1 }
 }
 
+/// Parameters strictly inside `(a, b)`, in order, at which a path `f` is cut so that each piece lies within `tol`
+/// of its chord (bisection, as for B-spline edges).
+pub fn chord_params(f: &dyn Fn(f64) -> DVec3, a: f64, b: f64, tol: f64) -> Vec<f64> {
+    let mut out = Vec::new();
+    bisect(f, a, b, tol, 0, &mut out);
+    out
+}
+
 /// Parameters strictly inside `(a, b)` that bisect it until each piece is within `tol` of its chord.
 fn bisect(f: &dyn Fn(f64) -> DVec3, a: f64, b: f64, tol: f64, depth: usize, out: &mut Vec<f64>) {
     let (pa, pb) = (f(a), f(b));

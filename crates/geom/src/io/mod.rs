@@ -328,7 +328,7 @@ pub enum IoError {
         face: Option<u64>,
     },
     /// A STEP face whose exact surface and edges could not be tessellated: a boundary point off its surface, loops
-    /// that bound no area of its parameter domain, a loop around a period without a seam edge.
+    /// that bound no area of its parameter domain, a face around the apex of a cone or the pole of a sphere.
     #[error("{}: {at}: this face cannot be tessellated: {message}", file.display())]
     Tessellation {
         /// The file.

@@ -14,7 +14,8 @@
 //!    vertices and samples are the mesh's points, shared by the two faces of each edge.
 //! 2. **Faces**: each loop's points are mapped into the surface's parameter domain ([`FaceSurface::inverse`], each
 //!    point from the previous one, so a periodic parameter runs on continuously across the seam and a loop along a
-//!    seam edge closes on the far side of the period), then the domain is triangulated and refined
+//!    seam edge closes on the far side of the period; a face between two loops that wind around the period in
+//!    opposite senses, with no seam edge, is cut along a seam of its own), then the domain is triangulated and refined
 //!    ([`crate::cad::trimmed`]) with the same tolerance; interior points are new mesh points. A boundary point more
 //!    than ten tolerances off its surface is an error naming the face.
 //! 3. The triangles are oriented by the loops (the face on the left of each loop seen from outside, as the bounds'
@@ -126,6 +127,7 @@ impl Builder<'_, '_> {
         // into the parameter domain, each point from the previous one
         let allowed = (10.0 * self.tolerance).max(1e-3);
         let mut domain_loops = Vec::with_capacity(loops.len());
+        let mut winding: Vec<(Vec<LoopPoint>, usize, f64)> = Vec::new();
         for lp in &loops {
             let mut hint: Option<DVec2> = None;
             let mut ring = Vec::with_capacity(lp.len() + 1);
@@ -149,24 +151,108 @@ impl Builder<'_, '_> {
                 ring.push(LoopPoint { q, p, id: k });
             }
             // the first point again, reached around the loop: the same parameters unless the loop winds around a
-            // period without a seam edge
+            // period of the surface
             let (Some(first), Some(last)) = (ring.first().copied(), ring.pop()) else { continue };
-            if (last.q - first.q).length() > 1e-6 * (1.0 + first.q.length()) {
+            let d = last.q - first.q;
+            if d.length() <= 1e-6 * (1.0 + first.q.length()) {
+                domain_loops.push(ring);
+                continue;
+            }
+            let (pu, pv) = surface.periods();
+            let around = |x: f64, y: f64, p: Option<f64>| {
+                p.is_some_and(|p| (x.abs() - p).abs() <= 1e-6 * p && y.abs() <= 1e-6 * p)
+            };
+            let axis = if around(d.x, d.y, pu) {
+                0
+            } else if around(d.y, d.x, pv) {
+                1
+            } else {
+                return Err(self.failure(
+                    id,
+                    format!("a loop does not close in the parameter domain of its surface #{surface_id}"),
+                ));
+            };
+            winding.push((ring, axis, d[axis]));
+        }
+        match winding.as_slice() {
+            [] => {}
+            [(a, i, wa), (b, j, wb)] if i == j && wa * wb < 0.0 => {
+                let band = self.band(&surface, a, b, *i, *wa);
+                domain_loops.push(band);
+            }
+            _ => {
                 return Err(self.failure(
                     id,
                     format!(
-                        "a loop winds around the period of its surface #{surface_id} without a seam edge, which is \
-                         not supported"
+                        "{} of its loops wind around a period of its surface #{surface_id} (a face around a pole or \
+                         apex), which is not supported",
+                        winding.len()
                     ),
                 ));
             }
-            domain_loops.push(ring);
         }
         let mesh = triangulate_trimmed(&surface, &domain_loops, self.tolerance, self.points.len(), FACE_BUDGET)
             .map_err(|reason| self.failure(id, format!("its surface #{surface_id} cannot be tessellated: {reason}")))?;
         self.points.extend(mesh.points);
         out.extend(mesh.triangles.into_iter().map(|t| MeshPolygon { vertices: t.to_vec(), place: Place::Entity(id) }));
         Ok(exact)
+    }
+
+    /// The one loop of a band: a face between two loops that wind around a period of its surface in opposite
+    /// senses (a full cylinder or cone between two circles, as Parasolid writes them, without a seam edge). The
+    /// domain is cut along a seam from the first point of `a` to the point of `b` nearest it in that parameter:
+    /// `a`, the seam, `b`, the seam back (the same points, one period over). `axis` is the winding parameter (0: u,
+    /// 1: v) and `wa` the signed period `a` winds by.
+    fn band(
+        &mut self,
+        surface: &FaceSurface,
+        a: &[LoopPoint],
+        b: &[LoopPoint],
+        axis: usize,
+        wa: f64,
+    ) -> Vec<LoopPoint> {
+        let period = wa.abs();
+        let ua = a[0].q[axis];
+        let offset = |x: f64| {
+            let r = (x - ua).rem_euclid(period);
+            r.min(period - r)
+        };
+        let k = (0..b.len()).min_by(|&x, &y| offset(b[x].q[axis]).total_cmp(&offset(b[y].q[axis]))).unwrap_or(0);
+        let mut b: Vec<LoopPoint> = b[k..].iter().chain(&b[..k]).copied().collect();
+        for j in 1..b.len() {
+            let step = b[j - 1].q[axis] - b[j].q[axis];
+            b[j].q[axis] += period * (step / period).round();
+        }
+        let shift = period * ((ua + wa - b[0].q[axis]) / period).round();
+        for p in &mut b {
+            p.q[axis] += shift;
+        }
+        let mut a_end = a[0];
+        a_end.q[axis] += wa;
+        let mut b_end = b[0];
+        b_end.q[axis] -= wa;
+        // the seam from the end of a to the start of b, sampled within the tolerance; its points serve both sides
+        let (from, to) = (a_end.q, b[0].q);
+        let path = |t: f64| surface.point(from + (to - from) * t);
+        let seam: Vec<LoopPoint> = crate::cad::geometry::chord_params(&path, 0.0, 1.0, self.tolerance)
+            .into_iter()
+            .map(|t| {
+                let p = path(t);
+                self.points.push(p);
+                LoopPoint { q: from + (to - from) * t, p, id: self.points.len() - 1 }
+            })
+            .collect();
+        let mut ring: Vec<LoopPoint> = a.to_vec();
+        ring.push(a_end);
+        ring.extend(seam.iter().copied());
+        ring.extend(b.iter().copied());
+        ring.push(b_end);
+        ring.extend(seam.iter().rev().map(|s| {
+            let mut s = *s;
+            s.q[axis] -= wa;
+            s
+        }));
+        ring
     }
 
     /// A loop's mesh points in order (each edge's points but its last), and whether its curves are exact ones;
