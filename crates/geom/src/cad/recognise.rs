@@ -335,7 +335,8 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
                 .unwrap_or(thickness);
             let shift = -f.normal * (d / 2.0);
             let (rings, deviation, arcs) = conservative_rings(f, bend_tolerance);
-            let (rings, gained) = narrowest_holes(f, rings, back.iter().map(|&j| &planes[j]), bend_tolerance);
+            let (rings, gained, filled) = narrowest_holes(f, rings, back.iter().map(|&j| &planes[j]), bend_tolerance);
+            max_deviation = max_deviation.max(filled);
             let plate_area = f.area + gained;
             max_deviation = max_deviation.max(deviation);
             let lift = |ring: &Vec<DVec3>| -> Vec<DVec3> {
@@ -701,31 +702,36 @@ fn conservative_rings(f: &PlanarFace<'_>, tolerance: f64) -> (Vec<Vec<DVec3>>, f
 /// The holes of a plate's front face narrowed to the other side's: a hole of a face on the other side whose
 /// projection lies inside a hole of the front face and is smaller replaces it (the smallest such), so that the
 /// plate's hole is the narrowest section of a countersunk or counterbored hole and never cuts into material. A hole
-/// of the other side that only overlaps one of the front's is left to the cover check. Returns the rings and the
-/// area the plate gains (mm^2).
+/// of the other side that only overlaps one of the front's is left to the cover check. Returns the rings, the area
+/// the plate gains (mm^2) and how far the pieces may then stand outside the solid (mm): the widest gap between a
+/// narrowed hole and the front's, which the plate fills (a countersink's cone).
 fn narrowest_holes<'a>(
     f: &PlanarFace<'_>,
     mut rings: Vec<Vec<DVec3>>,
     back: impl Iterator<Item = &'a PlanarFace<'a>>,
     tolerance: f64,
-) -> (Vec<Vec<DVec3>>, f64) {
-    let mut gained = 0.0;
+) -> (Vec<Vec<DVec3>>, f64, f64) {
     let to2 = |p: DVec3| DVec2::new((p - f.point).dot(f.u), (p - f.point).dot(f.v));
+    let flat = |ring: &[DVec3]| -> Vec<DVec2> { ring.iter().map(|p| to2(*p)).collect() };
     let area = |ring: &[DVec2]| {
         let n = ring.len();
         (0..n).map(|k| ring[k].perp_dot(ring[(k + 1) % n])).sum::<f64>().abs() / 2.0
     };
+    let inside =
+        |inner: &[DVec2], outer: &[DVec2]| inner.iter().all(|q| point_in_ring(*q, outer) != PointInRing::Outside);
     let back_holes: Vec<Vec<DVec3>> =
         back.flat_map(|b| conservative_rings(b, tolerance).0.into_iter().skip(1)).collect();
+    let front_holes: Vec<Vec<DVec2>> = rings.iter().skip(1).map(|r| flat(r)).collect();
+    let mut gained = 0.0;
     for hole in rings.iter_mut().skip(1) {
-        let h2: Vec<DVec2> = hole.iter().map(|p| to2(*p)).collect();
+        let h2 = flat(hole);
         let own = area(&h2);
         let mut best = own * (1.0 - 1e-9);
         let mut narrower: Option<&Vec<DVec3>> = None;
         for b in &back_holes {
-            let b2: Vec<DVec2> = b.iter().map(|p| to2(*p)).collect();
+            let b2 = flat(b);
             let a = area(&b2);
-            if a < best && b2.iter().all(|q| point_in_ring(*q, &h2) != PointInRing::Outside) {
+            if a < best && inside(&b2, &h2) {
                 best = a;
                 narrower = Some(b);
             }
@@ -733,10 +739,8 @@ fn narrowest_holes<'a>(
         if let Some(b) = narrower {
             // onto the front face's plane, in the front's hole orientation (clockwise about its normal)
             let mut ring: Vec<DVec3> = b.iter().map(|p| *p - f.normal * (*p - f.point).dot(f.normal)).collect();
-            let signed = {
-                let o = ring[0];
-                (1..ring.len() - 1).map(|k| (ring[k] - o).cross(ring[k + 1] - o).dot(f.normal)).sum::<f64>()
-            };
+            let o = ring[0];
+            let signed: f64 = (1..ring.len() - 1).map(|k| (ring[k] - o).cross(ring[k + 1] - o).dot(f.normal)).sum();
             if signed > 0.0 {
                 ring.reverse();
             }
@@ -744,7 +748,27 @@ fn narrowest_holes<'a>(
             gained += own - best;
         }
     }
-    (rings, gained)
+    // the pieces fill every hole of either side around a hole of the plate, up to that hole
+    let mut filled: f64 = 0.0;
+    let wider: Vec<Vec<DVec2>> = front_holes.into_iter().chain(back_holes.iter().map(|b| flat(b))).collect();
+    for hole in rings.iter().skip(1) {
+        let h2 = flat(hole);
+        let gap = |q: DVec2| {
+            (0..h2.len())
+                .map(|k| {
+                    let (a, c) = (h2[k], h2[(k + 1) % h2.len()]);
+                    let ac = c - a;
+                    let len2 = ac.length_squared();
+                    let s = if len2 > 0.0 { ((q - a).dot(ac) / len2).clamp(0.0, 1.0) } else { 0.0 };
+                    (a + s * ac - q).length()
+                })
+                .fold(f64::INFINITY, f64::min)
+        };
+        for w in wider.iter().filter(|w| area(w) > area(&h2) * (1.0 + 1e-9) && inside(&h2, w)) {
+            filled = w.iter().map(|q| gap(*q)).fold(filled, f64::max);
+        }
+    }
+    (rings, gained, filled)
 }
 
 /// Steps for an arc of radius `r` and sweep `phi` within `tolerance`: tangents deviate by `r (1/cos(d/2) - 1)`,
