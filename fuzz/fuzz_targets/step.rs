@@ -1,4 +1,6 @@
-//! STEP reader (exchange-file parser, entity graph to B-rep, units) on arbitrary bytes.
+//! STEP reader (exchange-file parser, entity graph to B-rep, units, and the tessellation of solids with faces on
+//! other surfaces than planes and cylinders) on arbitrary bytes. Seed its corpus with `fixtures/realparts/*.stp` and
+//! `fixtures/cad/*.step` to reach the B-rep and the tessellation.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;

@@ -2,6 +2,7 @@
 //! instead of one per file (each test binary links every dependency again). `cargo test -p PACKAGE NAME` still
 //! filters by module, e.g. `tightness::`.
 
+mod cadparts;
 mod decomposition;
 mod from_faces_and_edges;
 mod hull_props;

@@ -402,29 +402,42 @@ fn first_instance(text: &str, entity: &str) -> u64 {
 }
 
 #[test]
-fn an_unsupported_surface_is_an_error_naming_the_entity_and_its_face() {
+fn a_surface_that_is_not_read_is_an_error_naming_the_entity_and_its_face() {
     let text = box_step(CORNER, SIZE, 1.0, MM);
     let plane = first_instance(&text, "PLANE");
     let placement = text.split(&format!("#{plane} = PLANE('',#")).nth(1).and_then(|r| r.split(')').next()).expect("x");
-    let conical = text.replace(
-        &format!("#{plane} = PLANE('',#{placement});"),
-        &format!("#{plane} = CONICAL_SURFACE('',#{placement},5.,0.5);"),
-    );
-    let e = expect_err(&conical, &StepOptions::default());
+    let with = |surface: String| text.replace(&format!("#{plane} = PLANE('',#{placement});"), &surface);
+    let offset = with(format!("#{plane} = OFFSET_SURFACE('',#{placement},5.,.F.);"));
+    let e = expect_err(&offset, &StepOptions::default());
     let IoError::Unsupported { at: Place::Entity(at), kind, role, face: Some(_), .. } = &e else { panic!("{e:?}") };
-    assert_eq!((*at, kind.as_str(), *role), (plane, "CONICAL_SURFACE", "faces"));
-    assert!(e.to_string().contains(&format!("entity #{plane}: CONICAL_SURFACE faces are not supported")), "{e}");
+    assert_eq!((*at, kind.as_str(), *role), (plane, "OFFSET_SURFACE", "faces"));
+    assert!(e.to_string().contains(&format!("entity #{plane}: OFFSET_SURFACE faces are not supported")), "{e}");
+    // a cone is read, and tessellated; this one does not pass through its face's edges, and the error says so
+    let conical = with(format!("#{plane} = CONICAL_SURFACE('',#{placement},5.,0.5);"));
+    let e = expect_err(&conical, &StepOptions::default());
+    let IoError::Tessellation { at: Place::Entity(face), message, .. } = &e else { panic!("{e:?}") };
+    assert!(text.contains(&format!("#{face} = ADVANCED_FACE(")), "{e}");
+    assert!(message.contains(&format!("off its surface #{plane}")), "{e}");
 }
 
 #[test]
-fn an_unsupported_curve_is_an_error_naming_the_entity() {
-    let text =
-        box_step(CORNER, SIZE, 1.0, MM).replace("B_SPLINE_CURVE_WITH_KNOTS('',1,", "B_SPLINE_CURVE_WITH_KNOTS('',2,");
+fn a_curve_that_is_not_read_or_not_consistent_is_an_error_naming_the_entity() {
+    let text = box_step(CORNER, SIZE, 1.0, MM);
     let spline = first_instance(&text, "B_SPLINE_CURVE_WITH_KNOTS");
-    let e = expect_err(&text, &StepOptions::default());
-    let IoError::Unsupported { at: Place::Entity(at), role: "edges", .. } = &e else { panic!("{e:?}") };
+    // a degree-2 spline with the knots of a degree-1 one: inconsistent, named
+    let quadratic = text.replace("B_SPLINE_CURVE_WITH_KNOTS('',1,", "B_SPLINE_CURVE_WITH_KNOTS('',2,");
+    let e = expect_err(&quadratic, &StepOptions::default());
+    let IoError::Syntax { at: Place::Entity(at), message, .. } = &e else { panic!("{e:?}") };
     assert_eq!(*at, spline);
-    assert!(e.to_string().contains("B_SPLINE_CURVE_WITH_KNOTS of degree 2 edges are not supported"), "{e}");
+    assert!(message.contains("knots") && message.contains("degree 2"), "{e}");
+    // a curve the reader does not know
+    let head = format!("#{spline} = B_SPLINE_CURVE_WITH_KNOTS(");
+    let start = text.find(&head).expect("the spline");
+    let end = start + text[start..].find(';').expect("its end");
+    let hyperbola = format!("{}#{spline} = HYPERBOLA('',#1,1.,1.){}", &text[..start], &text[end..]);
+    let e = expect_err(&hyperbola, &StepOptions::default());
+    let IoError::Unsupported { at: Place::Entity(at), kind, role: "edges", .. } = &e else { panic!("{e:?}") };
+    assert_eq!((*at, kind.as_str()), (spline, "HYPERBOLA"));
 }
 
 #[test]
@@ -460,10 +473,11 @@ fn two_solids_need_a_choice() {
     assert!(matches!(e, IoError::SeveralSolids { count: 2, .. }), "{e:?}");
     assert!(e.to_string().contains("2 solids") && e.to_string().contains("--solid"), "{e}");
     for index in 0..2 {
-        let brep = parse(&two, &StepOptions { solid: Some(index) }).expect("a chosen solid reads");
+        let brep =
+            parse(&two, &StepOptions { solid: Some(index), ..Default::default() }).expect("a chosen solid reads");
         assert_eq!(brep.faces.len(), 6);
     }
-    let e = expect_err(&two, &StepOptions { solid: Some(2) });
+    let e = expect_err(&two, &StepOptions { solid: Some(2), ..Default::default() });
     assert!(matches!(e, IoError::NoSuchSolid { index: 2, count: 2, .. }), "{e:?}");
     // A closed shell that no solid uses is a solid of its own.
     let bare = text.replace(&format!("#{solid} = MANIFOLD_SOLID_BREP('box',#{shell});"), "");

@@ -37,7 +37,8 @@
 //! facet of at most one run (a skin may serve two runs: the base of a U-channel). The facets of a run become one
 //! cylindrical face, its axis the mean direction of its shared lines, refitted; seen along the axis, every vertex of a
 //! facet must lie on the facet's chord (between the points of its two shared lines, which are on the circle) within
-//! four fit tolerances, else the mesh is reported. Regions with smooth neighbours that
+//! four fit tolerances, else the run is no bend (a fan of facets on a cone or a torus can have parallel shared lines
+//! whose points happen to fit a circle). Regions with smooth neighbours that
 //! are not the facets of a run (tessellated hole walls, chamfers) stay planar faces.
 //!
 //! **Loops.** A face's boundary is its triangles' directed edges whose partner belongs to another face, chained at
@@ -132,25 +133,6 @@ pub enum MeshFaceError {
         /// Where its first triangle is in the file.
         place: Place,
     },
-    /// A run of facets fitted as a bend with a vertex off the fitted cylinder.
-    #[error(
-        "a chain of facets about the axis through {point} along {axis} is not a circular cylinder: vertex {vertex} \
-         (of the triangle at {place}) is {distance:.3e} mm off its facet's chord of the fitted circle of radius {radius}"
-    )]
-    NotCylinder {
-        /// Where the triangle is in the file.
-        place: Place,
-        /// A point of the fitted axis.
-        point: DVec3,
-        /// Its direction.
-        axis: DVec3,
-        /// The fitted radius.
-        radius: f64,
-        /// The vertex index.
-        vertex: usize,
-        /// Its distance from its facet's chord of the fitted circle (seen along the axis).
-        distance: f64,
-    },
     /// The boundary of a face does not chain into loops (a bug if it ever shows).
     #[error("the boundary of the face starting at the triangle at {place} does not close")]
     Boundary {
@@ -179,7 +161,7 @@ pub(crate) fn mesh_faces(points: &[DVec3], triangles: &[MeshPolygon], tolerance:
         volume,
         "mesh faces"
     );
-    Ok(Brep { faces, volume: Some(volume) })
+    Ok(Brep { faces, volume: Some(volume), tessellation: None })
 }
 
 /// The validated mesh with triangle adjacency and per-triangle geometry.
@@ -531,7 +513,7 @@ impl<'a> Mesh<'a> {
             if run.facets.iter().any(|&f| role[f] != Role::Free) || run.skins.iter().any(|&s| role[s] == Role::Facet) {
                 continue;
             }
-            let Some(bend) = self.fit_bend(regions, lines, &run)? else {
+            let Some(bend) = self.fit_bend(regions, lines, &run) else {
                 continue;
             };
             for &f in &run.facets {
@@ -674,8 +656,8 @@ impl<'a> Mesh<'a> {
     }
 
     /// The cylinder of an accepted run, its axis the mean direction of its lines; `None` if the refined fit fails.
-    fn fit_bend(&self, regions: &Regions, lines: &[SharedLine], run: &Run) -> Result<Option<Bend>, MeshFaceError> {
-        let Some(&first) = run.lines.first() else { return Ok(None) };
+    fn fit_bend(&self, regions: &Regions, lines: &[SharedLine], run: &Run) -> Option<Bend> {
+        let &first = run.lines.first()?;
         let reference = lines[first].direction();
         let mut sum = DVec3::ZERO;
         for &l in &run.lines {
@@ -684,16 +666,14 @@ impl<'a> Mesh<'a> {
         }
         let axis = sum.normalize_or_zero();
         if axis == DVec3::ZERO {
-            return Ok(None);
+            return None;
         }
         let frame = Frame::new(self.centre, axis);
-        let Some((circle, residual)) = fit_run(regions, lines, run, &frame) else {
-            return Ok(None);
-        };
+        let (circle, residual) = fit_run(regions, lines, run, &frame)?;
         let tolerance = self.fit_tolerance(circle.radius);
         if residual > tolerance {
             tracing::debug!(residual, tolerance, "the refined fit of a run fails");
-            return Ok(None);
+            return None;
         }
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
         let mut worst: Option<(f64, usize, usize)> = None;
@@ -718,14 +698,11 @@ impl<'a> Mesh<'a> {
         if let Some((distance, vertex, t)) = worst
             && distance > 4.0 * tolerance
         {
-            return Err(MeshFaceError::NotCylinder {
-                place: self.place(t),
-                point,
-                axis,
-                radius: circle.radius,
-                vertex,
-                distance,
-            });
+            // the shared lines fit a circle but the facets between them do not follow it (a fan of facets on a
+            // cone or a torus whose shared lines happen to be parallel): no bend, its regions stay planar faces
+            let place = self.place(t);
+            tracing::debug!(%place, vertex, distance, radius = circle.radius, "a run of facets is not a cylinder");
+            return None;
         }
         // convex: the middle facet's outward normal points away from the axis
         let m = run.facets.len() / 2;
@@ -733,7 +710,7 @@ impl<'a> Mesh<'a> {
             0.5 * (frame.project(lines[run.lines[m]].middle()) + frame.project(lines[run.lines[m + 1]].middle()));
         let normal = frame.project_direction(regions.regions[run.facets[m]].normal);
         let convex = normal.dot(middle - circle.centre) > 0.0;
-        Ok(Some(Bend { facets: run.facets.clone(), point, axis, radius: circle.radius, convex }))
+        Some(Bend { facets: run.facets.clone(), point, axis, radius: circle.radius, convex })
     }
 
     /// The faces: cylinders for the bends, planes for the other regions, numbered by their first triangle.

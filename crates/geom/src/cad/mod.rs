@@ -10,8 +10,11 @@
 //! the thickness), and [`bend`] turns each bend into convex segments that contain it.
 
 pub mod bend;
+pub mod geometry;
 pub mod mesh_faces;
+pub mod nurbs;
 pub mod recognise;
+pub mod trimmed;
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
@@ -201,4 +204,23 @@ pub struct Brep {
     /// The solid's volume (mm^3) where the source knows it exactly (a mesh: its enclosed volume), else `None` and
     /// recognition computes it from the recognised sheet.
     pub volume: Option<f64>,
+    /// For a STEP solid with faces on other surfaces than planes and cylinders: how it was tessellated (its faces
+    /// are then those [`mesh_faces`] finds in the tessellation).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tessellation: Option<Tessellation>,
+}
+
+/// How a STEP solid was tessellated to take it through the mesh route ([`crate::io::step`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Tessellation {
+    /// The solid's faces (all are tessellated).
+    pub faces: usize,
+    /// Of these, the faces on surfaces other than planes and cylinders, or bounded by curves other than lines,
+    /// circles and polylines: the ones that called for it.
+    pub curved_faces: usize,
+    /// Triangles of the mesh.
+    pub triangles: usize,
+    /// The chord tolerance (mm): every triangle and edge chord lies within it of the exact faces, so the pieces
+    /// recognised from the mesh contain the solid to within it.
+    pub chord_tolerance: f64,
 }

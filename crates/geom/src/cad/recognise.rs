@@ -126,6 +126,11 @@ pub struct Recognition {
     pub max_deviation: f64,
     /// The bend tolerance the pieces were made with (mm).
     pub bend_tolerance: f64,
+    /// For a STEP solid with faces on other surfaces than planes and cylinders: how it was tessellated. The pieces
+    /// are then recognised from the mesh: they contain it, and the solid to within the chord tolerance; they stand
+    /// outside the solid by at most `max_deviation`, which includes the chord tolerance.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tessellation: Option<super::Tessellation>,
 }
 
 /// Why a solid is not recognised as sheet metal. Every message names the faces.
@@ -219,6 +224,16 @@ pub enum RecogniseError {
     /// A bad option.
     #[error("the bend tolerance must be positive and finite, got {0}")]
     BadTolerance(f64),
+    /// A tessellated solid whose chord tolerance leaves nothing of the bend tolerance for the pieces.
+    #[error(
+        "the bend tolerance ({bend_tolerance} mm) must exceed the chord tolerance of the tessellation ({chord} mm)"
+    )]
+    ChordTolerance {
+        /// The chord tolerance (mm).
+        chord: f64,
+        /// The bend tolerance (mm).
+        bend_tolerance: f64,
+    },
 }
 
 /// One planar face, prepared: its frame and its loops as 2-D polygons (arcs sampled) for overlap tests.
@@ -253,6 +268,12 @@ const ARC_STEP: f64 = std::f64::consts::PI / 36.0;
 pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<(Part, Recognition), RecogniseError> {
     if !(options.bend_tolerance > 0.0 && options.bend_tolerance.is_finite()) {
         return Err(RecogniseError::BadTolerance(options.bend_tolerance));
+    }
+    // a tessellated solid: the mesh stands up to its chord tolerance outside the solid, so the pieces get the rest
+    let chord = brep.tessellation.map_or(0.0, |t| t.chord_tolerance);
+    let bend_tolerance = options.bend_tolerance - chord;
+    if bend_tolerance.is_nan() || bend_tolerance <= 0.0 {
+        return Err(RecogniseError::ChordTolerance { chord, bend_tolerance: options.bend_tolerance });
     }
     let tol = options.tolerance.max(1e-12);
     let planes: Vec<PlanarFace<'_>> = brep
@@ -313,7 +334,10 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
                 .or_else(|| partners.iter().find_map(|p| p.filter(|&(j, d)| j == i && at_thickness(d)).map(|(_, d)| d)))
                 .unwrap_or(thickness);
             let shift = -f.normal * (d / 2.0);
-            let (rings, deviation, arcs) = conservative_rings(f, options.bend_tolerance);
+            let (rings, deviation, arcs) = conservative_rings(f, bend_tolerance);
+            let (rings, gained, filled) = narrowest_holes(f, rings, back.iter().map(|&j| &planes[j]), bend_tolerance);
+            max_deviation = max_deviation.max(filled);
+            let plate_area = f.area + gained;
             max_deviation = max_deviation.max(deviation);
             let lift = |ring: &Vec<DVec3>| -> Vec<DVec3> {
                 ring.iter().map(|p| *p - f.normal * (*p - f.point).dot(f.normal) + shift).collect()
@@ -325,12 +349,12 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
                 faces: vec![f.face.source.clone()],
                 other_side: back.iter().map(|&j| planes[j].face.source.clone()).collect(),
                 normal: f.normal,
-                area: f.area,
+                area: plate_area,
                 holes: rings3.len(),
                 arcs,
                 pieces: Vec::new(),
             });
-            exact_volume += f.area * thickness;
+            exact_volume += plate_area * thickness;
             sheet.faces.push(SheetFace { outline, holes: rings3 });
         }
     }
@@ -415,10 +439,10 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
             Some(points) => {
                 let angles: Vec<f64> =
                     points.iter().map(|p| angle_of(b.bend.axis, b.bend.start, b.bend.center, *p)).collect();
-                b.bend.cuts_among(&angles, options.bend_tolerance)
+                b.bend.cuts_among(&angles, bend_tolerance)
             }
             None => {
-                let n = b.bend.segments_within(options.bend_tolerance);
+                let n = b.bend.segments_within(bend_tolerance);
                 (0..=n).map(|k| b.bend.angle * k as f64 / n as f64).collect()
             }
         };
@@ -447,6 +471,7 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
     check_overlap(&components, &owners, 10.0 * sheet_tol)?;
     check_cover(brep, &components, tol.max(1e-9 * diagonal(&components)), thickness, &partners, &planes)?;
     let solid_volume = brep.volume.unwrap_or(exact_volume);
+    let max_deviation = max_deviation + chord;
     let origin = PartOrigin::RecognisedSheet {
         thickness,
         plates: plate_records.len(),
@@ -476,6 +501,7 @@ pub fn recognise(brep: &Brep, name: &str, options: &RecogniseOptions) -> Result<
         pieces_volume,
         max_deviation,
         bend_tolerance: options.bend_tolerance,
+        tessellation: brep.tessellation,
     };
     Ok((part, recognition))
 }
@@ -671,6 +697,78 @@ fn conservative_rings(f: &PlanarFace<'_>, tolerance: f64) -> (Vec<Vec<DVec3>>, f
         out.push(ring);
     }
     (out, deviation, arcs)
+}
+
+/// The holes of a plate's front face narrowed to the other side's: a hole of a face on the other side whose
+/// projection lies inside a hole of the front face and is smaller replaces it (the smallest such), so that the
+/// plate's hole is the narrowest section of a countersunk or counterbored hole and never cuts into material. A hole
+/// of the other side that only overlaps one of the front's is left to the cover check. Returns the rings, the area
+/// the plate gains (mm^2) and how far the pieces may then stand outside the solid (mm): the widest gap between a
+/// narrowed hole and the front's, which the plate fills (a countersink's cone).
+fn narrowest_holes<'a>(
+    f: &PlanarFace<'_>,
+    mut rings: Vec<Vec<DVec3>>,
+    back: impl Iterator<Item = &'a PlanarFace<'a>>,
+    tolerance: f64,
+) -> (Vec<Vec<DVec3>>, f64, f64) {
+    let to2 = |p: DVec3| DVec2::new((p - f.point).dot(f.u), (p - f.point).dot(f.v));
+    let flat = |ring: &[DVec3]| -> Vec<DVec2> { ring.iter().map(|p| to2(*p)).collect() };
+    let area = |ring: &[DVec2]| {
+        let n = ring.len();
+        (0..n).map(|k| ring[k].perp_dot(ring[(k + 1) % n])).sum::<f64>().abs() / 2.0
+    };
+    let inside =
+        |inner: &[DVec2], outer: &[DVec2]| inner.iter().all(|q| point_in_ring(*q, outer) != PointInRing::Outside);
+    let back_holes: Vec<Vec<DVec3>> =
+        back.flat_map(|b| conservative_rings(b, tolerance).0.into_iter().skip(1)).collect();
+    let front_holes: Vec<Vec<DVec2>> = rings.iter().skip(1).map(|r| flat(r)).collect();
+    let mut gained = 0.0;
+    for hole in rings.iter_mut().skip(1) {
+        let h2 = flat(hole);
+        let own = area(&h2);
+        let mut best = own * (1.0 - 1e-9);
+        let mut narrower: Option<&Vec<DVec3>> = None;
+        for b in &back_holes {
+            let b2 = flat(b);
+            let a = area(&b2);
+            if a < best && inside(&b2, &h2) {
+                best = a;
+                narrower = Some(b);
+            }
+        }
+        if let Some(b) = narrower {
+            // onto the front face's plane, in the front's hole orientation (clockwise about its normal)
+            let mut ring: Vec<DVec3> = b.iter().map(|p| *p - f.normal * (*p - f.point).dot(f.normal)).collect();
+            let o = ring[0];
+            let signed: f64 = (1..ring.len() - 1).map(|k| (ring[k] - o).cross(ring[k + 1] - o).dot(f.normal)).sum();
+            if signed > 0.0 {
+                ring.reverse();
+            }
+            *hole = ring;
+            gained += own - best;
+        }
+    }
+    // the pieces fill every hole of either side around a hole of the plate, up to that hole
+    let mut filled: f64 = 0.0;
+    let wider: Vec<Vec<DVec2>> = front_holes.into_iter().chain(back_holes.iter().map(|b| flat(b))).collect();
+    for hole in rings.iter().skip(1) {
+        let h2 = flat(hole);
+        let gap = |q: DVec2| {
+            (0..h2.len())
+                .map(|k| {
+                    let (a, c) = (h2[k], h2[(k + 1) % h2.len()]);
+                    let ac = c - a;
+                    let len2 = ac.length_squared();
+                    let s = if len2 > 0.0 { ((q - a).dot(ac) / len2).clamp(0.0, 1.0) } else { 0.0 };
+                    (a + s * ac - q).length()
+                })
+                .fold(f64::INFINITY, f64::min)
+        };
+        for w in wider.iter().filter(|w| area(w) > area(&h2) * (1.0 + 1e-9) && inside(&h2, w)) {
+            filled = w.iter().map(|q| gap(*q)).fold(filled, f64::max);
+        }
+    }
+    (rings, gained, filled)
 }
 
 /// Steps for an arc of radius `r` and sweep `phi` within `tolerance`: tangents deviate by `r (1/cos(d/2) - 1)`,
@@ -1099,7 +1197,7 @@ mod tests {
                 loops: vec![vec![circle(0.0)], vec![circle(t)]],
             });
         }
-        Brep { faces, volume: None }
+        Brep { faces, volume: None, tessellation: None }
     }
 
     fn exact_volume(hole: bool) -> f64 {

@@ -308,8 +308,8 @@ pub enum IoError {
         /// The reason.
         source: PoseError,
     },
-    /// A STEP entity reached from the solid whose type the reader does not handle: a surface other than a plane or a
-    /// circular cylinder, a curve other than a line, a circle or a degree-1 spline or polyline, a solid with voids.
+    /// A STEP entity reached from the solid whose type the reader does not handle: a surface or curve that is none
+    /// of those [`step`] reads, a solid with voids.
     #[error(
         "{}: {at}: {kind} {role} are not supported{}",
         file.display(),
@@ -326,6 +326,17 @@ pub enum IoError {
         role: &'static str,
         /// The STEP face it belongs to, if any.
         face: Option<u64>,
+    },
+    /// A STEP face whose exact surface and edges could not be tessellated: a boundary point off its surface, loops
+    /// that bound no area of its parameter domain, a face around the apex of a cone or the pole of a sphere.
+    #[error("{}: {at}: this face cannot be tessellated: {message}", file.display())]
+    Tessellation {
+        /// The file.
+        file: PathBuf,
+        /// The face.
+        at: Place,
+        /// Why.
+        message: String,
     },
     /// A STEP reference to an instance that the file does not define.
     #[error("{}: {at}: refers to #{target}, which is not in the file", file.display())]
@@ -393,6 +404,7 @@ impl IoError {
             | IoError::MeshFaces { file, .. }
             | IoError::BadPose { file, .. }
             | IoError::Unsupported { file, .. }
+            | IoError::Tessellation { file, .. }
             | IoError::MissingReference { file, .. }
             | IoError::SeveralSolids { file, .. }
             | IoError::NoSuchSolid { file, .. }

@@ -1,6 +1,10 @@
 //! Sheet-metal parts from CAD files: a STEP solid, or one closed mesh (STL, OBJ) that is not convex, recognised as
 //! a sheet of constant thickness ([`crate::cad::recognise`]) and decomposed conservatively.
 //!
+//! A STEP solid with faces on other surfaces than planes and cylinders is tessellated within a quarter of the bend
+//! tolerance and its mesh segmented as a mesh's ([`super::step`]); the pieces are then made within the rest of the
+//! bend tolerance ([`crate::cad::recognise`]).
+//!
 //! The recognition's length tolerance follows the source: for STEP `1e-7` of the solid's size (at least `1e-6`
 //! mm: the files carry about 13 significant digits and an uncertainty of `1e-7` of their unit); for a mesh ten times
 //! the mesh's own tolerance ([`super::mesh`]: about 16 roundings of its largest single-precision coordinate), since a
@@ -19,7 +23,10 @@ pub fn read_sheet(path: impl AsRef<Path>, options: &ReadOptions) -> Result<(Part
     let path = path.as_ref();
     match extension(path).as_deref() {
         Some("step" | "stp") => {
-            let brep = super::step::read_step(path, &super::step::StepOptions { solid: options.solid })?;
+            // a solid with faces on other surfaces is tessellated within a quarter of the bend tolerance
+            let chord = options.bend_tolerance.unwrap_or(DEFAULT_BEND_TOLERANCE) / 4.0;
+            let step = super::step::StepOptions { solid: options.solid, chord_tolerance: Some(chord) };
+            let brep = super::step::read_step(path, &step)?;
             let size = brep_size(&brep);
             recognise_brep(path, stem_name(path), &brep, options, (1e-7 * size).max(1e-6))
         }

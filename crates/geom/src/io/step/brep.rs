@@ -3,6 +3,7 @@
 
 use super::StepOptions;
 use super::p21::{Body, Exchange, Instance, Record, Value};
+use crate::cad::geometry::Frame;
 use crate::cad::{Brep, BrepFace, FaceSource, Segment, Surface};
 use crate::io::{IoError, Place, check_coordinate};
 use glam::DVec3;
@@ -15,7 +16,7 @@ const MAX_CHAIN: usize = 8;
 
 /// Builds the B-rep of the chosen solid.
 pub(super) fn build(ex: &Exchange, file: &Path, options: &StepOptions) -> Result<Brep, IoError> {
-    let mut graph = Graph { ex, file, scale: 1.0 };
+    let mut graph = Graph { ex, file, scale: 1.0, angle: 1.0 };
     let solids = graph.solids()?;
     let solid = match (options.solid, solids.len()) {
         (_, 0) => {
@@ -32,23 +33,32 @@ pub(super) fn build(ex: &Exchange, file: &Path, options: &StepOptions) -> Result
         }
     };
     graph.scale = graph.length_scale(solid)?;
-    let faces = graph.solid_faces(solid)?;
-    Ok(Brep { faces, volume: None })
+    match graph.solid_faces(solid) {
+        Ok(faces) => Ok(Brep { faces, volume: None, tessellation: None }),
+        Err(IoError::Unsupported { at, kind, role: role @ ("faces" | "edges"), .. }) => {
+            tracing::debug!(file = %file.display(), %at, kind, role, "the solid is tessellated");
+            graph.angle = graph.angle_scale(solid)?;
+            super::tessellated_brep(&graph, solid, options)
+        }
+        Err(e) => Err(e),
+    }
 }
 
 /// The instances and the length unit (mm per file unit).
-struct Graph<'a> {
-    ex: &'a Exchange,
-    file: &'a Path,
-    scale: f64,
+pub(super) struct Graph<'a> {
+    pub(super) ex: &'a Exchange,
+    pub(super) file: &'a Path,
+    pub(super) scale: f64,
+    /// Radians per plane-angle unit (read only where a surface needs it: a cone's semi-angle).
+    pub(super) angle: f64,
 }
 
 /// One simple instance and its number, for reading arguments with located errors.
 #[derive(Clone, Copy)]
-struct Entity<'a> {
-    id: u64,
-    rec: &'a Record,
-    file: &'a Path,
+pub(super) struct Entity<'a> {
+    pub(super) id: u64,
+    pub(super) rec: &'a Record,
+    pub(super) file: &'a Path,
 }
 
 fn describe(v: &Value) -> String {
@@ -67,7 +77,7 @@ fn describe(v: &Value) -> String {
 }
 
 /// A plain or typed (`LENGTH_MEASURE(2.)`) number.
-fn number(v: &Value) -> Option<f64> {
+pub(super) fn number(v: &Value) -> Option<f64> {
     match v {
         Value::Real(r) => Some(*r),
         Value::Integer(i) => Some(*i as f64),
@@ -77,50 +87,50 @@ fn number(v: &Value) -> Option<f64> {
 }
 
 impl<'a> Entity<'a> {
-    fn error(&self, message: String) -> IoError {
+    pub(super) fn error(&self, message: String) -> IoError {
         IoError::Syntax { file: self.file.to_path_buf(), at: Place::Entity(self.id), message }
     }
 
-    fn name(&self) -> &'a str {
+    pub(super) fn name(&self) -> &'a str {
         &self.rec.name
     }
 
     /// Requires exactly `n` arguments.
-    fn arity(&self, n: usize) -> Result<(), IoError> {
+    pub(super) fn arity(&self, n: usize) -> Result<(), IoError> {
         let got = self.rec.args.len();
         if got == n { Ok(()) } else { Err(self.error(format!("{} needs {n} arguments, got {got}", self.name()))) }
     }
 
-    fn arg(&self, i: usize) -> Result<&'a Value, IoError> {
+    pub(super) fn arg(&self, i: usize) -> Result<&'a Value, IoError> {
         self.rec.args.get(i).ok_or_else(|| {
             self.error(format!("{} needs at least {} arguments, got {}", self.name(), i + 1, self.rec.args.len()))
         })
     }
 
-    fn wrong(&self, i: usize, what: &str, expected: &str, got: &Value) -> IoError {
+    pub(super) fn wrong(&self, i: usize, what: &str, expected: &str, got: &Value) -> IoError {
         self.error(format!("{}: argument {} ({what}) must be {expected}, got {}", self.name(), i + 1, describe(got)))
     }
 
-    fn reference(&self, i: usize, what: &str) -> Result<u64, IoError> {
+    pub(super) fn reference(&self, i: usize, what: &str) -> Result<u64, IoError> {
         match self.arg(i)? {
             Value::Ref(n) => Ok(*n),
             other => Err(self.wrong(i, what, "a reference", other)),
         }
     }
 
-    fn number(&self, i: usize, what: &str) -> Result<f64, IoError> {
+    pub(super) fn number(&self, i: usize, what: &str) -> Result<f64, IoError> {
         let v = self.arg(i)?;
         number(v).filter(|x| x.is_finite()).ok_or_else(|| self.wrong(i, what, "a finite number", v))
     }
 
-    fn integer(&self, i: usize, what: &str) -> Result<i64, IoError> {
+    pub(super) fn integer(&self, i: usize, what: &str) -> Result<i64, IoError> {
         match self.arg(i)? {
             Value::Integer(n) => Ok(*n),
             other => Err(self.wrong(i, what, "an integer", other)),
         }
     }
 
-    fn logical(&self, i: usize, what: &str) -> Result<bool, IoError> {
+    pub(super) fn logical(&self, i: usize, what: &str) -> Result<bool, IoError> {
         match self.arg(i)? {
             Value::Enum(e) if e == "T" => Ok(true),
             Value::Enum(e) if e == "F" => Ok(false),
@@ -128,7 +138,7 @@ impl<'a> Entity<'a> {
         }
     }
 
-    fn list(&self, i: usize, what: &str) -> Result<&'a [Value], IoError> {
+    pub(super) fn list(&self, i: usize, what: &str) -> Result<&'a [Value], IoError> {
         match self.arg(i)? {
             Value::List(items) => Ok(items),
             other => Err(self.wrong(i, what, "a list", other)),
@@ -136,7 +146,7 @@ impl<'a> Entity<'a> {
     }
 
     /// A list of references.
-    fn references(&self, i: usize, what: &str) -> Result<Vec<u64>, IoError> {
+    pub(super) fn references(&self, i: usize, what: &str) -> Result<Vec<u64>, IoError> {
         self.list(i, what)?
             .iter()
             .map(|v| match v {
@@ -161,7 +171,7 @@ fn collect_refs(values: &[Value], out: &mut Vec<u64>) {
 }
 
 /// The records of an instance.
-fn records(inst: &Instance) -> &[Record] {
+pub(super) fn records(inst: &Instance) -> &[Record] {
     match &inst.body {
         Body::Simple(r) => std::slice::from_ref(r),
         Body::Complex(rs) => rs,
@@ -234,7 +244,7 @@ fn orient_planar_loops(loops: &mut Vec<Vec<Segment>>, normal: DVec3) {
 }
 
 impl<'a> Graph<'a> {
-    fn instance(&self, id: u64, from: u64) -> Result<&'a Instance, IoError> {
+    pub(super) fn instance(&self, id: u64, from: u64) -> Result<&'a Instance, IoError> {
         self.ex.instances.get(&id).ok_or_else(|| IoError::MissingReference {
             file: self.file.to_path_buf(),
             at: Place::Entity(from),
@@ -242,12 +252,12 @@ impl<'a> Graph<'a> {
         })
     }
 
-    fn syntax(&self, at: u64, message: String) -> IoError {
+    pub(super) fn syntax(&self, at: u64, message: String) -> IoError {
         IoError::Syntax { file: self.file.to_path_buf(), at: Place::Entity(at), message }
     }
 
     /// Instance `id`, referenced from `from`, which must be a simple instance of one of the `expected` types.
-    fn expect(&self, id: u64, from: u64, expected: &[&str]) -> Result<Entity<'a>, IoError> {
+    pub(super) fn expect(&self, id: u64, from: u64, expected: &[&str]) -> Result<Entity<'a>, IoError> {
         let inst = self.instance(id, from)?;
         match &inst.body {
             Body::Simple(rec) if expected.contains(&rec.name.as_str()) => Ok(Entity { id, rec, file: self.file }),
@@ -256,7 +266,7 @@ impl<'a> Graph<'a> {
     }
 
     /// Instance `id` as a simple instance of any type, or `None` for a complex one.
-    fn simple(&self, id: u64, from: u64) -> Result<(Option<Entity<'a>>, &'a Instance), IoError> {
+    pub(super) fn simple(&self, id: u64, from: u64) -> Result<(Option<Entity<'a>>, &'a Instance), IoError> {
         let inst = self.instance(id, from)?;
         Ok(match &inst.body {
             Body::Simple(rec) => (Some(Entity { id, rec, file: self.file }), inst),
@@ -328,9 +338,42 @@ impl<'a> Graph<'a> {
         }
     }
 
+    /// Radians per plane-angle unit for `solid`: its context's `PLANE_ANGLE_UNIT`, an `SI_UNIT` (radians) or a
+    /// `CONVERSION_BASED_UNIT` (`DEGREE`) defined by a `(PLANE_ANGLE_)MEASURE_WITH_UNIT` of radians; radians when the
+    /// context names none.
+    pub(super) fn angle_scale(&self, solid: u64) -> Result<f64, IoError> {
+        let Some((representation, context)) = self.context_of(solid) else { return Ok(1.0) };
+        let inst = self.instance(context, representation)?;
+        let Some(rec) = inst.record("GLOBAL_UNIT_ASSIGNED_CONTEXT") else { return Ok(1.0) };
+        for unit in (Entity { id: context, rec, file: self.file }).references(0, "units")? {
+            let u = self.instance(unit, context)?;
+            if u.record("PLANE_ANGLE_UNIT").is_none() {
+                continue;
+            }
+            let Some(c) = u.record("CONVERSION_BASED_UNIT") else { return Ok(1.0) };
+            let e = Entity { id: unit, rec: c, file: self.file };
+            let measure = e.reference(c.args.len().saturating_sub(1), "conversion factor")?;
+            let m = self.instance(measure, unit)?;
+            let r = ["PLANE_ANGLE_MEASURE_WITH_UNIT", "MEASURE_WITH_UNIT"]
+                .iter()
+                .filter_map(|name| m.record(name))
+                .find(|r| r.args.len() == 2)
+                .ok_or_else(|| {
+                    self.syntax(unit, format!("#{measure} is a {}, expected a MEASURE_WITH_UNIT", m.type_name()))
+                })?;
+            let value = Entity { id: measure, rec: r, file: self.file }.number(0, "value")?;
+            return if value > 0.0 {
+                Ok(value)
+            } else {
+                Err(self.syntax(measure, format!("a plane angle unit of {value} rad is not positive")))
+            };
+        }
+        Ok(1.0)
+    }
+
     /// The first representation (`..._REPRESENTATION(name, items, context)`) whose items hold `item`, and its
     /// context.
-    fn context_of(&self, item: u64) -> Option<(u64, u64)> {
+    pub(super) fn context_of(&self, item: u64) -> Option<(u64, u64)> {
         self.ex.order.iter().find_map(|&id| {
             let inst = self.ex.instances.get(&id)?;
             records(inst).iter().find_map(|rec| match rec.args.as_slice() {
@@ -415,6 +458,16 @@ impl<'a> Graph<'a> {
 
     /// The faces of a solid (or of a closed shell taken as one).
     fn solid_faces(&self, solid: u64) -> Result<Vec<BrepFace>, IoError> {
+        let (shell, faces, flip) = self.shell(solid)?;
+        let mut out = Vec::with_capacity(faces.len());
+        for f in faces {
+            out.push(self.face(f, shell, flip)?);
+        }
+        Ok(out)
+    }
+
+    /// The closed shell of a solid, its faces, and whether the solid uses it reversed.
+    pub(super) fn shell(&self, solid: u64) -> Result<(u64, Vec<u64>, bool), IoError> {
         let e = self.expect(solid, solid, &["MANIFOLD_SOLID_BREP", "CLOSED_SHELL", "BREP_WITH_VOIDS"])?;
         let (shell, flip) = match e.name() {
             "CLOSED_SHELL" => (e, false),
@@ -441,12 +494,7 @@ impl<'a> Graph<'a> {
             }
         };
         shell.arity(2)?;
-        let faces = shell.references(1, "faces")?;
-        let mut out = Vec::with_capacity(faces.len());
-        for f in faces {
-            out.push(self.face(f, shell.id, flip)?);
-        }
-        Ok(out)
+        Ok((shell.id, shell.references(1, "faces")?, flip))
     }
 
     fn face(&self, id: u64, from: u64, flip: bool) -> Result<BrepFace, IoError> {
@@ -506,7 +554,7 @@ impl<'a> Graph<'a> {
     }
 
     /// A positive length argument, scaled to mm.
-    fn length(&self, e: Entity<'_>, i: usize, what: &'static str) -> Result<f64, IoError> {
+    pub(super) fn length(&self, e: Entity<'_>, i: usize, what: &'static str) -> Result<f64, IoError> {
         let value = check_coordinate(e.number(i, what)? * self.scale, self.file, || Place::Entity(e.id))?;
         if value > 0.0 {
             Ok(value)
@@ -678,14 +726,14 @@ impl<'a> Graph<'a> {
         Ok(EdgePiece { id, start_vertex, end_vertex, start, end, segments })
     }
 
-    fn vertex(&self, id: u64, from: u64) -> Result<DVec3, IoError> {
+    pub(super) fn vertex(&self, id: u64, from: u64) -> Result<DVec3, IoError> {
         let e = self.expect(id, from, &["VERTEX_POINT"])?;
         e.arity(2)?;
         self.point(e.reference(1, "vertex geometry")?, id)
     }
 
     /// A `CARTESIAN_POINT` in mm.
-    fn point(&self, id: u64, from: u64) -> Result<DVec3, IoError> {
+    pub(super) fn point(&self, id: u64, from: u64) -> Result<DVec3, IoError> {
         let e = self.expect(id, from, &["CARTESIAN_POINT"])?;
         e.arity(2)?;
         let coords = e.list(1, "coordinates")?;
@@ -701,7 +749,7 @@ impl<'a> Graph<'a> {
     }
 
     /// A `DIRECTION` as a unit vector.
-    fn direction(&self, id: u64, from: u64) -> Result<DVec3, IoError> {
+    pub(super) fn direction(&self, id: u64, from: u64) -> Result<DVec3, IoError> {
         let e = self.expect(id, from, &["DIRECTION"])?;
         e.arity(2)?;
         let ratios = e.list(1, "direction ratios")?;
@@ -723,6 +771,12 @@ impl<'a> Graph<'a> {
 
     /// An `AXIS2_PLACEMENT_3D`: its location (mm) and unit z axis (`$`: +z).
     fn placement(&self, id: u64, from: u64) -> Result<(DVec3, DVec3), IoError> {
+        let frame = self.frame(id, from)?;
+        Ok((frame.origin, frame.z))
+    }
+
+    /// An `AXIS2_PLACEMENT_3D` as a frame: location (mm), z axis (`$`: +z) and reference direction (`$`: any).
+    pub(super) fn frame(&self, id: u64, from: u64) -> Result<Frame, IoError> {
         let e = self.expect(id, from, &["AXIS2_PLACEMENT_3D"])?;
         e.arity(4)?;
         let location = self.point(e.reference(1, "location")?, id)?;
@@ -731,7 +785,12 @@ impl<'a> Graph<'a> {
             Value::Ref(d) => self.direction(*d, id)?,
             other => return Err(e.wrong(2, "axis", "a reference or $", other)),
         };
-        Ok((location, axis))
+        let reference = match e.arg(3)? {
+            Value::Unset => None,
+            Value::Ref(d) => Some(self.direction(*d, id)?),
+            other => return Err(e.wrong(3, "ref_direction", "a reference or $", other)),
+        };
+        Ok(Frame::new(location, axis, reference))
     }
 }
 

@@ -40,10 +40,15 @@
 //!
 mod brep;
 mod p21;
+mod tessellate;
 
 use super::{IoError, Place, read_bytes};
-use crate::cad::Brep;
+use crate::cad::{Brep, Tessellation};
 use std::path::Path;
+
+/// The chord tolerance (mm) of tessellated faces when [`StepOptions::chord_tolerance`] gives none: a quarter of the
+/// default bend tolerance ([`crate::cad::recognise::DEFAULT_BEND_TOLERANCE`]).
+pub const DEFAULT_CHORD_TOLERANCE: f64 = crate::cad::recognise::DEFAULT_BEND_TOLERANCE / 4.0;
 
 /// Options for reading a STEP file.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -51,6 +56,9 @@ pub struct StepOptions {
     /// Which solid to read when the file holds several: 0-based, in the order of the solids' instances in the file
     /// (the CLI's `--solid N`). `None`: the file must hold exactly one.
     pub solid: Option<usize>,
+    /// The chord tolerance (mm, positive) of a solid that is tessellated: how far its triangles may stand from its
+    /// exact faces. Default [`DEFAULT_CHORD_TOLERANCE`]; [`crate::io::sheet`] takes a quarter of the bend tolerance.
+    pub chord_tolerance: Option<f64>,
 }
 
 /// Reads the solid of a STEP file: [`parse_step`] on the file's bytes.
@@ -71,4 +79,39 @@ pub fn parse_step(bytes: &[u8], file: &Path, options: &StepOptions) -> Result<Br
         message: e.message,
     })?;
     brep::build(&exchange, file, options)
+}
+
+/// The B-rep of a tessellated solid: its mesh segmented into faces as a mesh is. The mesh's length tolerance is
+/// `1e-9` of its size (at least `1e-6` mm): its points are on the exact faces to rounding.
+fn tessellated_brep(graph: &brep::Graph<'_>, solid: u64, options: &StepOptions) -> Result<Brep, IoError> {
+    let chord = options.chord_tolerance.filter(|c| c.is_finite() && *c > 0.0).unwrap_or(DEFAULT_CHORD_TOLERANCE);
+    let mesh = tessellate::tessellate_solid(graph, solid, chord)?;
+    let (mut lo, mut hi) = (glam::DVec3::INFINITY, glam::DVec3::NEG_INFINITY);
+    for p in &mesh.points {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    let size = (hi - lo).length();
+    let tolerance = if size.is_finite() { (1e-9 * size).max(1e-6) } else { 1e-6 };
+    let brep = crate::cad::mesh_faces::mesh_faces(&mesh.points, &mesh.triangles, tolerance)
+        .map_err(|source| IoError::MeshFaces { file: graph.file.to_path_buf(), source: Box::new(source) })?;
+    tracing::info!(
+        file = %graph.file.display(),
+        faces = mesh.faces,
+        curved_faces = mesh.curved,
+        triangles = mesh.triangles.len(),
+        chord_tolerance = chord,
+        "STEP solid tessellated: {} of its {} faces are on other surfaces than planes and cylinders",
+        mesh.curved,
+        mesh.faces
+    );
+    Ok(Brep {
+        tessellation: Some(Tessellation {
+            faces: mesh.faces,
+            curved_faces: mesh.curved,
+            triangles: mesh.triangles.len(),
+            chord_tolerance: chord,
+        }),
+        ..brep
+    })
 }
