@@ -30,7 +30,7 @@ pub struct Args {
     /// The planner's options.
     #[command(flatten)]
     pub planner: PlannerArgs,
-    /// Output directory.
+    /// Output directory (created if missing).
     #[arg(long, default_value = "sweep")]
     pub out: PathBuf,
 }
@@ -184,7 +184,11 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let sweep = SweepJson { part_name: part.name.clone(), count: args.planner.count, runs };
     let scenes: Vec<Scene> = plans.iter().map(|(_, _, f)| stack_scene(f, false)).collect();
     let figure = Figure {
-        title: format!("{} x {} for w = {}", args.planner.count, part.name, args.w_values),
+        title: format!(
+            "{} {} parts for each weight w (0: spread low on the floor; 1: small footprint, columns)",
+            args.planner.count, part.name
+        ),
+        legend: scenes.first().map(|s| s.legend.clone()).unwrap_or_default(),
         panels: scenes
             .iter()
             .zip(&sweep.runs)
@@ -208,7 +212,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let mut text = String::new();
     for r in &sweep.runs {
         text.push_str(&format!(
-            "w = {}: {} placed, {} layers, height {:.1} mm, footprint {:.1} x {:.1} mm, total cost {:.1}, {:.1} s\n",
+            "w = {}: {} placed, {} layers, height {:.1} mm, footprint {:.1} x {:.1} mm, total cost {:.1} mm^2, {:.1} s\n",
             short_number(r.w),
             r.placed,
             r.layers,
@@ -219,7 +223,11 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
             r.seconds
         ));
     }
-    text.push_str(&format!("wrote {}\n", args.out.display()));
+    text.push_str(&format!(
+        "wrote {}: {}, sweep.json, sweep.svg, sweep.png\n",
+        args.out.display(),
+        plans.iter().map(|(name, _, _)| name.as_str()).collect::<Vec<_>>().join(", ")
+    ));
     crate::output::print_summary(&text)?;
     let complete = sweep.runs.iter().all(|r| r.stopped.is_none());
     Ok(if complete { Outcome::Success } else { Outcome::ChecksFailed })
