@@ -110,7 +110,8 @@ pub fn warn_implausible_size(spec: &str, part: &Part) {
     let units = READ_SETTINGS.get().map(|s| s.units).unwrap_or_default();
     if size < 20.0 {
         tracing::warn!(
-            "{spec}: the part is only {} mm across, read as {units}; if the file is in inches or metres, say so with              --units in or --units m",
+            "{spec}: the part is only {} mm across, read as {units}; if the file is in inches or metres, say so with \
+             --units in or --units m",
             short_number((size * 1000.0).round() / 1000.0)
         );
     } else if size > 20_000.0 {
