@@ -258,3 +258,76 @@ fn identical_warnings_print_once() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(stderr(&o), "", "a plan of a real bracket is quiet");
 }
+
+/// Every key of `value` (nested), with its path.
+fn keys(value: &Value, path: &str, out: &mut Vec<String>) {
+    match value {
+        Value::Object(map) => {
+            for (k, v) in map {
+                out.push(format!("{path}.{k}"));
+                keys(v, &format!("{path}.{k}"), out);
+            }
+        }
+        Value::Array(items) => items.iter().for_each(|v| keys(v, &format!("{path}[]"), out)),
+        _ => {}
+    }
+}
+
+/// The JSON of `plan`, `place`, `check` and `part poses` names every angle with its unit: no key is one of the
+/// libraries' unitless angle names, and the radians are where the docs say (`_rad`); a plan file with the older names
+/// (`dtheta`, `grasp_tilt`) still renders and checks alike.
+#[test]
+fn angles_in_json_carry_their_unit() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let o = run_in(dir.path(), &["plan", "example:cube", "--count", "2", "--cup-diameter", "0.5", "--out", "p"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let plan = read_json(&dir.path().join("p/plan.json"));
+    let place = run_in(dir.path(), &["place", "example:cube", "--stack", "p/plan.json", "--json"]);
+    let check = run_in(dir.path(), &["check", "p/plan.json", "--json"]);
+    let poses = run_in(dir.path(), &["part", "poses", "example:channel", "--json"]);
+    let documents = [
+        ("plan.json", plan.clone()),
+        ("place", serde_json::from_str(&stdout(&place)).expect("place json")),
+        ("check", serde_json::from_str(&stdout(&check)).expect("check json")),
+        ("part poses", serde_json::from_str(&stdout(&poses)).expect("poses json")),
+    ];
+    let unitless = ["theta", "dtheta", "grasp_tilt", "max_tilt", "tilt", "angle", "start"];
+    let mut all = Vec::new();
+    for (name, doc) in &documents {
+        let mut found = Vec::new();
+        keys(doc, "", &mut found);
+        for key in &found {
+            let last = key.rsplit('.').next().expect("a key");
+            assert!(!unitless.contains(&last), "{name}: {key} names an angle without its unit");
+        }
+        all.extend(found.into_iter().map(|k| format!("{name}{k}")));
+    }
+    for expected in [
+        "plan.json.plan.options.dtheta_rad",
+        "plan.json.plan.options.grasp_tilt_rad",
+        "place.placements[].theta_rad",
+        "place.placements[].theta_deg",
+        "check.options.grasp.max_tilt_rad",
+        "part poses.poses[].grasp_faces[].tilt_rad",
+    ] {
+        assert!(all.iter().any(|k| k == expected), "{expected} missing");
+    }
+    let dtheta = plan["plan"]["options"]["dtheta_rad"].as_f64().expect("dtheta_rad");
+    assert!((dtheta - 5f64.to_radians()).abs() < 1e-15, "the default step, 5 degrees");
+
+    // the older names read the same
+    let mut older = plan.clone();
+    let options = older["plan"]["options"].as_object_mut().expect("options");
+    for (new, old) in [("dtheta_rad", "dtheta"), ("grasp_tilt_rad", "grasp_tilt")] {
+        let v = options.remove(new).expect("present");
+        options.insert(old.to_string(), v);
+    }
+    std::fs::write(dir.path().join("older.json"), older.to_string()).expect("write");
+    let o = run_in(dir.path(), &["render", "older.json", "--png", "older.png"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read(dir.path().join("older.png")).ok(), std::fs::read(dir.path().join("p/stack.png")).ok());
+    let o = run_in(dir.path(), &["check", "older.json", "--json"]);
+    let report: Value = serde_json::from_str(&stdout(&o)).expect("json");
+    let (a, b) = (&report["options"]["grasp"]["max_tilt_rad"], &documents[2].1["options"]["grasp"]["max_tilt_rad"]);
+    assert_eq!(a, b);
+}

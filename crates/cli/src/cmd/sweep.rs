@@ -24,7 +24,8 @@ use std::path::PathBuf;
 pub struct Args {
     /// Part file or built-in example (`example:NAME`).
     pub part: String,
-    /// The weights w, comma-separated, each in [0, 1].
+    /// The weights w, comma-separated, each from 0 to 1: 0 spreads parts on the floor, keeping the centres of gravity
+    /// low; 1 keeps the footprint small, building columns.
     #[arg(long, value_name = "W,W,...", default_value = "0,0.5,1")]
     pub w_values: String,
     /// The planner's options.
@@ -212,10 +213,11 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let mut text = String::new();
     for r in &sweep.runs {
         text.push_str(&format!(
-            "w = {}: {} placed, {} layers, height {:.1} mm, footprint {:.1} x {:.1} mm, total cost {:.1} mm^2, {:.1} s\n",
+            "w = {}: {} placed, {} layer{}, height {:.1} mm, footprint {:.1} x {:.1} mm, total cost {:.1} mm^2, {:.1} s\n",
             short_number(r.w),
             r.placed,
             r.layers,
+            if r.layers == 1 { "" } else { "s" },
             r.height,
             r.footprint_size[0],
             r.footprint_size[1],
