@@ -371,7 +371,8 @@ fn plan_writes_every_output_and_check_accepts_the_plan() {
         assert!(outside[0][field].as_f64().is_some_and(|d| d > least), "{field}: {report}");
         assert_eq!((report["ok"].clone(), report["parts"][3]["ok"].clone()), (Value::from(false), Value::from(false)));
         let o = run_in(dir.path(), &["check", "moved.json"]);
-        assert!(stdout(&o).contains("floor volume: part 3 lies"), "{}", stdout(&o));
+        // the table numbers parts from 1: index 3 is part 4
+        assert!(stdout(&o).contains("floor volume: part 4 lies"), "{}", stdout(&o));
     }
     // a floor volume that is not one is an error naming the nested key
     let mut bad_floor = plan.clone();
@@ -414,8 +415,8 @@ fn plan_rejects_bad_requests_without_writing_anything() {
     assert!(stderr(&o).contains("too small"), "{}", stderr(&o));
 }
 
-/// The text table of `contacts` gives the extremal bounds in the JSON's units, mm and radians, and says so (the
-/// bounds on the command line are in degrees).
+/// The text table of `contacts` gives the extremal bounds in mm and degrees, as the bounds on the command line, and
+/// says so; its first line counts the feasible states and the states evaluated (the JSON's `states`).
 #[test]
 fn contacts_table_names_its_units() {
     let o = run(&[
@@ -432,9 +433,11 @@ fn contacts_table_names_its_units() {
     assert!(o.status.success(), "{}", stderr(&o));
     let text = stdout(&o);
     let header = text.lines().nth(1).expect("a header line");
-    assert!(header.contains("lower bounds [x y z (mm) rx ry rz (rad)]"), "{header}");
-    // a feasible cube-on-cube state tilts up to 2 degrees = 3.491e-2 rad
-    assert!(text.contains("3.491e-2") && !text.contains("2.000e0"), "{text}");
+    assert!(header.contains("lowest x y z (mm) rx ry rz (deg)"), "{header}");
+    // a feasible cube-on-cube state tilts up to 2 degrees (3.491e-2 rad)
+    assert!(text.contains(" 2.000") && !text.contains("3.491e-2") && !text.contains("0.035"), "{text}");
+    let first = text.lines().next().expect("a first line");
+    assert!(first.contains("feasible contact states of") && first.contains("evaluated"), "{first}");
 }
 
 /// The GA's effort is bounded (`--population 100000 --generations 100000`, each within its range, ran for hours):

@@ -4,5 +4,6 @@
 
 mod commands;
 mod common;
+mod conventions;
 mod part;
 mod plans;

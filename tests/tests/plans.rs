@@ -42,7 +42,7 @@ fn render_reproduces_every_file_of_a_plan() {
     // the build strip: one frame per part, captioned with the part count, the report shows it
     let strip = std::fs::read_to_string(plan.join("build.svg")).expect("build.svg");
     assert_eq!(strip.matches("<g id=\"view-").count(), 4);
-    assert!(strip.contains(">n = 4</text>"));
+    assert!(strip.contains(">4 parts</text>"));
     let html = std::fs::read_to_string(plan.join("report.html")).expect("report");
     assert!(html.contains("src=\"build.png\""));
 }

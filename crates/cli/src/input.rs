@@ -4,6 +4,19 @@ use anyhow::Context;
 use stackplan_geom::Part;
 use stackplan_geom::sheet_metal::Decomposition;
 
+/// The weight w of the planner's cost in `plan`, `sweep` and `place`.
+pub const DEFAULT_W: f64 = 0.5;
+/// The horizontal clearance between parts of `plan` and `sweep` (mm); `check` takes a plan file's own.
+pub const DEFAULT_CLEARANCE_MM: f64 = 5.0;
+/// The step of the turns about the vertical axis of `plan`, `sweep` and `place` (degrees).
+pub const DEFAULT_DTHETA_DEG: f64 = 5.0;
+/// The friction coefficient of `plan`, `sweep` and `check`.
+pub const DEFAULT_MU: f64 = 0.5;
+/// The suction cup's diameter in `plan`, `sweep`, `check` and `part poses` (mm).
+pub const DEFAULT_CUP_DIAMETER_MM: f64 = 10.0;
+/// The largest tilt from level of a face that holds the cup, in `plan`, `sweep`, `check` and `part poses` (degrees).
+pub const DEFAULT_GRASP_TILT_DEG: f64 = 5.0;
+
 /// Where a part comes from, shared by every command that reads one.
 #[derive(Debug, Clone, clap::Args)]
 pub struct PartArgs {
@@ -97,7 +110,8 @@ pub fn warn_implausible_size(spec: &str, part: &Part) {
     let units = READ_SETTINGS.get().map(|s| s.units).unwrap_or_default();
     if size < 20.0 {
         tracing::warn!(
-            "{spec}: the part is only {} mm across, read as {units}; if the file is in inches or metres, say so with              --units in or --units m",
+            "{spec}: the part is only {} mm across, read as {units}; if the file is in inches or metres, say so with \
+             --units in or --units m",
             short_number((size * 1000.0).round() / 1000.0)
         );
     } else if size > 20_000.0 {

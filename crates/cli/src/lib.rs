@@ -6,6 +6,7 @@
 
 pub mod cmd;
 pub mod input;
+pub mod logging;
 pub mod output;
 pub mod plan_files;
 pub mod render;
@@ -116,7 +117,7 @@ pub fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(e) => e.exit(),
     };
-    init_logging(cli.verbose, cli.quiet);
+    logging::init(cli.verbose, cli.quiet);
     output::set_quiet(cli.quiet);
     let settings = input::ReadSettings {
         mesh_tolerance: cli.mesh_tolerance,
@@ -143,6 +144,8 @@ pub fn main() -> ExitCode {
         Command::Check(a) => cmd::check::run(a),
         Command::Contacts(a) => cmd::contacts::run(a),
     });
+    // every distinct warning once, with its count, before the error (if any)
+    logging::flush_warnings();
     match result {
         Ok(Outcome::Success) => ExitCode::SUCCESS,
         Ok(Outcome::ChecksFailed) => ExitCode::from(1),
@@ -172,28 +175,6 @@ pub fn error_text(e: &anyhow::Error) -> String {
         text.push_str(&message);
     }
     text
-}
-
-fn init_logging(verbose: u8, quiet: bool) {
-    use tracing_subscriber::prelude::*;
-    let level = if quiet {
-        "error"
-    } else {
-        match verbose {
-            0 => "warn",
-            1 => "info",
-            2 => "debug",
-            _ => "trace",
-        }
-    };
-    let filter = tracing_subscriber::EnvFilter::try_from_env("STACKPLAN_LOG")
-        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(level));
-    let indicatif_layer = tracing_indicatif::IndicatifLayer::new();
-    let _ = tracing_subscriber::registry()
-        .with(filter)
-        .with(tracing_subscriber::fmt::layer().with_writer(indicatif_layer.get_stderr_writer()).with_target(false))
-        .with(indicatif_layer)
-        .try_init();
 }
 
 #[cfg(test)]

@@ -14,6 +14,22 @@ pub fn set_quiet(quiet: bool) {
     QUIET.store(quiet, Ordering::Relaxed);
 }
 
+/// Says which files a command wrote (`wrote F`), unless `-q` was given: on stdout, or on stderr when stdout carries
+/// the command's JSON (`json`), so that stdout stays one JSON document.
+pub fn print_wrote(paths: &[&Path], json: bool) -> anyhow::Result<()> {
+    if QUIET.load(Ordering::Relaxed) || paths.is_empty() {
+        return Ok(());
+    }
+    let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    let line = format!("wrote {}\n", names.join(", "));
+    if json {
+        let mut err = std::io::stderr().lock();
+        err.write_all(line.as_bytes())?;
+        return Ok(err.flush()?);
+    }
+    print_text(&line)
+}
+
 /// Writes `bytes` to `path` atomically (a temporary file in the same directory, synced, then renamed): the
 /// writer of `stackplan_geom::io`, so the library and the program share one implementation.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
@@ -55,4 +71,51 @@ pub fn print_summary(text: &str) -> anyhow::Result<()> {
         return Ok(());
     }
     print_text(text)
+}
+
+/// Renames the key at the end of `path` in `value` to `to`: `path` is the keys from the top, `*` standing for every
+/// element of an array (`["placements", "*", "theta"]`). Missing keys are left alone. The JSON outputs name an angle
+/// in radians with the suffix `_rad` this way where the libraries' own names carry no unit (docs/formats.md,
+/// "Conventions").
+pub fn rename_key(value: &mut serde_json::Value, path: &[&str], to: &str) {
+    use serde_json::Value;
+    match path {
+        [] => {}
+        ["*", rest @ ..] => {
+            if let Value::Array(items) = value {
+                for item in items {
+                    rename_key(item, rest, to);
+                }
+            }
+        }
+        [last] => {
+            if let Value::Object(map) = value
+                && let Some(v) = map.remove(*last)
+            {
+                map.insert(to.to_string(), v);
+            }
+        }
+        [key, rest @ ..] => {
+            if let Some(inner) = value.get_mut(*key) {
+                rename_key(inner, rest, to);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::rename_key;
+
+    #[test]
+    fn keys_are_renamed_along_a_path() {
+        let mut v = serde_json::json!({"placements": [{"theta": 1.0, "cost": 2}, {"theta": 0.5}], "theta": 3});
+        rename_key(&mut v, &["placements", "*", "theta"], "theta_rad");
+        assert_eq!(
+            v,
+            serde_json::json!({"placements": [{"theta_rad": 1.0, "cost": 2}, {"theta_rad": 0.5}], "theta": 3})
+        );
+        rename_key(&mut v, &["missing", "theta"], "x");
+        assert_eq!(v["theta"], 3);
+    }
 }

@@ -10,7 +10,8 @@
 
 use crate::output::write_all_atomic;
 use crate::render::{
-    Figure, FigurePanel, ISOMETRIC, MUTED, Marker, Scene, Solid, figure_png, figure_svg, part_color, three_views,
+    CG_MARK, Figure, FigurePanel, ISOMETRIC, LegendItem, MUTED, Marker, Scene, Solid, Swatch, figure_png, figure_svg,
+    part_color, parts_legend, three_views,
 };
 use serde_json::{Map, Value, json};
 use stackplan::planner::{FloorVolume, Plan};
@@ -106,8 +107,15 @@ pub fn plan_document_text(part: &Part, plan: &Plan, seconds: f64) -> anyhow::Res
         m.insert("seconds".into(), json!(seconds));
         m.insert("part_origin".into(), serde_json::to_value(&part.origin)?);
     }
+    // angles in radians carry the unit in their names (docs/formats.md, "Conventions")
+    for (key, to) in RADIAN_OPTIONS {
+        crate::output::rename_key(&mut summary, &["options", key], to);
+    }
     crate::output::json_text(&json!({ "part": inline, "placements": placements, "plan": summary }))
 }
+
+/// The planner's options in radians, with their names in plan files: `PlanOptions` names them without the unit.
+const RADIAN_OPTIONS: [(&str, &str); 2] = [("dtheta", "dtheta_rad"), ("grasp_tilt", "grasp_tilt_rad")];
 
 /// Reads a plan file.
 pub fn read_plan_file(path: &Path) -> Result<PlanFile, PlanFileError> {
@@ -128,13 +136,26 @@ pub fn parse_plan_file(bytes: &[u8], path: &Path) -> Result<PlanFile, PlanFileEr
     // the summary is typed; the placements' planner fields (cost, theta, stage, ...) are read leniently for the
     // report: JSON has no infinity or NaN, so a non-finite number is written as `null` and shown as "-"
     summary.insert("parts".into(), Value::Array(Vec::new()));
-    // the error names the nested key (`plan.options.floor.height`), not only the summary
-    let plan: Plan = serde_path_to_error::deserialize(Value::Object(summary)).map_err(|e| {
-        let key = match e.path().to_string().as_str() {
+    // `dtheta_rad` and `grasp_tilt_rad` are `PlanOptions`' `dtheta` and `grasp_tilt` (files written before the
+    // names carried the unit hold those)
+    let mut summary = Value::Object(summary);
+    for (key, named) in RADIAN_OPTIONS {
+        crate::output::rename_key(&mut summary, &["options", named], key);
+    }
+    // the error names the nested key (`plan.options.floor.height`), not only the summary, by its name in the file
+    let plan: Plan = serde_path_to_error::deserialize(summary).map_err(|e| {
+        let mut key = match e.path().to_string().as_str() {
             "." => "plan".to_string(),
             nested => format!("plan.{nested}"),
         };
-        PlanFileError::Malformed { file: path.to_path_buf(), message: format!("key `{key}`: {}", e.inner()) }
+        let mut message = e.inner().to_string();
+        for (name, named) in RADIAN_OPTIONS {
+            if key == format!("plan.options.{name}") {
+                key = format!("plan.options.{named}");
+            }
+            message = message.replace(&format!("`{name}`"), &format!("`{named}`"));
+        }
+        PlanFileError::Malformed { file: path.to_path_buf(), message: format!("key `{key}`: {message}") }
     })?;
     if count == 0 {
         return Err(PlanFileError::Empty { file: path.to_path_buf() });
@@ -315,14 +336,25 @@ pub fn stack_scene(file: &PlanFile, annotate: bool) -> Scene {
         scene.markers.clear();
     }
     let plan = &file.plan;
+    let [[x0, y0], [x1, y1]] = plan.footprint;
     scene.title = format!(
-        "{} x {}: w = {}, height {:.1} mm, total cost {:.1}",
+        "{} {} parts, w = {}: height {:.1} mm, footprint {:.1} x {:.1} mm, total cost {:.1} mm^2",
         file.poses.len(),
         file.part.name,
-        plan.options.w,
+        crate::input::short_number(plan.options.w),
         plan.height,
+        x1 - x0,
+        y1 - y0,
         plan.total_cost
     );
+    scene.legend = if annotate {
+        parts_legend(true)
+    } else {
+        vec![
+            LegendItem::new(Swatch::Square(part_color(0)), "one colour per part"),
+            LegendItem::new(Swatch::Floor, "floor area"),
+        ]
+    };
     scene
 }
 
@@ -342,7 +374,7 @@ fn frame_scene(file: &PlanFile, count: usize, new_from: usize, floor: Vec<DVec3>
         if numbered {
             let cg = pose.apply(file.part.mass.center_of_gravity);
             scene.labels.push((i + 1, cg));
-            scene.markers.push(Marker { position: cg, color: [200, 0, 0] });
+            scene.markers.push(Marker { position: cg, color: CG_MARK });
         }
     }
     scene
@@ -376,7 +408,7 @@ fn build_frames(file: &PlanFile) -> Vec<(Scene, String)> {
         .map(|count| {
             let scene = frame_scene(file, count, previous, outline.clone(), count - previous == 1);
             previous = count;
-            (scene, format!("n = {count}"))
+            (scene, format!("{count} part{}", if count == 1 { "" } else { "s" }))
         })
         .collect()
 }
@@ -384,13 +416,19 @@ fn build_frames(file: &PlanFile) -> Vec<(Scene, String)> {
 fn build_figure<'a>(file: &PlanFile, frames: &'a [(Scene, String)]) -> Figure<'a> {
     let n = file.poses.len();
     let step = n.div_ceil(MAX_BUILD_FRAMES).max(1);
+    let new = if step == 1 { "the part added" } else { "the parts added (the last one numbered)" };
     Figure {
         title: format!(
-            "Building the stack of {n} x {}: {}, the new part{} in colour",
+            "Building the stack of {n} {} parts: {}",
             file.part.name,
             if step == 1 { "one frame per part".to_string() } else { format!("one frame per {step} parts") },
-            if step == 1 { "" } else { "s" }
         ),
+        legend: vec![
+            LegendItem::new(Swatch::Square(part_color(0)), new),
+            LegendItem::new(Swatch::Square(MUTED), "parts placed before"),
+            LegendItem::new(Swatch::Label, "part number"),
+            LegendItem::new(Swatch::Disc(CG_MARK), "centre of gravity"),
+        ],
         panels: frames
             .iter()
             .map(|(scene, caption)| FigurePanel { scene, view: ISOMETRIC, caption: caption.clone() })
@@ -401,51 +439,184 @@ fn build_figure<'a>(file: &PlanFile, frames: &'a [(Scene, String)]) -> Figure<'a
     }
 }
 
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+}
+
+/// What a part touches, for people: `the floor`, `part 3`, `a side of the floor`, `the maximum height` (parts
+/// numbered from 1), each once, in the order of `contacts`.
+pub fn contacts_text(contacts: Option<&Value>) -> String {
+    let mut named: Vec<String> = Vec::new();
+    for c in contacts.and_then(Value::as_array).into_iter().flatten() {
+        let name = match c.get("with").and_then(Value::as_str) {
+            Some("floor") => "the floor".to_string(),
+            Some("stack") => match c.get("stack_part").and_then(Value::as_u64) {
+                Some(k) => format!("part {}", k + 1),
+                None => "a part".to_string(),
+            },
+            Some("floor_side") => "a side of the floor area".to_string(),
+            Some("ceiling") => "the maximum height".to_string(),
+            _ => continue,
+        };
+        if !named.contains(&name) {
+            named.push(name);
+        }
+    }
+    if named.is_empty() { "-".to_string() } else { named.join(", ") }
+}
+
+/// Why a part is where it is, for people: the stage that placed it, and whether cheaper candidates were rejected.
+pub fn placement_reason(p: &Map<String, Value>) -> String {
+    let stage = match p.get("stage").and_then(Value::as_u64) {
+        Some(1) => "stage 1 (within the stack's footprint)",
+        Some(2) => "stage 2 (the whole floor)",
+        _ => "stage unknown",
+    };
+    let rejected = p.get("rejected_candidates").and_then(Value::as_u64).unwrap_or(0);
+    let why = match rejected {
+        0 => "the cheapest candidate of its stage passed every check".to_string(),
+        1 => "1 cheaper candidate failed a check (stability, grasp, insertion or clearance)".to_string(),
+        k => format!("{k} cheaper candidates failed a check (stability, grasp, insertion or clearance)"),
+    };
+    let drop = p.get("release_drop").and_then(Value::as_f64).unwrap_or(0.0);
+    let drop =
+        if drop > 0.0 { format!("; released {drop:.1} mm above its rest and drops into place") } else { String::new() };
+    format!("{stage}: {why}{drop}")
+}
+
+/// The paragraph that says what the plan was asked, what it found, and why it stopped if it did.
+pub fn plan_paragraph(file: &PlanFile) -> String {
+    let (part, plan) = (&file.part, &file.plan);
+    let o = &plan.options;
+    let n = crate::input::short_number;
+    let (lo, hi) = o.floor.polygon.iter().fold(([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]), |(lo, hi), p| {
+        ([lo[0].min(p.x), lo[1].min(p.y)], [hi[0].max(p.x), hi[1].max(p.y)])
+    });
+    let asked = format!(
+        "Asked: {count} {name} parts on a floor of {fx:.0} x {fy:.0} mm, at most {h:.0} mm high, with weight w = {w} \
+         ({wmeaning}), {clearance} mm horizontal clearance between parts, turns in steps of {dtheta} degrees, a \
+         {cup} mm suction cup on faces up to {tilt} degrees off level, and friction mu = {mu}.",
+        count = o.count,
+        name = part.name,
+        fx = hi[0] - lo[0],
+        fy = hi[1] - lo[1],
+        h = o.floor.height,
+        w = n(o.w),
+        wmeaning = crate::cmd::plan::W_MEANING,
+        clearance = n(o.clearance),
+        dtheta = n((o.dtheta.to_degrees() * 1e6).round() / 1e6),
+        cup = n(o.cup_diameter),
+        tilt = n((o.grasp_tilt.to_degrees() * 1e6).round() / 1e6),
+        mu = n(o.mu),
+    );
+    let [[x0, y0], [x1, y1]] = plan.footprint;
+    let found = format!(
+        "Found: {placed} of {count} parts placed, {height:.1} mm high on a footprint of {fx:.1} x {fy:.1} mm, total \
+         cost {cost:.1} mm^2; the whole stack is {stable}.",
+        placed = file.poses.len(),
+        count = o.count,
+        height = plan.height,
+        fx = x1 - x0,
+        fy = y1 - y0,
+        cost = plan.total_cost,
+        stable = if plan.stack_stable { "stable" } else { "not stable" },
+    );
+    let stopped = match &plan.stopped {
+        Some(reason) => format!("The plan stopped early: {reason}."),
+        None => "Every part was placed.".to_string(),
+    };
+    let st = &plan.stats;
+    let rejected = [
+        (st.rejected_not_stable, "not stable on its supports"),
+        (st.rejected_stack_not_stable, "the stack with it not stable"),
+        (st.rejected_not_graspable, "no face for the cup"),
+        (st.rejected_not_insertable, "not insertable from above"),
+        (st.rejected_clearance, "short of the clearance"),
+    ];
+    let total: usize = rejected.iter().map(|(k, _)| k).sum();
+    let reasons: Vec<String> = rejected.iter().filter(|(k, _)| *k > 0).map(|(k, why)| format!("{k} {why}")).collect();
+    let searched = format!(
+        "The planner ran {searches} placement searches and checked {checked} candidates in {seconds:.1} s; {rejected}",
+        searches = st.searches,
+        checked = st.candidates_checked,
+        seconds = file.seconds,
+        rejected = if total == 0 {
+            "none was rejected.".to_string()
+        } else {
+            format!("{total} were rejected: {}.", reasons.join(", "))
+        },
+    );
+    format!("{asked} {found} {stopped} {searched}")
+}
+
+/// What each column of the report's table means.
+pub const REPORT_COLUMNS: [(&str, &str); 11] = [
+    ("#", "the part's number: 1 is placed first (plan.json: placements[# - 1], whose index is # - 1)"),
+    ("position (mm)", "where the part's file origin comes to rest: x, y, z"),
+    ("turn (deg)", "the part's turn about the vertical axis from its resting pose"),
+    ("pose", "which stable resting pose it lies in: 1 has the lowest centre of gravity"),
+    ("stage", "1: placed within the stack's footprint; 2: found by searching the whole floor"),
+    ("cost (mm^2)", "the part's term of the cost the planner minimises (w weighs floor use against c.g. height)"),
+    ("c.g. height (mm)", "the height of the part's centre of gravity"),
+    (
+        "margin",
+        "the largest sideways push, as a fraction of the part's weight, that it resists on its supports (up to 10; \
+         '-': not computed)",
+    ),
+    ("grasp radius (mm)", "the largest suction disc on its upward faces; the cup needs half its diameter"),
+    ("touches", "what it rests on or touches"),
+    ("why here", "the stage that placed it, and whether cheaper candidates were rejected"),
+];
+
 fn report_html(file: &PlanFile, svg_text: &str) -> String {
-    let (part, plan, seconds) = (&file.part, &file.plan, file.seconds);
-    let esc = |s: &str| s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;");
+    let part = &file.part;
     let mut rows = String::new();
     for (i, p) in file.placements.iter().enumerate() {
         let number = |key: &str, digits: usize| match p.get(key).and_then(Value::as_f64) {
             Some(x) => format!("{x:.digits$}"),
             None => "-".to_string(),
         };
+        let pose = p.get("resting_pose").and_then(Value::as_u64).map_or("-".to_string(), |k| (k + 1).to_string());
         let position = file.poses[i].position;
         rows.push_str(&format!(
-            "<tr><td>{}</td><td>{:.2}, {:.2}, {:.2}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+            "<tr><td>{}</td><td>{:.2}, {:.2}, {:.2}</td><td>{}</td><td>{pose}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"text\">{}</td><td class=\"text\">{}</td></tr>\n",
             i + 1,
             position.x,
             position.y,
             position.z,
             number("theta_deg", 1),
-            number("resting_pose", 0),
             number("stage", 0),
             number("cost", 2),
             number("cg_height", 2),
             number("stability_margin", 2),
             number("grasp_radius", 1),
-            p.get("contacts").and_then(Value::as_array).map_or("-".to_string(), |c| c.len().to_string())
+            esc(&contacts_text(p.get("contacts"))),
+            esc(&placement_reason(p)),
         ));
     }
+    let header: String = REPORT_COLUMNS.iter().map(|(c, _)| format!("<th>{}</th>", esc(c))).collect();
+    let columns: String =
+        REPORT_COLUMNS.iter().map(|(c, m)| format!("<dt>{}</dt><dd>{}</dd>\n", esc(c), esc(m))).collect();
     format!(
         r#"<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>stackplan: {name}</title>
-<style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse}}td,th{{border:1px solid #ccc;padding:3px 8px;text-align:right}}img{{max-width:100%}}</style>
+<style>body{{font-family:sans-serif;margin:2em;max-width:80em}}table{{border-collapse:collapse}}td,th{{border:1px solid #ccc;padding:3px 8px;text-align:right}}td.text{{text-align:left}}img{{max-width:100%}}dt{{font-weight:bold;float:left;clear:left;width:11em}}dd{{margin-left:12em}}</style>
 </head><body>
-<h1>Stacking plan: {placed} x {name}</h1>
-{origin}<p id="summary">{status}. Height {height:.1} mm, footprint {fx:.1} x {fy:.1} mm, total cost {cost:.1} (w = {w}),
-clearance {clearance} mm, whole stack stable: {stable}. Planned in {seconds:.1} s
-({searches} placement searches, {checked} candidates checked, {pairs} component pairs evaluated).</p>
+<h1>Stacking plan: {placed} {name} parts</h1>
+{origin}<p id="summary">{paragraph}</p>
 <h2>Pictures</h2>
-<p><img src="stack.png" alt="the stack: isometric, top and side views" width="1080"></p>
+<p><img src="stack.png" alt="the stack: isometric, top and side views, parts numbered in placing order" width="1080"></p>
 <details><summary>SVG</summary>{svg}</details>
 <h2>Build</h2>
 <p><img id="build" src="build.png" alt="the stack built part by part, the new part in colour" width="1100"></p>
-<p>3-D model: <a href="stack.glb">stack.glb</a> (any glTF viewer). Plan: <a href="plan.json">plan.json</a>
-(a stack file: <code>stackplan check plan.json</code>).</p>
+<p>3-D model: <a href="stack.glb">stack.glb</a> (any glTF viewer; its nodes are named after the parts' numbers).
+Plan: <a href="plan.json">plan.json</a> (a stack file: <code>stackplan check plan.json</code> checks it again).</p>
 <h2>Parts</h2>
-<table id="parts"><tr><th>#</th><th>position (mm)</th><th>theta (deg)</th><th>pose</th><th>stage</th><th>cost</th><th>c.g. height</th><th>margin</th><th>grasp radius</th><th>contacts</th></tr>
+<table id="parts"><tr>{header}</tr>
 {rows}</table>
+<h3>Columns</h3>
+<dl id="columns">
+{columns}</dl>
 </body></html>
 "#,
         name = esc(&part.name),
@@ -456,20 +627,8 @@ clearance {clearance} mm, whole stack stable: {stable}. Planned in {seconds:.1} 
             .map(|n| format!("<p id=\"origin\">Part: {}.</p>\n", esc(&n)))
             .unwrap_or_default(),
         placed = file.poses.len(),
-        status = esc(plan.stopped.as_deref().unwrap_or("All parts placed")),
-        height = plan.height,
-        fx = plan.footprint[1][0] - plan.footprint[0][0],
-        fy = plan.footprint[1][1] - plan.footprint[0][1],
-        cost = plan.total_cost,
-        w = plan.options.w,
-        clearance = plan.options.clearance,
-        stable = plan.stack_stable,
-        seconds = seconds,
-        searches = plan.stats.searches,
-        checked = plan.stats.candidates_checked,
-        pairs = plan.stats.pairs_evaluated,
+        paragraph = esc(&plan_paragraph(file)),
         svg = svg_text,
-        rows = rows,
     )
 }
 

@@ -13,10 +13,17 @@
 //! rounding to 1e-7 of the scene's size, once per scene (the three views of a stack share them).
 //!
 //! One drawing routine ([`draw_figure`]) serves both formats through the [`Canvas`] trait: [`SvgCanvas`] writes SVG
-//! elements, [`PngCanvas`] paints with tiny-skia. tiny-skia has no text, so the PNG writes text with a built-in 5 x 7
-//! bitmap font ([`GLYPHS`]: digits and the few signs of part numbers, frame and sweep captions such as `n = 12`,
-//! `w = 0.5`); text with other characters (titles, view names) is drawn in the SVG only.
+//! elements, [`PngCanvas`] paints with tiny-skia and writes text with the bundled DejaVu Sans
+//! (`assets/fonts/DejaVuSans.ttf`, rasterised by `ab_glyph`; the SVG names the same font). Text is measured with that
+//! font for both formats, so the two lay out alike.
+//!
+//! Every figure reads without the docs: a title, a legend under it ([`LegendItem`]: the colours, the c.g. mark, the
+//! floor), a caption under each panel (the view's name), and the parts' numbers. A number sits in a white box above
+//! its part's c.g. when that place is free; otherwise the box goes to the nearest free place in the panel and a leader
+//! line joins it to the c.g. ([`label_layout`]), so that no two boxes overlap. O(L^2 G) for L labels and G candidate
+//! places per panel.
 
+use ab_glyph::{Font, FontRef, PxScale, ScaleFont};
 use stackplan_geom::{ConvexPolytope, DVec2, DVec3};
 use std::fmt::Write;
 
@@ -27,7 +34,7 @@ pub struct Solid {
     pub polytope: ConvexPolytope,
     /// Base colour (sRGB, 0..255).
     pub color: [u8; 3],
-    /// Index of the part it belongs to (parts are numbered in the picture from 1).
+    /// Index of the part it belongs to (0-based; the pictures number parts from 1).
     pub part: usize,
 }
 
@@ -51,8 +58,10 @@ pub struct Scene {
     pub floor: Vec<DVec3>,
     /// Title.
     pub title: String,
-    /// Label each part with its number at its c.g. (one position per part).
+    /// Label each part with its number at its c.g. (one position per part; the number as written, 1-based).
     pub labels: Vec<(usize, DVec3)>,
+    /// The legend of its pictures.
+    pub legend: Vec<LegendItem>,
 }
 
 /// A view: the direction the viewer looks along and the screen's up vector.
@@ -110,8 +119,10 @@ pub struct FigurePanel<'a> {
 /// A figure: panels on a grid of equal cells under a title.
 #[derive(Debug, Clone)]
 pub struct Figure<'a> {
-    /// Title at the top (SVG only unless it uses the bitmap font's characters).
+    /// Title at the top.
     pub title: String,
+    /// What the colours and marks mean, in a row under the title (none: no row).
+    pub legend: Vec<LegendItem>,
     /// The panels, row by row.
     pub panels: Vec<FigurePanel<'a>>,
     /// Panels per row (at least 1).
@@ -125,7 +136,53 @@ pub struct Figure<'a> {
 
 const MARGIN: f64 = 14.0;
 const TITLE: f64 = 28.0;
+const LEGEND: f64 = 20.0;
 const CAPTION: f64 = 18.0;
+
+/// The mark drawn before a legend entry's text.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Swatch {
+    /// A filled square of this colour (a part's colour).
+    Square([u8; 3]),
+    /// A disc of this colour (the c.g. mark).
+    Disc([u8; 3]),
+    /// A dashed outline on the floor's grey (the floor area).
+    Floor,
+    /// A numbered label box with a leader line.
+    Label,
+}
+
+/// One entry of a figure's legend.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LegendItem {
+    /// The mark.
+    pub swatch: Swatch,
+    /// What it means.
+    pub text: String,
+}
+
+impl LegendItem {
+    /// An entry.
+    pub fn new(swatch: Swatch, text: impl Into<String>) -> Self {
+        Self { swatch, text: text.into() }
+    }
+}
+
+/// The legend of pictures of numbered parts: part colours, label boxes, the c.g. mark and (with `floor`) the floor.
+pub fn parts_legend(floor: bool) -> Vec<LegendItem> {
+    let mut items = vec![
+        LegendItem::new(Swatch::Square(part_color(0)), "one colour per part"),
+        LegendItem::new(Swatch::Label, "part number: 1 = placed first"),
+        LegendItem::new(Swatch::Disc(CG_MARK), "centre of gravity"),
+    ];
+    if floor {
+        items.push(LegendItem::new(Swatch::Floor, "floor area"));
+    }
+    items
+}
+
+/// The colour of the centre-of-gravity mark.
+pub const CG_MARK: [u8; 3] = [200, 0, 0];
 
 struct Frame {
     right: DVec3,
@@ -183,15 +240,20 @@ impl Figure<'_> {
         self.panels.len().div_ceil(self.columns.max(1)).max(1)
     }
 
+    /// Height of the title and legend above the panels.
+    fn header(&self) -> f64 {
+        TITLE + if self.legend.is_empty() { 0.0 } else { LEGEND }
+    }
+
     /// Width and height of the figure.
     pub fn size(&self) -> (f64, f64) {
         let cols = self.columns.clamp(1, self.panels.len().max(1));
-        (cols as f64 * self.cell.0, TITLE + self.rows() as f64 * (self.cell.1 + CAPTION))
+        (cols as f64 * self.cell.0, self.header() + self.rows() as f64 * (self.cell.1 + CAPTION))
     }
 
     fn cell_origin(&self, k: usize) -> DVec2 {
         let cols = self.columns.max(1);
-        DVec2::new((k % cols) as f64 * self.cell.0, TITLE + (k / cols) as f64 * (self.cell.1 + CAPTION))
+        DVec2::new((k % cols) as f64 * self.cell.0, self.header() + (k / cols) as f64 * (self.cell.1 + CAPTION))
     }
 
     fn placements(&self) -> Vec<Placement> {
@@ -244,8 +306,8 @@ pub struct TextStyle {
     pub anchor: Anchor,
     /// Colour.
     pub color: [u8; 3],
-    /// A white background (halo) under the text, for numbers drawn over parts.
-    pub halo: bool,
+    /// The SVG element's class (`label` for part numbers), for readers of the SVG.
+    pub class: Option<&'static str>,
 }
 
 /// Something a figure is drawn on.
@@ -348,12 +410,227 @@ fn visible_faces(scene: &Scene, seams: &[Vec<Vec<bool>>], at: &Placement) -> Vec
     faces
 }
 
-/// Draws `figure` on `canvas` (the canvas is `figure.size()` large).
-pub fn draw_figure(figure: &Figure<'_>, canvas: &mut dyn Canvas) {
-    let title = TextStyle { size: 16.0, anchor: Anchor::Start, color: [0, 0, 0], halo: false };
+/// Size of the part numbers (SVG units: the em).
+const LABEL_SIZE: f64 = 11.0;
+/// Space between a number and its box's edge.
+const LABEL_PAD: f64 = 2.0;
+/// Height of a digit, as a fraction of the em (DejaVu Sans: 1493 / 2048).
+const DIGIT_HEIGHT: f64 = 0.73;
+/// Step of the candidate places of a moved label box (SVG units).
+const LABEL_STEP: f64 = 2.0;
+/// The colour of label boxes' outlines and leader lines.
+const LEADER: [u8; 3] = [90, 90, 90];
+
+/// A part number's box as drawn in a figure (SVG units; the PNG is `scale` times larger).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LabelBox {
+    /// The panel it is drawn in (0-based, row by row).
+    pub panel: usize,
+    /// The part's number, as written (1-based).
+    pub number: usize,
+    /// Where the part's c.g. is drawn: the leader line's end when the box was moved away from it.
+    pub anchor: DVec2,
+    /// The box's top-left corner.
+    pub min: DVec2,
+    /// The box's bottom-right corner.
+    pub max: DVec2,
+}
+
+impl LabelBox {
+    /// Whether the two boxes share interior or boundary points.
+    pub fn overlaps(&self, other: &LabelBox) -> bool {
+        self.min.x <= other.max.x && other.min.x <= self.max.x && self.min.y <= other.max.y && other.min.y <= self.max.y
+    }
+
+    /// Whether the box sits at its anchor (no leader line): its bottom edge centred just above the c.g.
+    pub fn at_anchor(&self) -> bool {
+        let preferred = preferred_min(self.anchor, self.max - self.min);
+        (self.min - preferred).length() < 1e-9
+    }
+
+    /// The point of the box nearest to `p`.
+    fn nearest(&self, p: DVec2) -> DVec2 {
+        p.clamp(self.min, self.max)
+    }
+}
+
+/// The preferred top-left corner of a label box of `size` for a c.g. drawn at `anchor`: centred above it.
+fn preferred_min(anchor: DVec2, size: DVec2) -> DVec2 {
+    DVec2::new(anchor.x - size.x / 2.0, anchor.y - 4.0 - size.y)
+}
+
+/// Whether a label box at `min` of `size` is free in its panel: one unit away from every box in `placed`, and
+/// clear of every c.g. mark (`anchors`).
+fn label_free(placed: &[LabelBox], anchors: &[DVec2], min: DVec2, size: DVec2) -> bool {
+    let b = LabelBox { panel: 0, number: 0, anchor: DVec2::ZERO, min, max: min + size };
+    let grown = LabelBox { min: b.min - DVec2::ONE, max: b.max + DVec2::ONE, ..b };
+    let mark = |a: DVec2| LabelBox { min: a - DVec2::splat(3.5), max: a + DVec2::splat(3.5), ..b };
+    !placed.iter().any(|p| p.overlaps(&grown)) && !anchors.iter().any(|a| mark(*a).overlaps(&b))
+}
+
+/// The free place for a box of `size` nearest to `target` on a grid of [`LABEL_STEP`] within `[lo, hi]`, if any.
+fn nearest_free(
+    placed: &[LabelBox],
+    anchors: &[DVec2],
+    target: DVec2,
+    size: DVec2,
+    lo: DVec2,
+    hi: DVec2,
+) -> Option<DVec2> {
+    let (nx, ny) = (((hi.x - lo.x - size.x) / LABEL_STEP).floor(), ((hi.y - lo.y - size.y) / LABEL_STEP).floor());
+    if nx < 0.0 || ny < 0.0 {
+        return None;
+    }
+    let mut candidates: Vec<DVec2> = (0..=nx as usize)
+        .flat_map(|i| (0..=ny as usize).map(move |j| (i, j)))
+        .map(|(i, j)| lo + DVec2::new(i as f64, j as f64) * LABEL_STEP)
+        .collect();
+    // nearest first; ties by position, so that the layout does not depend on the sort
+    candidates.sort_by(|a, b| {
+        let (da, db) = ((*a - target).length_squared(), (*b - target).length_squared());
+        da.total_cmp(&db).then(a.y.total_cmp(&b.y)).then(a.x.total_cmp(&b.x))
+    });
+    candidates.into_iter().find(|c| label_free(placed, anchors, *c, size))
+}
+
+/// The boxes of every part number of `figure`, where [`draw_figure`] draws them, panel by panel and in increasing
+/// numbers within a panel. In increasing numbers, each box goes to its preferred place, centred above its c.g., when
+/// that place is free: one unit away from every box placed before and clear of every c.g. mark of the panel. The
+/// others are moved beside the parts' drawing, into a column left of it (a c.g. left of the drawing's middle) or right
+/// of it, ordered by the height of their c.g.s and as close to it as the column allows, joined to their c.g. by a
+/// leader line ([`LabelBox::at_anchor`] is false). A box that finds no free place there takes the free place nearest
+/// to its c.g. on a grid of [`LABEL_STEP`] inside the panel's cell. Boxes of one panel never overlap, unless the cell
+/// has no free place left (hundreds of parts in one view), when a box stays at its preferred place.
+pub fn label_layout(figure: &Figure<'_>) -> Vec<LabelBox> {
+    const GAP: f64 = 3.0;
+    let mut out = Vec::new();
+    for (k, (panel, at)) in figure.panels.iter().zip(figure.placements()).enumerate() {
+        let cell = figure.cell_origin(k);
+        let (lo, hi) = (cell + DVec2::splat(2.0), cell + DVec2::new(figure.cell.0, figure.cell.1) - DVec2::splat(2.0));
+        let inside = |min: DVec2, size: DVec2| min.cmpge(lo).all() && (min + size).cmple(hi).all();
+        let mut labels: Vec<(usize, DVec2)> = panel.scene.labels.iter().map(|(n, p)| (*n, at.to_screen(*p))).collect();
+        labels.sort_by_key(|(n, _)| *n);
+        let anchors: Vec<DVec2> = labels.iter().map(|(_, a)| *a).collect();
+        // the parts' drawing on screen
+        let (mut dlo, mut dhi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+        for p in panel
+            .scene
+            .solids
+            .iter()
+            .flat_map(|s| s.polytope.vertices())
+            .map(|v| at.to_screen(*v))
+            .chain(anchors.iter().copied())
+        {
+            (dlo, dhi) = (dlo.min(p), dhi.max(p));
+        }
+        let mut placed: Vec<LabelBox> = Vec::new();
+        let mut moved: Vec<(usize, DVec2, DVec2)> = Vec::new();
+        for (number, anchor) in labels {
+            let size = DVec2::new(
+                text_width(&number.to_string(), LABEL_SIZE) + 2.0 * LABEL_PAD,
+                DIGIT_HEIGHT * LABEL_SIZE + 2.0 * LABEL_PAD,
+            );
+            let preferred = preferred_min(anchor, size);
+            if inside(preferred, size) && label_free(&placed, &anchors, preferred, size) {
+                placed.push(LabelBox { panel: k, number, anchor, min: preferred, max: preferred + size });
+            } else {
+                moved.push((number, anchor, size));
+            }
+        }
+        let middle = (dlo.x + dhi.x) / 2.0;
+        for left in [true, false] {
+            let mut column: Vec<&(usize, DVec2, DVec2)> = moved.iter().filter(|m| (m.1.x < middle) == left).collect();
+            column.sort_by(|a, b| a.1.y.total_cmp(&b.1.y).then(a.0.cmp(&b.0)));
+            // each centred on its c.g.'s height, pushed down below the one above, then up to end inside the cell
+            let mut tops: Vec<f64> = Vec::with_capacity(column.len());
+            let mut bottom = lo.y - GAP;
+            for (_, anchor, size) in &column {
+                let top = (anchor.y - size.y / 2.0).max(bottom + GAP);
+                tops.push(top);
+                bottom = top + size.y;
+            }
+            let mut limit = hi.y;
+            for (top, (_, _, size)) in tops.iter_mut().zip(&column).rev() {
+                *top = top.min(limit - size.y);
+                limit = *top - GAP;
+            }
+            for (top, &&(number, anchor, size)) in tops.into_iter().zip(&column) {
+                let x = if left { dlo.x - 8.0 - size.x } else { dhi.x + 8.0 };
+                let min = DVec2::new(x.clamp(lo.x, (hi.x - size.x).max(lo.x)), top);
+                let min = if inside(min, size) && label_free(&placed, &anchors, min, size) {
+                    min
+                } else {
+                    nearest_free(&placed, &anchors, min, size, lo, hi).unwrap_or_else(|| preferred_min(anchor, size))
+                };
+                placed.push(LabelBox { panel: k, number, anchor, min, max: min + size });
+            }
+        }
+        placed.sort_by_key(|b| b.number);
+        out.extend(placed);
+    }
+    out
+}
+
+fn rectangle(min: DVec2, max: DVec2) -> [DVec2; 4] {
+    [min, DVec2::new(max.x, min.y), max, DVec2::new(min.x, max.y)]
+}
+
+/// Draws the legend's entries in a row under the title.
+fn draw_legend(items: &[LegendItem], canvas: &mut dyn Canvas) {
+    let text = TextStyle { size: 11.0, anchor: Anchor::Start, color: [60, 60, 60], class: None };
+    let baseline = TITLE + LEGEND - 7.0;
+    let mut x = MARGIN;
+    for item in items {
+        let (top, bottom) = (baseline - 9.0, baseline + 1.0);
+        let width = match item.swatch {
+            Swatch::Square(c) => {
+                canvas.polygon(
+                    &rectangle(DVec2::new(x, top), DVec2::new(x + 10.0, bottom)),
+                    Some(c),
+                    Some((OUTLINE, 0.5, false)),
+                );
+                10.0
+            }
+            Swatch::Disc(c) => {
+                canvas.disc(DVec2::new(x + 4.0, baseline - 4.0), 3.0, c);
+                8.0
+            }
+            Swatch::Floor => {
+                let r = rectangle(DVec2::new(x, top), DVec2::new(x + 16.0, bottom));
+                canvas.polygon(&r, Some(FLOOR), Some((FLOOR_EDGE, 0.8, true)));
+                16.0
+            }
+            Swatch::Label => {
+                let style = TextStyle { size: 9.0, anchor: Anchor::Middle, color: [0, 0, 0], class: None };
+                let (min, max) = (DVec2::new(x + 8.0, top - 1.0), DVec2::new(x + 17.0, bottom + 1.0));
+                canvas.lines(&[(DVec2::new(x + 1.0, bottom + 1.0), DVec2::new(min.x, max.y))], LEADER, 0.6);
+                canvas.polygon(&rectangle(min, max), Some([255, 255, 255]), Some((LEADER, 0.6, false)));
+                canvas.text(DVec2::new((min.x + max.x) / 2.0, baseline), "1", style);
+                17.0
+            }
+        };
+        canvas.text(DVec2::new(x + width + 4.0, baseline), &item.text, text);
+        x += width + 4.0 + text_width(&item.text, text.size) + 16.0;
+    }
+}
+
+/// The floor's fill and outline.
+const FLOOR: [u8; 3] = [242, 242, 242];
+const FLOOR_EDGE: [u8; 3] = [136, 136, 136];
+
+/// Draws `figure` on `canvas` (the canvas is `figure.size()` large); returns the part numbers' boxes as drawn
+/// ([`label_layout`]).
+pub fn draw_figure(figure: &Figure<'_>, canvas: &mut dyn Canvas) -> Vec<LabelBox> {
+    let title = TextStyle { size: 16.0, anchor: Anchor::Start, color: [0, 0, 0], class: None };
     canvas.text(DVec2::new(MARGIN, 20.0), &figure.title, title);
-    let label = TextStyle { size: 11.0, anchor: Anchor::Middle, color: [0, 0, 0], halo: true };
-    let caption = TextStyle { size: 12.0, anchor: Anchor::Start, color: [85, 85, 85], halo: false };
+    if !figure.legend.is_empty() {
+        canvas.begin_group("legend");
+        draw_legend(&figure.legend, canvas);
+        canvas.end_group();
+    }
+    let label = TextStyle { size: LABEL_SIZE, anchor: Anchor::Middle, color: [0, 0, 0], class: Some("label") };
+    let caption = TextStyle { size: 12.0, anchor: Anchor::Start, color: [85, 85, 85], class: None };
+    let boxes = label_layout(figure);
     let mut last_seams: Option<(&Scene, Vec<Vec<Vec<bool>>>)> = None;
     for (k, (panel, at)) in figure.panels.iter().zip(figure.placements()).enumerate() {
         canvas.begin_group(&format!("view-{k}"));
@@ -365,7 +642,7 @@ pub fn draw_figure(figure: &Figure<'_>, canvas: &mut dyn Canvas) {
         };
         if scene.floor.len() >= 3 {
             let pts: Vec<DVec2> = scene.floor.iter().map(|p| at.to_screen(*p)).collect();
-            canvas.polygon(&pts, Some([242, 242, 242]), Some(([136, 136, 136], 0.8, true)));
+            canvas.polygon(&pts, Some(FLOOR), Some((FLOOR_EDGE, 0.8, true)));
         }
         let faces = visible_faces(scene, &scene_seams, &at);
         last_seams = Some((scene, scene_seams));
@@ -387,19 +664,29 @@ pub fn draw_figure(figure: &Figure<'_>, canvas: &mut dyn Canvas) {
         for m in &scene.markers {
             canvas.disc(at.to_screen(m.position), 3.0, m.color);
         }
-        for (n, p) in &scene.labels {
-            canvas.text(at.to_screen(*p) - DVec2::new(0.0, 3.0), &n.to_string(), label);
+        let panel_boxes: Vec<&LabelBox> = boxes.iter().filter(|b| b.panel == k).collect();
+        let leaders: Vec<(DVec2, DVec2)> =
+            panel_boxes.iter().filter(|b| !b.at_anchor()).map(|b| (b.anchor, b.nearest(b.anchor))).collect();
+        if !leaders.is_empty() {
+            canvas.lines(&leaders, LEADER, 0.6);
+        }
+        for b in &panel_boxes {
+            canvas.polygon(&rectangle(b.min, b.max), Some([255, 255, 255]), Some((LEADER, 0.6, false)));
+            let baseline = DVec2::new((b.min.x + b.max.x) / 2.0, b.max.y - LABEL_PAD);
+            canvas.text(baseline, &b.number.to_string(), label);
         }
         let cell = figure.cell_origin(k);
         canvas.text(DVec2::new(cell.x + MARGIN, cell.y + figure.cell.1 + CAPTION - 5.0), &panel.caption, caption);
         canvas.end_group();
     }
+    boxes
 }
 
 /// The standard picture of one scene: isometric, top and side views side by side, each fitted on its own.
 pub fn three_views(scene: &Scene) -> Figure<'_> {
     Figure {
         title: scene.title.clone(),
+        legend: scene.legend.clone(),
         panels: VIEWS.iter().map(|v| FigurePanel { scene, view: *v, caption: v.name.to_string() }).collect(),
         columns: VIEWS.len(),
         cell: (360.0, 340.0),
@@ -450,10 +737,10 @@ impl Canvas for SvgCanvas {
             return;
         }
         let anchor = if style.anchor == Anchor::Middle { r#" text-anchor="middle""# } else { "" };
-        let halo = if style.halo { r#" stroke="white" stroke-width="2.5" paint-order="stroke""# } else { "" };
+        let class = style.class.map(|c| format!(r#" class="{c}""#)).unwrap_or_default();
         let _ = writeln!(
             self.out,
-            r#"<text x="{:.2}" y="{:.2}" font-size="{}"{anchor} fill="{}"{halo}>{}</text>"#,
+            r#"<text{class} x="{:.2}" y="{:.2}" font-size="{}"{anchor} fill="{}">{}</text>"#,
             at.x,
             at.y,
             style.size,
@@ -474,7 +761,7 @@ pub fn figure_svg(figure: &Figure<'_>) -> String {
     let (w, h) = figure.size();
     let mut canvas = SvgCanvas {
         out: format!(
-            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {w} {h}\" font-family=\"sans-serif\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {w} {h}\" font-family=\"DejaVu Sans, sans-serif\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
         ),
     };
     draw_figure(figure, &mut canvas);
@@ -482,33 +769,36 @@ pub fn figure_svg(figure: &Figure<'_>) -> String {
     canvas.out
 }
 
-/// The 5 x 7 bitmap font of the PNG pictures: each glyph is 7 rows of 5 bits (the high bit on the left).
-pub const GLYPHS: [(char, [u8; 7]); 16] = [
-    ('0', [0b01110, 0b10001, 0b10011, 0b10101, 0b11001, 0b10001, 0b01110]),
-    ('1', [0b00100, 0b01100, 0b00100, 0b00100, 0b00100, 0b00100, 0b01110]),
-    ('2', [0b01110, 0b10001, 0b00001, 0b00010, 0b00100, 0b01000, 0b11111]),
-    ('3', [0b11111, 0b00010, 0b00100, 0b00010, 0b00001, 0b10001, 0b01110]),
-    ('4', [0b00010, 0b00110, 0b01010, 0b10010, 0b11111, 0b00010, 0b00010]),
-    ('5', [0b11111, 0b10000, 0b11110, 0b00001, 0b00001, 0b10001, 0b01110]),
-    ('6', [0b00110, 0b01000, 0b10000, 0b11110, 0b10001, 0b10001, 0b01110]),
-    ('7', [0b11111, 0b00001, 0b00010, 0b00100, 0b01000, 0b01000, 0b01000]),
-    ('8', [0b01110, 0b10001, 0b10001, 0b01110, 0b10001, 0b10001, 0b01110]),
-    ('9', [0b01110, 0b10001, 0b10001, 0b01111, 0b00001, 0b00010, 0b01100]),
-    ('.', [0b00000, 0b00000, 0b00000, 0b00000, 0b00000, 0b01100, 0b01100]),
-    ('=', [0b00000, 0b00000, 0b11111, 0b00000, 0b11111, 0b00000, 0b00000]),
-    ('-', [0b00000, 0b00000, 0b00000, 0b11111, 0b00000, 0b00000, 0b00000]),
-    ('w', [0b00000, 0b00000, 0b10001, 0b10001, 0b10101, 0b10101, 0b01010]),
-    ('n', [0b00000, 0b00000, 0b10110, 0b11001, 0b10001, 0b10001, 0b10001]),
-    (' ', [0; 7]),
-];
+/// The pictures' font: DejaVu Sans (`assets/fonts/`, with its licence).
+static FONT_BYTES: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
 
-fn glyph(c: char) -> Option<&'static [u8; 7]> {
-    GLYPHS.iter().find(|(g, _)| *g == c).map(|(_, rows)| rows)
+/// The bundled font, parsed once (`None` only if the bundled file were not a font: a unit test reads it).
+pub fn font() -> Option<&'static FontRef<'static>> {
+    static FONT: std::sync::OnceLock<Option<FontRef<'static>>> = std::sync::OnceLock::new();
+    FONT.get_or_init(|| FontRef::try_from_slice(FONT_BYTES).ok()).as_ref()
 }
 
-/// Whether the PNG's bitmap font can write `text`.
-pub fn bitmap_font_has(text: &str) -> bool {
-    !text.is_empty() && text.chars().all(|c| glyph(c).is_some())
+/// The glyph scale of an em of `em` pixels (ab_glyph scales by the font's height, ascent to descent).
+fn px_scale(font: &FontRef<'_>, em: f64) -> PxScale {
+    let per_em = font.units_per_em().unwrap_or(2048.0) as f64;
+    PxScale::from((em * font.height_unscaled() as f64 / per_em) as f32)
+}
+
+/// The advance width of `text` at a font size (em) of `size`, in the same unit, kerning included.
+pub fn text_width(text: &str, size: f64) -> f64 {
+    let Some(font) = font() else { return 0.6 * size * text.chars().count() as f64 };
+    let scaled = font.as_scaled(px_scale(font, size));
+    let mut width = 0.0;
+    let mut previous = None;
+    for c in text.chars() {
+        let id = scaled.glyph_id(c);
+        if let Some(p) = previous {
+            width += scaled.kern(p, id) as f64;
+        }
+        width += scaled.h_advance(id) as f64;
+        previous = Some(id);
+    }
+    width
 }
 
 /// A tiny-skia pixmap, `scale` pixels per SVG unit.
@@ -530,9 +820,19 @@ impl PngCanvas {
         tiny_skia::Transform::from_scale(self.scale as f32, self.scale as f32)
     }
 
-    fn pixel_rect(&mut self, x: f64, y: f64, w: f64, h: f64, c: [u8; 3]) {
-        if let Some(r) = tiny_skia::Rect::from_xywh(x as f32, y as f32, w as f32, h as f32) {
-            self.pixmap.fill_rect(r, &paint(c, false), tiny_skia::Transform::identity(), None);
+    /// Covers pixel `(x, y)` with colour `c` by `coverage` (0 to 1); the picture is opaque, so premultiplied and
+    /// plain colours agree.
+    fn blend(&mut self, x: i64, y: i64, c: [u8; 3], coverage: f32) {
+        let (w, h) = (self.pixmap.width() as i64, self.pixmap.height() as i64);
+        if x < 0 || y < 0 || x >= w || y >= h {
+            return;
+        }
+        let k = ((y * w + x) * 4) as usize;
+        let a = coverage.clamp(0.0, 1.0);
+        let data = self.pixmap.data_mut();
+        for (i, channel) in c.iter().enumerate() {
+            let d = data[k + i] as f32;
+            data[k + i] = (d + (*channel as f32 - d) * a).round() as u8;
         }
     }
 }
@@ -544,6 +844,14 @@ impl Canvas for PngCanvas {
         if n < 3 || area2.abs() < 1e-6 {
             return; // seen edge-on: nothing to fill
         }
+        // a face seen almost edge-on can still be thinner than tiny-skia fills (1/4096 pixel): its outline is all
+        // there is to see, and filling it would only raise tiny-skia's warning about empty paths
+        let (lo, hi) =
+            points.iter().fold((DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)), |(lo, hi), p| {
+                (lo.min(*p), hi.max(*p))
+            });
+        let thin = ((hi - lo) * self.scale).min_element() < 1e-3;
+        let fill = if thin { None } else { fill };
         let mut pb = tiny_skia::PathBuilder::new();
         pb.move_to(points[0].x as f32, points[0].y as f32);
         for p in &points[1..] {
@@ -578,31 +886,28 @@ impl Canvas for PngCanvas {
             self.pixmap.fill_path(&path, &paint(fill, true), tiny_skia::FillRule::Winding, t, None);
         }
     }
-    /// Bitmap text: one font pixel is a square of whole device pixels, so the digits stay sharp; with a halo, a
-    /// white box one font pixel larger than the text on every side.
+    /// Text in the bundled font, anti-aliased, its baseline at `at`.
     fn text(&mut self, at: DVec2, text: &str, style: TextStyle) {
-        if !bitmap_font_has(text) {
-            return;
-        }
-        let cell = (style.size * self.scale / 8.0).round().max(1.0);
-        let width = (text.chars().count() * 6 - 1) as f64 * cell;
-        let height = 7.0 * cell;
-        let base = at * self.scale;
-        let x0 = (if style.anchor == Anchor::Middle { base.x - width / 2.0 } else { base.x }).round();
-        let y0 = (base.y - height).round();
-        if style.halo {
-            self.pixel_rect(x0 - cell, y0 - cell, width + 2.0 * cell, height + 2.0 * cell, [255, 255, 255]);
-        }
-        for (k, c) in text.chars().enumerate() {
-            let Some(rows) = glyph(c) else { continue };
-            for (row, bits) in rows.iter().enumerate() {
-                for col in 0..5 {
-                    if bits & (0b10000 >> col) != 0 {
-                        let x = x0 + (k * 6 + col) as f64 * cell;
-                        self.pixel_rect(x, y0 + row as f64 * cell, cell, cell, style.color);
-                    }
-                }
+        let Some(font) = font() else { return };
+        let scale = px_scale(font, style.size * self.scale);
+        let scaled = font.as_scaled(scale);
+        let width = text_width(text, style.size) * self.scale;
+        let mut x = at.x * self.scale - if style.anchor == Anchor::Middle { width / 2.0 } else { 0.0 };
+        let y = at.y * self.scale;
+        let mut previous = None;
+        for c in text.chars() {
+            let id = scaled.glyph_id(c);
+            if let Some(p) = previous {
+                x += scaled.kern(p, id) as f64;
             }
+            let glyph = id.with_scale_and_position(scale, ab_glyph::point(x as f32, y as f32));
+            if let Some(outlined) = font.outline_glyph(glyph) {
+                let bounds = outlined.px_bounds();
+                let (x0, y0) = (bounds.min.x as i64, bounds.min.y as i64);
+                outlined.draw(|gx, gy, coverage| self.blend(x0 + gx as i64, y0 + gy as i64, style.color, coverage));
+            }
+            x += scaled.h_advance(id) as f64;
+            previous = Some(id);
         }
     }
 }
@@ -631,7 +936,7 @@ pub fn svg(scene: &Scene) -> String {
     figure_svg(&three_views(scene))
 }
 
-/// The scene's three views as a PNG image, `scale` pixels per SVG unit (part numbers in the bitmap font).
+/// The scene's three views as a PNG image, `scale` pixels per SVG unit.
 pub fn png(scene: &Scene, scale: f64) -> anyhow::Result<Vec<u8>> {
     figure_png(&three_views(scene), scale)
 }
@@ -657,6 +962,7 @@ mod tests {
             floor: vec![DVec3::new(-1.0, -1.0, 0.0), DVec3::new(2.0, -1.0, 0.0), DVec3::new(2.0, 2.0, 0.0)],
             title: "two cubes <test>".into(),
             labels: vec![(1, DVec3::splat(0.5)), (2, DVec3::new(0.5, 0.5, 1.5))],
+            legend: parts_legend(true),
         }
     }
 
@@ -667,9 +973,10 @@ mod tests {
     #[test]
     fn pictures_contain_every_visible_face() {
         let scene = two_cubes();
-        let s = svg(&scene);
+        let bare = Scene { labels: Vec::new(), legend: Vec::new(), ..two_cubes() };
         // isometric: 3 faces per cube; top: 1 per cube (the upward face); side: 1 per cube
-        assert_eq!(s.matches("stroke-linejoin").count(), 2 * 3 + 2 + 2);
+        assert_eq!(svg(&bare).matches("stroke-linejoin").count(), 2 * 3 + 2 + 2);
+        let s = svg(&scene);
         assert!(s.contains("&lt;test&gt;"));
         assert_eq!(s.matches(">2</text>").count(), 3, "part 2 numbered in each view");
         let p = png(&scene, 1.0).expect("png");
@@ -695,6 +1002,7 @@ mod tests {
         let pixel_on_the_shared_edge = |scene: &Scene| {
             let figure = Figure {
                 title: String::new(),
+                legend: Vec::new(),
                 panels: vec![FigurePanel { scene, view: top, caption: String::new() }],
                 columns: 1,
                 cell: (200.0, 120.0),
@@ -715,27 +1023,59 @@ mod tests {
         assert!(s.contains(r##"fill="none" stroke="#222222""##), "{s}");
     }
 
-    /// The PNG's part numbers: the pixels of the glyphs of "12" appear, black on a white box, at the label.
+    /// The PNG writes text with the bundled font: a title in black appears where it is written (dark pixels in its
+    /// line, none above it), and its width is the font's measure of it.
     #[test]
-    fn png_numbers_are_drawn_in_the_bitmap_font() {
-        let mut canvas = PngCanvas { pixmap: tiny_skia::Pixmap::new(60, 30).expect("pixmap"), scale: 1.0 };
-        canvas.pixmap.fill(tiny_skia::Color::from_rgba8(0, 0, 255, 255));
-        let style = TextStyle { size: 8.0, anchor: Anchor::Start, color: [0, 0, 0], halo: true };
-        canvas.text(DVec2::new(10.0, 20.0), "12", style);
-        // cell = 1 px; glyph origin (10, 13); '1' row 0 = 00100 -> pixel (12, 13) black; (10, 13) white (halo box)
-        let px = |canvas: &PngCanvas, x: u32, y: u32| {
-            let c = canvas.pixmap.pixel(x, y).expect("inside");
-            [c.red(), c.green(), c.blue()]
+    fn png_text_is_drawn_in_the_bundled_font() {
+        assert!(font().is_some(), "the bundled font parses");
+        let mut canvas = PngCanvas { pixmap: tiny_skia::Pixmap::new(200, 40).expect("pixmap"), scale: 1.0 };
+        canvas.pixmap.fill(tiny_skia::Color::WHITE);
+        let style = TextStyle { size: 16.0, anchor: Anchor::Start, color: [0, 0, 0], class: None };
+        canvas.text(DVec2::new(10.0, 30.0), "Stack of 15", style);
+        let dark = |x0: u32, x1: u32, y0: u32, y1: u32| {
+            (x0..x1)
+                .flat_map(|x| (y0..y1).map(move |y| (x, y)))
+                .filter(|&(x, y)| canvas.pixmap.pixel(x, y).expect("inside").red() < 128)
+                .count()
         };
-        assert_eq!(px(&canvas, 12, 13), [0, 0, 0]);
-        assert_eq!(px(&canvas, 10, 13), [255, 255, 255]);
-        // '2' starts 6 px later: row 6 = 11111 -> (16..=20, 19) black
-        assert!((16..=20).all(|x| px(&canvas, x, 19) == [0, 0, 0]));
-        // outside the halo box the background stays
-        assert_eq!(px(&canvas, 5, 5), [0, 0, 255]);
-        // text outside the font (a title) is not drawn at all
-        canvas.text(DVec2::new(30.0, 28.0), "Stack", style);
-        assert_eq!(px(&canvas, 31, 25), [0, 0, 255]);
+        let width = text_width("Stack of 15", 16.0);
+        assert!((70.0..110.0).contains(&width), "{width}");
+        assert!(dark(10, 10 + width.ceil() as u32, 17, 31) > 100, "the glyphs are drawn");
+        assert_eq!(dark(0, 200, 0, 14), 0, "nothing above the capitals");
+        assert_eq!(dark(12 + width.ceil() as u32, 200, 0, 40), 0, "nothing past the text's width");
+        // the widths of digits: "10" is two digits wide, and every digit has the same advance
+        assert!((text_width("10", 11.0) - 2.0 * text_width("8", 11.0)).abs() < 1e-9);
+    }
+
+    /// Fifteen labels at one point (a nested stack's c.g.s seen from above) get boxes that do not overlap, each joined
+    /// to its c.g. by a leader line except the first, which sits above it; the SVG and the PNG draw them.
+    #[test]
+    fn labels_at_one_point_are_moved_apart() {
+        let mut scene = two_cubes();
+        scene.labels = (1..=15).map(|n| (n, DVec3::new(0.5, 0.5, 1.0 + 1e-5 * n as f64))).collect();
+        let figure = three_views(&scene);
+        let boxes = label_layout(&figure);
+        assert_eq!(boxes.len(), 45);
+        for (a, b) in boxes.iter().zip(boxes.iter().skip(1)) {
+            assert!(a.panel < b.panel || a.number < b.number);
+        }
+        for (k, a) in boxes.iter().enumerate() {
+            for b in &boxes[k + 1..] {
+                assert!(a.panel != b.panel || !a.overlaps(b), "{a:?} {b:?}");
+            }
+            let cell = figure.cell_origin(a.panel);
+            assert!(a.min.cmpge(cell).all() && a.max.cmple(cell + DVec2::new(360.0, 340.0)).all(), "{a:?}");
+        }
+        assert!(boxes.iter().filter(|b| b.number == 1).all(LabelBox::at_anchor));
+        assert!(boxes.iter().filter(|b| b.number > 1).all(|b| !b.at_anchor()));
+        let s = svg(&scene);
+        assert_eq!(s.matches(r#"<text class="label""#).count(), 45);
+        let image = decode(&png(&scene, 2.0).expect("png"));
+        for b in &boxes {
+            // the box's outline, drawn in the leader colour, at the middle of its top edge
+            let p = image.pixel((b.min.x + b.max.x) as u32, (2.0 * b.min.y).floor() as u32).expect("inside");
+            assert!(p.red() < 200, "{b:?}: {p:?}");
+        }
     }
 
     #[test]
@@ -745,6 +1085,7 @@ mod tests {
         tall.solids.push(Solid { polytope: cube_at(DVec3::new(0.0, 0.0, 2.0)), color: part_color(2), part: 2 });
         let figure = Figure {
             title: String::new(),
+            legend: Vec::new(),
             panels: vec![
                 FigurePanel { scene: &low, view: ISOMETRIC, caption: "n = 2".into() },
                 FigurePanel { scene: &tall, view: ISOMETRIC, caption: "n = 3".into() },

@@ -20,19 +20,20 @@ use std::path::{Path, PathBuf};
 pub struct Args {
     /// The stack file (JSON: a part and its placements).
     pub stack: PathBuf,
-    /// Coulomb friction coefficient [default: a plan file's `options.mu`, else 0.5].
+    /// Coulomb friction coefficient [default: a plan file's `options.mu`, else 0.5, as in plan].
     #[arg(long)]
     pub mu: Option<f64>,
     /// Required horizontal clearance between parts (mm); 0 disables the test [default: a plan file's
-    /// `options.clearance`, else 0].
-    #[arg(long)]
+    /// `options.clearance`, else 0, which differs from plan's 5 because a plain stack file records no clearance it
+    /// was built with].
+    #[arg(long, value_name = "MM")]
     pub clearance: Option<f64>,
-    /// Suction cup diameter (mm) [default: a plan file's `options.cup_diameter`, else 30].
-    #[arg(long)]
+    /// Suction cup diameter (mm) [default: a plan file's `options.cup_diameter`, else 10, as in plan].
+    #[arg(long, value_name = "MM")]
     pub cup_diameter: Option<f64>,
-    /// Largest tilt from level of a face that holds the cup (degrees) [default: a plan file's `options.grasp_tilt`,
-    /// else 5].
-    #[arg(long)]
+    /// Largest tilt from level of a face that holds the cup (degrees) [default: a plan file's
+    /// `options.grasp_tilt_rad` in degrees, else 5, as in plan].
+    #[arg(long, value_name = "DEG")]
     pub grasp_tilt_deg: Option<f64>,
     /// Contact tolerance (mm) instead of the policy's 1e-9 x stack size (for stacks with rounded coordinates).
     #[arg(long)]
@@ -76,7 +77,7 @@ pub struct FloorCheck {
 /// A part that leaves the floor volume.
 #[derive(Debug, Serialize)]
 pub struct FloorViolation {
-    /// The part's index in the stack.
+    /// The part's index in the stack (0-based: part `index + 1` of the table).
     pub index: usize,
     /// How far its farthest vertex lies outside the floor polygon, horizontally (mm; 0 when inside).
     pub beyond_sides: f64,
@@ -156,7 +157,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     };
     let mu = match args.mu {
         Some(mu) => mu,
-        None => option("mu")?.unwrap_or(0.5),
+        None => option("mu")?.unwrap_or(crate::input::DEFAULT_MU),
     };
     let clearance = match args.clearance {
         Some(clearance) => clearance,
@@ -164,14 +165,18 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     };
     let cup_diameter = match args.cup_diameter {
         Some(cup) => cup,
-        None => option("cup_diameter")?.unwrap_or(30.0),
+        None => option("cup_diameter")?.unwrap_or(crate::input::DEFAULT_CUP_DIAMETER_MM),
     };
     let max_tilt = match args.grasp_tilt_deg {
         Some(deg) => {
             crate::input::check_grasp_tilt(deg)?;
             deg.to_radians()
         }
-        None => option("grasp_tilt")?.unwrap_or(stackplan::stability::grasp::DEFAULT_MAX_TILT),
+        None => match option("grasp_tilt_rad")? {
+            Some(rad) => rad,
+            // (plan files written before the `_rad` names)
+            None => option("grasp_tilt")?.unwrap_or(crate::input::DEFAULT_GRASP_TILT_DEG.to_radians()),
+        },
     };
     let options = CheckOptions {
         mu,
@@ -198,18 +203,22 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     }
     let ok = report.ok;
     if args.json {
-        output::print_json(&CheckJson { stack_file: args.stack.display().to_string(), options, floor, report })?;
+        let mut json =
+            serde_json::to_value(CheckJson { stack_file: args.stack.display().to_string(), options, floor, report })?;
+        output::rename_key(&mut json, &["options", "grasp", "max_tilt"], "max_tilt_rad");
+        output::print_json(&json)?;
     } else {
         let mut text = format!(
-            "stack {}: {} parts, {}\n  part  interference  clearance  stable  margin  stack_stable  grasp_radius  insertable  removable  ok\n",
+            "stack {}: {} parts (numbered from 1 in placing order), {}\n  part  interference_mm  clearance_met  \
+             stable  margin  stack_stable  grasp_radius_mm  insertable  removable  ok\n",
             args.stack.display(),
             report.parts.len(),
             if ok { "all checks pass" } else { "CHECKS FAILED" }
         );
         for p in &report.parts {
             text.push_str(&format!(
-                "  {:>4}  {:>12.6}  {:>9}  {:>6}  {:>6}  {:>12}  {:>12.3}  {:>10}  {:>9}  {}\n",
-                p.index,
+                "  {:>4}  {:>15.6}  {:>13}  {:>6}  {:>6}  {:>12}  {:>15.3}  {:>10}  {:>9}  {}\n",
+                p.index + 1,
                 p.interference,
                 p.clearance_met,
                 p.stable.is_stable(),
@@ -222,9 +231,14 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
             ));
         }
         text.push_str(&format!(
-            "  whole stack: {:?}, margin {}\n",
+            "  whole stack: {:?}, margin {}\n  (interference: penetration depth; margin: the largest sideways push, as \
+             a fraction of the weight, that the part resists on its supports, up to 10; clearance {} mm, cup {} mm, \
+             mu {})\n",
             report.stack.verdict,
-            report.stack.margin.map_or("-".to_string(), |m| format!("{m:.3}"))
+            report.stack.margin.map_or("-".to_string(), |m| format!("{m:.3}")),
+            crate::input::short_number(options.clearance),
+            crate::input::short_number(options.grasp.cup_diameter),
+            crate::input::short_number(options.mu),
         ));
         if let Some(f) = &floor {
             if f.ok {
@@ -233,7 +247,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
             for v in &f.outside {
                 text.push_str(&format!(
                     "  floor volume: part {} lies {:.6} mm beyond the floor polygon and {:.6} mm above the maximum height\n",
-                    v.index, v.beyond_sides, v.above_height
+                    v.index + 1, v.beyond_sides, v.above_height
                 ));
             }
         }

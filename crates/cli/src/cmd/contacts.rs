@@ -115,16 +115,47 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let graph = generate(&fixed, &moving, bounds, settings).context("--population / --generations")?;
     if let Some(path) = &args.dot {
         output::write_atomic(path, graph.to_dot().as_bytes())?;
+        output::print_wrote(&[path], args.json)?;
     }
     if args.json {
         output::print_json(&graph)?;
     } else {
-        let per_level = graph.counts_per_level();
-        let total: usize = per_level.iter().sum();
-        let mut text =
-            format!("{total} feasible contact states; per level (1..): {:?}\n", &per_level[1.min(per_level.len())..]);
-        text.push_str(&graph.extremal_table());
-        output::print_text(&text)?;
+        output::print_text(&contacts_text(&graph))?;
     }
     Ok(Outcome::Success)
+}
+
+/// The text output of `contacts`: the counts, then a table of the states that were searched (the library's
+/// `Acsg::extremal_table` in the units people read: mm and degrees).
+pub fn contacts_text(graph: &stackplan::contact_states::acsg::Acsg) -> String {
+    use std::fmt::Write as _;
+    let per_level = graph.counts_per_level();
+    let total: usize = per_level.iter().sum();
+    let levels: Vec<String> = per_level.iter().enumerate().skip(1).map(|(k, n)| format!("{n} at level {k}")).collect();
+    let mut text = format!(
+        "{total} feasible contact states of {} evaluated ({}; the level is the number of principal contacts)\n",
+        graph.states.len(),
+        if levels.is_empty() { "none".to_string() } else { levels.join(", ") }
+    );
+    let _ = writeln!(
+        text,
+        "{:<32} {:>11} {:<11} {:<62} {:<62}",
+        "state", "objective", "feasibility", "lowest x y z (mm) rx ry rz (deg)", "highest x y z (mm) rx ry rz (deg)"
+    );
+    let fmt = |b: &[f64; 6]| {
+        (0..6)
+            .map(|k| if k < 3 { format!("{:.4}", b[k]) } else { format!("{:.3}", b[k].to_degrees()) })
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    for r in graph.states.iter().filter(|r| r.pruned.is_none()) {
+        let (lo, hi) = match &r.range {
+            Some(b) => (fmt(&b.min), fmt(&b.max)),
+            None => (String::new(), String::new()),
+        };
+        let objective = r.objective.map_or("-".to_string(), |o| format!("{o:.3e}"));
+        let feasibility = if r.feasible { "feasible" } else { "infeasible" };
+        let _ = writeln!(text, "{:<32} {objective:>11} {feasibility:<11} {lo:<62} {hi:<62}", r.label);
+    }
+    text
 }

@@ -266,10 +266,12 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let obstacles = obstacles(args)?;
     if let Some(path) = &args.obj {
         output::write_atomic(path, obj_text(args, &obstacles)?.as_bytes())?;
+        output::print_wrote(&[path], false)?;
         return Ok(Outcome::Success);
     }
     if let Some(path) = &args.svg {
         output::write_atomic(path, svg_text(args, &obstacles).as_bytes())?;
+        output::print_wrote(&[path], false)?;
         return Ok(Outcome::Success);
     }
     let json = CspaceJson {
@@ -282,11 +284,15 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     if args.json {
         output::print_json(&json)?;
     } else {
-        let mut text = format!("theta = {} deg, {} convex pairs\n", args.theta_deg, json.pairs.len());
+        let mut text = format!(
+            "theta = {} deg, {} convex pairs (pieces are indexed from 0, as in --pair and the JSON)\n",
+            args.theta_deg,
+            json.pairs.len()
+        );
         for p in &json.pairs {
             let _ = writeln!(
                 text,
-                "moving {} / fixed {}: {} vertices, {} faces, volume {:.6}",
+                "moving piece {} / fixed piece {}: {} vertices, {} faces, volume {:.6} mm^3",
                 p.moving_piece,
                 p.fixed_piece,
                 p.vertices.len(),

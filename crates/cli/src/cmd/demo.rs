@@ -1,4 +1,5 @@
-//! `stackplan demo [--out DIR]`: the built-in example parts, described and drawn, written under `out/`.
+//! `stackplan demo [--out DIR]`: the built-in example parts, described and drawn, written under `demo/` (not `out/`,
+//! where `stackplan plan` writes).
 //!
 //! For each example part: `NAME.json` (the `part info --json` document), `NAME.glb` (binary glTF for any 3-D viewer),
 //! `NAME.svg` and `NAME.png` (isometric, top and side views, components coloured), and `summary.json`.
@@ -6,7 +7,7 @@
 use crate::Outcome;
 use crate::cmd::part::part_info;
 use crate::output::{json_text, write_all_atomic};
-use crate::render::{Marker, Scene, Solid, part_color, png, svg};
+use crate::render::{CG_MARK, LegendItem, Marker, Scene, Solid, Swatch, part_color, png, svg};
 use anyhow::Context;
 use stackplan_geom::io::glb::{GlbItem, glb_bytes};
 use std::path::PathBuf;
@@ -14,8 +15,8 @@ use std::path::PathBuf;
 /// Arguments of `demo`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Output directory (created if missing).
-    #[arg(long, default_value = "out")]
+    /// Output directory (created if missing; `plan` writes to out/).
+    #[arg(long, default_value = "demo")]
     pub out: PathBuf,
     /// Use the seed's plain triangulation for concave faces.
     #[arg(long)]
@@ -47,10 +48,21 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
                 .enumerate()
                 .map(|(i, c)| Solid { polytope: c.clone(), color: part_color(i), part: 0 })
                 .collect(),
-            markers: vec![Marker { position: part.mass.center_of_gravity, color: [200, 0, 0] }],
+            markers: vec![Marker { position: part.mass.center_of_gravity, color: CG_MARK }],
             floor: Vec::new(),
-            title: format!("{name}: {} convex components, c.g. marked", part.components.len()),
+            title: format!(
+                "{name}: {} convex pieces, {:.0} mm^3, {:.0} x {:.0} x {:.0} mm",
+                part.components.len(),
+                part.mass.volume,
+                info.bounding_box[1][0] - info.bounding_box[0][0],
+                info.bounding_box[1][1] - info.bounding_box[0][1],
+                info.bounding_box[1][2] - info.bounding_box[0][2]
+            ),
             labels: Vec::new(),
+            legend: vec![
+                LegendItem::new(Swatch::Square(part_color(0)), "one colour per convex piece"),
+                LegendItem::new(Swatch::Disc(CG_MARK), "centre of gravity"),
+            ],
         };
         files.push((args.out.join(format!("{name}.svg")), svg(&scene).into_bytes()));
         files.push((args.out.join(format!("{name}.png")), png(&scene, 2.0)?));
@@ -65,7 +77,12 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     }
     bar.finish_and_clear();
     files.push((args.out.join("summary.json"), json_text(&summary)?.into_bytes()));
+    let count = files.len();
     write_all_atomic(files)?;
-    tracing::info!("wrote {} examples to {}", EXAMPLES.len(), args.out.display());
+    crate::output::print_summary(&format!(
+        "wrote {count} files for {} example parts to {} (NAME.json, .glb, .svg, .png; summary.json)\n",
+        EXAMPLES.len(),
+        args.out.display()
+    ))?;
     Ok(Outcome::Success)
 }

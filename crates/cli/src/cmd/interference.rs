@@ -29,7 +29,8 @@ pub struct Args {
     /// Pose of the fixed part: JSON `{"position": [x, y, z], "rotation": [[row 0], [row 1], [row 2]]}`.
     #[arg(long, value_name = "POSE.json")]
     pub fixed_pose: Option<PathBuf>,
-    /// Also report separated pairs closer than this (mm).
+    /// Also report separated pairs closer than this (mm). The default differs from plan's 5 because this is a
+    /// question, not a robot's tolerance: 0 reports penetrating and touching pairs only.
     #[arg(long, value_name = "MM", default_value_t = 0.0)]
     pub clearance: f64,
     /// Split concave sheet-metal faces by plain triangulation (the seed's component counts).
@@ -122,11 +123,21 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     if args.json {
         output::print_json(&json)?;
     } else {
-        let mut text = format!("{} penetrating, {} touching pairs\n", json.penetrating, json.touching);
+        let mut text = format!(
+            "{} penetrating, {} touching pairs (pieces are indexed from 0, as in the JSON)\n",
+            json.penetrating, json.touching
+        );
         for p in &json.pairs {
-            let amount = p.depth.or(p.gap).unwrap_or(0.0);
-            let _ =
-                writeln!(text, "moving {} / fixed {}: {} ({amount:.6} mm)", p.moving_piece, p.fixed_piece, p.contact);
+            let (what, amount) = match (p.depth, p.gap) {
+                (Some(depth), _) => ("depth", depth),
+                (None, Some(gap)) => ("gap", gap),
+                (None, None) => ("gap", 0.0),
+            };
+            let _ = writeln!(
+                text,
+                "moving piece {} / fixed piece {}: {} ({what} {amount:.6} mm)",
+                p.moving_piece, p.fixed_piece, p.contact
+            );
         }
         output::print_text(&text)?;
     }

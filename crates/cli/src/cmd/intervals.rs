@@ -152,7 +152,10 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     } else {
         let mut text = String::new();
         for p in &out.pairs {
-            text.push_str(&format!("pair moving {} / fixed {}: {} events\n", p.moving_piece, p.fixed_piece, p.events));
+            text.push_str(&format!(
+                "moving piece {} / fixed piece {} (indexed from 0): {} events\n",
+                p.moving_piece, p.fixed_piece, p.events
+            ));
             for t in p.intervals.iter().filter(|t| !t.degenerate) {
                 let kind = t.event.as_ref().and_then(|e| e["kind"].as_str()).unwrap_or("none");
                 text.push_str(&format!("  [{:10.6}, {:10.6}) deg  ends by {kind}\n", t.start_deg, t.end_deg));

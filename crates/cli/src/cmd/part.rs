@@ -166,10 +166,14 @@ fn info(args: &InfoArgs) -> anyhow::Result<Outcome> {
         info.recognition = Some(stackplan_geom::io::sheet::read_sheet(&args.part.part, &options)?.1);
     }
     if args.json {
-        output::print_json(&info)?;
+        let mut json = serde_json::to_value(&info)?;
+        for key in ["start", "angle"] {
+            output::rename_key(&mut json, &["recognition", "bends", "*", "bend", key], &format!("{key}_rad"));
+        }
+        output::print_json(&json)?;
     } else {
         let text = format!(
-            "part            {}\norigin          {}\ncomponents      {}\nvolume          {:.6} mm^3\nmass            {:.6} (density {})\ncentre of grav. [{:.6}, {:.6}, {:.6}] mm\nbounding box    [{:.3}, {:.3}, {:.3}] .. [{:.3}, {:.3}, {:.3}] mm\nboundary faces  {}\n",
+            "part            {}\norigin          {}\ncomponents      {}\nvolume          {:.6} mm^3\nmass            {:.6} (density {} per mm^3)\ncentre of grav. [{:.6}, {:.6}, {:.6}] mm\nbounding box    [{:.3}, {:.3}, {:.3}] .. [{:.3}, {:.3}, {:.3}] mm\nboundary faces  {}\n",
             info.name,
             serde_json::to_string(&info.origin)?,
             info.components,
@@ -249,6 +253,8 @@ fn export(args: &ExportArgs) -> anyhow::Result<Outcome> {
     let glb = args.glb.as_ref().map(|p| (p, glb_bytes(&[GlbItem::part(&part)])));
     let obj = args.obj.as_ref().map(|p| (p, obj_string(&part).into_bytes()));
     let stl = args.stl.as_ref().map(|p| (p, stl_binary_bytes(&part)));
+    let written: Vec<PathBuf> = [&glb, &obj, &stl].into_iter().flatten().map(|(p, _)| p.to_path_buf()).collect();
     output::write_all_atomic([glb, obj, stl].into_iter().flatten())?;
+    output::print_wrote(&written.iter().map(PathBuf::as_path).collect::<Vec<_>>(), false)?;
     Ok(Outcome::Success)
 }

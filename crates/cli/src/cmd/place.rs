@@ -32,7 +32,8 @@ pub struct Args {
     /// Maximum stack height (mm). Default: the stack's top plus twice the part's diagonal.
     #[arg(long)]
     pub height: Option<f64>,
-    /// Weight w in [0, 1] of cost (1) (default 0.5). Not with --target.
+    /// Weight w, from 0 to 1, of the cost: 0 puts the part low, spreading the stack on the floor; 1 keeps the
+    /// footprint small, building columns [default: 0.5, as in plan]. Not with --target.
     #[arg(long, conflicts_with = "target")]
     pub w: Option<f64>,
     /// Origin (x0, y0, z0) of cost (1) `X,Y,Z` (default: the mean of the floor polygon's corners at z = 0; not the
@@ -42,11 +43,13 @@ pub struct Args {
     /// Minimise the squared distance of the part's c.g. to `X,Y,Z` instead of cost (1).
     #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
     pub target: Option<[f64; 3]>,
-    /// Step of the rotation about z (degrees, 0.01 to 360).
-    #[arg(long, default_value_t = 1.0)]
+    /// Step of the turns about the vertical axis tried (degrees, 0.01 to 360).
+    #[arg(long, value_name = "DEG", default_value_t = crate::input::DEFAULT_DTHETA_DEG)]
     pub dtheta_deg: f64,
-    /// Minimum distance to the stack's parts (mm).
-    #[arg(long, default_value_t = 0.0)]
+    /// Minimum distance to the stack's parts in every direction (mm). The default differs from plan's 5 because
+    /// this clearance is a distance in space, not only horizontal: any other value keeps the part off the parts it
+    /// would rest on.
+    #[arg(long, value_name = "MM", default_value_t = 0.0)]
     pub clearance: f64,
     /// Require a free vertical path from above (top-down insertion).
     #[arg(long)]
@@ -161,7 +164,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     request.cost = match args.target {
         Some(t) => Cost::Target { target: DVec3::from_array(t) },
         None => Cost::Stacking {
-            w: args.w.unwrap_or(0.5),
+            w: args.w.unwrap_or(crate::input::DEFAULT_W),
             origin: args.origin.map(DVec3::from_array).unwrap_or_else(|| floor.centre()),
         },
     };
@@ -172,16 +175,20 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     };
     let result = place(&request).with_context(|| format!("placing {} on {floor_source}", args.part.part))?;
     if args.json {
-        output::print_json(&Output {
+        let mut json = serde_json::to_value(Output {
             placements: &result.placements,
             exhausted: result.exhausted,
             stats: &result.stats,
         })?;
+        output::rename_key(&mut json, &["placements", "*", "theta"], "theta_rad");
+        output::print_json(&json)?;
     } else {
+        let unit = if args.target.is_some() { "mm^2 (squared distance to the target)" } else { "mm^2" };
         let mut text = String::new();
         for (i, p) in result.placements.iter().enumerate() {
             text.push_str(&format!(
-                "#{i}: position ({:.3}, {:.3}, {:.3}) theta {:.1} deg cost {:.6} contacts {}\n",
+                "placement {}: position ({:.3}, {:.3}, {:.3}) mm, turn {:.1} deg, cost {:.6} {unit}, {} contacts\n",
+                i + 1,
                 p.position[0],
                 p.position[1],
                 p.position[2],
@@ -195,7 +202,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         }
         let s = &result.stats;
         text.push_str(&format!(
-            "orientations {} (searched {}), pairs evaluated {} of {}, nodes {}, {:.1} ms\n",
+            "orientations {} (searched {}), component pairs evaluated {} of {}, search nodes {}, {:.1} ms\n",
             s.orientations_requested,
             s.orientations_searched,
             s.pairs_evaluated,

@@ -19,16 +19,21 @@ pub struct Args {
     /// Part file or built-in example (`example:NAME`).
     #[arg(default_value = "example:channel")]
     pub part: String,
-    /// Weight w of cost (1): 0 favours low c.g. (spread on the floor), 1 favours small floor use (columns).
-    #[arg(long, default_value_t = 0.5)]
+    /// Weight w, from 0 to 1, of the cost the planner minimises for each part: 0 spreads parts on the floor, keeping
+    /// the centres of gravity low; 1 keeps the footprint small, building columns.
+    #[arg(long, default_value_t = crate::input::DEFAULT_W)]
     pub w: f64,
     /// The planner's options.
     #[command(flatten)]
     pub planner: PlannerArgs,
-    /// Output directory.
+    /// Output directory (created if missing).
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
 }
+
+/// What the weight w means, in words (`--w`'s help says the same).
+pub const W_MEANING: &str =
+    "0 spreads parts on the floor, keeping the centres of gravity low; 1 keeps the footprint small, building columns";
 
 /// The planner's options, shared by `plan` and `sweep`.
 #[derive(Debug, Clone, clap::Args)]
@@ -43,17 +48,18 @@ pub struct PlannerArgs {
     /// part's bounding box in its file coordinates (Channel, 200 x 102 x 51 mm: 612; Triangle: 6 x 195 = 1170).
     #[arg(long)]
     pub height: Option<f64>,
-    /// Clearance between parts for the robot's positioning error (mm).
-    #[arg(long, default_value_t = 5.0)]
+    /// Horizontal clearance between parts for the robot's positioning error (mm); parts may still rest on each
+    /// other.
+    #[arg(long, value_name = "MM", default_value_t = crate::input::DEFAULT_CLEARANCE_MM)]
     pub clearance: f64,
-    /// Step of the rotation about z (degrees, 0.01 to 360).
-    #[arg(long, default_value_t = 5.0)]
+    /// Step of the turns about the vertical axis tried for each part (degrees, 0.01 to 360).
+    #[arg(long, value_name = "DEG", default_value_t = crate::input::DEFAULT_DTHETA_DEG)]
     pub dtheta_deg: f64,
-    /// Friction coefficient.
-    #[arg(long, default_value_t = 0.5)]
+    /// Coulomb friction coefficient of the stability checks.
+    #[arg(long, default_value_t = crate::input::DEFAULT_MU)]
     pub mu: f64,
     /// Suction cup diameter (mm).
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long, value_name = "MM", default_value_t = crate::input::DEFAULT_CUP_DIAMETER_MM)]
     pub cup_diameter: f64,
     /// Interference-free candidates tested per part and stage (stage 2 after an accepted stage 1 tests every one
     /// cheaper than that part).
@@ -69,7 +75,7 @@ pub struct PlannerArgs {
     pub search_partitions: usize,
     /// Largest tilt from level of a face that holds the suction cup (degrees, 0 to 89): the cup approaches along the
     /// face's normal. Bent parts often rest with their largest face a degree or two off level.
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, value_name = "DEG", default_value_t = crate::input::DEFAULT_GRASP_TILT_DEG)]
     pub grasp_tilt_deg: f64,
     /// Seconds the plan may take (each plan, for several weights): past them the plan ends with the parts placed so
     /// far and says why. Default: no limit.
@@ -200,14 +206,16 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let plan_text = plan_document_text(&part, &plan, seconds)?;
     let file = parse_plan_file(plan_text.as_bytes(), &args.out.join("plan.json"))?;
     plan_pictures(&file)?.write_all(&args.out, plan_text.as_bytes())?;
+    let [[x0, y0], [x1, y1]] = plan.footprint;
     crate::output::print_summary(&format!(
-        "{} of {} parts placed ({}), height {:.1} mm, footprint {:.1} x {:.1} mm, total cost {:.1}, {:.1} s; wrote {}\n",
+        "{} of {} parts placed ({}): height {:.1} mm, footprint {:.1} x {:.1} mm, total cost {:.1} mm^2, {:.1} s\n\
+         wrote {}: plan.json, stack.svg, stack.png, build.svg, build.png, stack.glb, report.html\n",
         plan.parts.len(),
         options.count,
         plan.stopped.as_deref().unwrap_or("complete"),
         plan.height,
-        plan.footprint[1][0] - plan.footprint[0][0],
-        plan.footprint[1][1] - plan.footprint[0][1],
+        x1 - x0,
+        y1 - y0,
         plan.total_cost,
         seconds,
         args.out.display()

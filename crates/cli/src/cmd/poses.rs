@@ -15,11 +15,11 @@ pub struct PosesArgs {
     #[command(flatten)]
     pub part: PartArgs,
     /// Suction cup diameter (mm).
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, value_name = "MM", default_value_t = crate::input::DEFAULT_CUP_DIAMETER_MM)]
     pub cup_diameter: f64,
     /// Largest tilt from level of a face that holds the cup (degrees, 0 to 89): the cup approaches along the face's
     /// normal.
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, value_name = "DEG", default_value_t = crate::input::DEFAULT_GRASP_TILT_DEG)]
     pub grasp_tilt_deg: f64,
     /// JSON output.
     #[arg(long)]
@@ -94,16 +94,29 @@ pub fn run_poses(args: &PosesArgs) -> anyhow::Result<Outcome> {
     }
     let out = PosesJson { part: part.name.clone(), cup_diameter: args.cup_diameter, poses };
     if args.json {
-        output::print_json(&out)?;
+        let mut json = serde_json::to_value(&out)?;
+        output::rename_key(&mut json, &["poses", "*", "grasp_faces", "*", "tilt"], "tilt_rad");
+        output::print_json(&json)?;
     } else {
-        let mut text =
-            format!("part {}: {} stable resting poses (cup {} mm)\n", out.part, out.poses.len(), out.cup_diameter);
-        text.push_str("  face   phi_deg   psi_deg  cg_height     margin  grasp_radius  graspable\n");
-        for p in &out.poses {
+        let mut text = format!(
+            "part {}: {} stable resting poses, lowest centre of gravity first (cup {} mm)\n",
+            out.part,
+            out.poses.len(),
+            out.cup_diameter
+        );
+        text.push_str("  pose  hull_face  phi_deg  psi_deg  cg_height_mm  margin_mm  grasp_radius_mm  graspable\n");
+        for (k, p) in out.poses.iter().enumerate() {
             let radius = p.grasp_faces.first().map_or(0.0, |f| f.inscribed_radius);
             text.push_str(&format!(
-                "  {:>4}  {:>8.3}  {:>8.3}  {:>9.3}  {:>9.3}  {:>12.3}  {}\n",
-                p.hull_face, p.phi_deg, p.psi_deg, p.cg_height, p.margin, radius, p.graspable
+                "  {:>4}  {:>9}  {:>7.3}  {:>7.3}  {:>12.3}  {:>9.3}  {:>15.3}  {}\n",
+                k + 1,
+                p.hull_face,
+                p.phi_deg,
+                p.psi_deg,
+                p.cg_height,
+                p.margin,
+                radius,
+                p.graspable
             ));
         }
         output::print_text(&text)?;

@@ -68,6 +68,8 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         files.extend(pictures.files().into_iter().map(|(name, bytes)| (dir.join(name), bytes)));
     }
     files.extend(outputs.into_iter().filter_map(|(path, bytes)| path.as_ref().map(|p| (p.clone(), bytes))));
+    let written: Vec<PathBuf> = files.iter().map(|(p, _)| p.clone()).collect();
     write_all_atomic(files)?;
+    crate::output::print_wrote(&written.iter().map(PathBuf::as_path).collect::<Vec<_>>(), false)?;
     Ok(Outcome::Success)
 }

@@ -24,13 +24,14 @@ use std::path::PathBuf;
 pub struct Args {
     /// Part file or built-in example (`example:NAME`).
     pub part: String,
-    /// The weights w, comma-separated, each in [0, 1].
+    /// The weights w, comma-separated, each from 0 to 1: 0 spreads parts on the floor, keeping the centres of gravity
+    /// low; 1 keeps the footprint small, building columns.
     #[arg(long, value_name = "W,W,...", default_value = "0,0.5,1")]
     pub w_values: String,
     /// The planner's options.
     #[command(flatten)]
     pub planner: PlannerArgs,
-    /// Output directory.
+    /// Output directory (created if missing).
     #[arg(long, default_value = "sweep")]
     pub out: PathBuf,
 }
@@ -184,7 +185,11 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let sweep = SweepJson { part_name: part.name.clone(), count: args.planner.count, runs };
     let scenes: Vec<Scene> = plans.iter().map(|(_, _, f)| stack_scene(f, false)).collect();
     let figure = Figure {
-        title: format!("{} x {} for w = {}", args.planner.count, part.name, args.w_values),
+        title: format!(
+            "{} {} parts for each weight w (0: spread low on the floor; 1: small footprint, columns)",
+            args.planner.count, part.name
+        ),
+        legend: scenes.first().map(|s| s.legend.clone()).unwrap_or_default(),
         panels: scenes
             .iter()
             .zip(&sweep.runs)
@@ -208,10 +213,11 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let mut text = String::new();
     for r in &sweep.runs {
         text.push_str(&format!(
-            "w = {}: {} placed, {} layers, height {:.1} mm, footprint {:.1} x {:.1} mm, total cost {:.1}, {:.1} s\n",
+            "w = {}: {} placed, {} layer{}, height {:.1} mm, footprint {:.1} x {:.1} mm, total cost {:.1} mm^2, {:.1} s\n",
             short_number(r.w),
             r.placed,
             r.layers,
+            if r.layers == 1 { "" } else { "s" },
             r.height,
             r.footprint_size[0],
             r.footprint_size[1],
@@ -219,7 +225,11 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
             r.seconds
         ));
     }
-    text.push_str(&format!("wrote {}\n", args.out.display()));
+    text.push_str(&format!(
+        "wrote {}: {}, sweep.json, sweep.svg, sweep.png\n",
+        args.out.display(),
+        plans.iter().map(|(name, _, _)| name.as_str()).collect::<Vec<_>>().join(", ")
+    ));
     crate::output::print_summary(&text)?;
     let complete = sweep.runs.iter().all(|r| r.stopped.is_none());
     Ok(if complete { Outcome::Success } else { Outcome::ChecksFailed })

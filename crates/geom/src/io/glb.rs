@@ -122,7 +122,8 @@ pub fn glb_bytes(items: &[GlbItem<'_>]) -> Vec<u8> {
             r.x_axis.x, r.x_axis.y, r.x_axis.z, 0.0, r.y_axis.x, r.y_axis.y, r.y_axis.z, 0.0, r.z_axis.x, r.z_axis.y,
             r.z_axis.z, 0.0, p.x, p.y, p.z, 1.0,
         ];
-        nodes.push(json!({"name": format!("{} #{i}", item.part.name), "mesh": i, "matrix": matrix}));
+        // nodes are named after the parts' numbers, counted from 1 as people read them
+        nodes.push(json!({"name": format!("{} #{}", item.part.name, i + 1), "mesh": i, "matrix": matrix}));
     }
     let mut document = json!({
         "asset": {"version": "2.0", "generator": "stackplan"},
