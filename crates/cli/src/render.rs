@@ -499,7 +499,7 @@ fn nearest_free(
 /// others are moved beside the parts' drawing, into a column left of it (a c.g. left of the drawing's middle) or right
 /// of it, ordered by the height of their c.g.s and as close to it as the column allows, joined to their c.g. by a
 /// leader line ([`LabelBox::at_anchor`] is false). A box that finds no free place there takes the free place nearest
-/// to its c.g. on a grid of [`LABEL_STEP`] inside the panel's cell. Boxes of one panel never overlap, unless the cell
+/// to its c.g. on a grid of `LABEL_STEP` inside the panel's cell. Boxes of one panel never overlap, unless the cell
 /// has no free place left (hundreds of parts in one view), when a box stays at its preferred place.
 pub fn label_layout(figure: &Figure<'_>) -> Vec<LabelBox> {
     const GAP: f64 = 3.0;
