@@ -28,7 +28,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     options.dtheta = dtheta.to_radians();
     options.clearance = clearance.unwrap_or(options.clearance);
     options.cup_diameter = cup.unwrap_or(options.cup_diameter);
-    options.partitions = partitions.unwrap_or(options.partitions);
+    options.tuning.partitions = partitions.unwrap_or(options.tuning.partitions);
     let started = std::time::Instant::now();
     let plan = plan_stack(&part, &options)?;
     let seconds = started.elapsed().as_secs_f64();

@@ -33,7 +33,7 @@ pub enum PlaneOrigin {
     },
     /// A vertical side of the insertion obstacle (through a silhouette edge).
     InsertionSide,
-    /// A side of the region another search covers ([`crate::PlacementRequest::searched_elsewhere`]): a boundary of
+    /// A side of the region another search covers ([`crate::request::SearchTuning::searched_elsewhere`]): a boundary of
     /// the search, never a contact.
     SearchedElsewhere,
 }
@@ -143,7 +143,7 @@ impl DerivedObstacle {
     /// The region of positions at which the part, at `orientation`, lies inside the convex polygon `polygon`
     /// (counter-clockwise seen from above) in the plan view: one vertical plane per side, the sides of
     /// `Omega(theta)` of that polygon ([`Orientation::sides_within`]). Subtracted
-    /// like an obstacle, it leaves the region to another search ([`crate::PlacementRequest::searched_elsewhere`]).
+    /// like an obstacle, it leaves the region to another search ([`crate::request::SearchTuning::searched_elsewhere`]).
     /// O(sides x part vertices).
     pub fn searched_elsewhere(orientation: &Orientation, polygon: &[glam::DVec2]) -> Self {
         let planes: Vec<Plane> = orientation

@@ -62,7 +62,7 @@ pub(crate) struct MergedPair {
 /// For each component of the moving part, its plate (empty when the request does not merge plates or the part has
 /// none).
 pub(crate) fn moving_plates(request: &PlacementRequest<'_>) -> Vec<Option<u32>> {
-    if !request.merge_plates || request.part.plates.is_empty() {
+    if !request.tuning.merge_plates || request.part.plates.is_empty() {
         return Vec::new();
     }
     request.part.plate_of_components()

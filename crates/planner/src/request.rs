@@ -95,12 +95,6 @@ pub struct PlacementRequest<'a> {
     pub stack: Vec<StackPart<'a>>,
     /// The floor volume `Sigma`.
     pub floor: FloorVolume,
-    /// A region another search covers: a convex polygon (counter-clockwise seen from above). Positions at which the
-    /// part's shadow lies inside it by more than the tolerance (the interior of the permissible set `Omega(theta)`
-    /// of this polygon's prism, which has the floor volume's height) are not searched; positions on its boundary
-    /// and outside are. `None` (the default): the whole floor volume. The stacking planner's stage 2 leaves stage
-    /// 1's region to stage 1 ([`crate::stack_plan`]).
-    pub searched_elsewhere: Option<Vec<DVec2>>,
     /// `Some(z)`: the 2-D permissible set at `p_z = z` (\[A\] VII-A-2); `None`: the 3-D one.
     pub fixed_z: Option<f64>,
     /// Minimum distance between the new part's components and the stack's (mm); obstacles grown by it (\[A\] eq.
@@ -117,6 +111,26 @@ pub struct PlacementRequest<'a> {
     pub insertion: bool,
     /// How many placements (best first, one per free-space cell).
     pub k: usize,
+    /// When the search gives up with [`PlacementError::TimeLimit`] (checked every 1024 nodes); `None`: never.
+    pub deadline: Option<std::time::Instant>,
+    /// How the search runs: switches of the reference routes and limits that do not change its results (apart
+    /// from where it gives up). [`SearchTuning::default`].
+    #[doc(hidden)]
+    pub tuning: SearchTuning,
+}
+
+/// How a placement search runs, apart from what it searches for: the switches of its reference routes (the results do
+/// not depend on them), its limits, and the region the stacking planner's stage 2 leaves to stage 1. The defaults
+/// are what every user wants; tests and benchmarks turn the switches off to compare the routes.
+#[doc(hidden)]
+#[derive(Debug, Clone, PartialEq)]
+pub struct SearchTuning {
+    /// A region another search covers: a convex polygon (counter-clockwise seen from above). Positions at which the
+    /// part's shadow lies inside it by more than the tolerance (the interior of the permissible set `Omega(theta)`
+    /// of this polygon's prism, which has the floor volume's height) are not searched; positions on its boundary
+    /// and outside are. `None` (the default): the whole floor volume. The stacking planner's stage 2 leaves stage
+    /// 1's region to stage 1 ([`crate::stack_plan`]).
+    pub searched_elsewhere: Option<Vec<DVec2>>,
     /// Search one period of the part's rotational symmetry about z only (when the theta set allows it).
     pub use_symmetry: bool,
     /// Extrapolate obstacles within their constant-topology intervals instead of constructing each one
@@ -132,8 +146,6 @@ pub struct PlacementRequest<'a> {
     /// Largest number of search nodes popped before giving up with [`PlacementError::NodeBudget`] (per partition
     /// of the orientations: each partition counts its own pops).
     pub node_budget: usize,
-    /// When the search gives up with [`PlacementError::TimeLimit`] (checked every 1024 nodes); `None`: never.
-    pub deadline: Option<std::time::Instant>,
     /// Into how many partitions the search splits the orientations (blocks of a few consecutive orientations dealt
     /// round-robin, searched in parallel and merged in the search's total order, [`crate::search`]'s "Partitions";
     /// 1: the sequential search). The results depend on this number, never on the thread count. Default
@@ -141,14 +153,27 @@ pub struct PlacementRequest<'a> {
     pub partitions: usize,
 }
 
-/// The default [`PlacementRequest::partitions`]: the two cores of the machines the planner is built for (a fixed
+impl Default for SearchTuning {
+    fn default() -> Self {
+        Self {
+            searched_elsewhere: None,
+            use_symmetry: true,
+            extrapolate: true,
+            merge_plates: true,
+            node_budget: DEFAULT_NODE_BUDGET,
+            partitions: DEFAULT_PARTITIONS,
+        }
+    }
+}
+
+/// The default [`SearchTuning::partitions`]: the two cores of the machines the planner is built for (a fixed
 /// number, not the thread count, so that results do not depend on the machine).
 pub const DEFAULT_PARTITIONS: usize = 2;
 
-/// The largest [`PlacementRequest::partitions`] accepted.
+/// The largest [`SearchTuning::partitions`] accepted.
 pub const MAX_PARTITIONS: usize = 64;
 
-/// The default of [`PlacementRequest::node_budget`]: about 2-4 GB of search state at its end for parts of a few
+/// The default of [`SearchTuning::node_budget`]: about 2-4 GB of search state at its end for parts of a few
 /// hundred pieces, so that a search that cannot finish stops before it exhausts a 24 GB machine.
 pub const DEFAULT_NODE_BUDGET: usize = 2_000_000;
 
@@ -210,7 +235,7 @@ fn check_convex_polygon(poly: &[DVec2], what: &str) -> Result<(), String> {
 
 impl<'a> PlacementRequest<'a> {
     /// Defaults: the part as it lies, 1-degree steps, no clearance, cost (1) with `w = 0.5` about the floor centre,
-    /// no insertion, `k = 1`, symmetry on, extrapolation on, 3-D permissible set.
+    /// no insertion, `k = 1`, 3-D permissible set, [`SearchTuning::default`].
     pub fn new(part: &'a Part, stack: Vec<StackPart<'a>>, floor: FloorVolume) -> Self {
         let origin = floor.centre();
         Self {
@@ -219,26 +244,21 @@ impl<'a> PlacementRequest<'a> {
             thetas: uniform_thetas(360),
             stack,
             floor,
-            searched_elsewhere: None,
             fixed_z: None,
             clearance: 0.0,
             horizontal_clearance: false,
             cost: Cost::Stacking { w: 0.5, origin },
             insertion: false,
             k: 1,
-            use_symmetry: true,
-            extrapolate: true,
-            merge_plates: true,
-            node_budget: DEFAULT_NODE_BUDGET,
             deadline: None,
-            partitions: DEFAULT_PARTITIONS,
+            tuning: SearchTuning::default(),
         }
     }
 
     /// Checks every option; see [`PlacementError`].
     pub fn validate(&self) -> Result<(), PlacementError> {
         check_convex_polygon(&self.floor.polygon, "floor").map_err(PlacementError::BadFloor)?;
-        if let Some(region) = &self.searched_elsewhere {
+        if let Some(region) = &self.tuning.searched_elsewhere {
             check_convex_polygon(region, "searched-elsewhere").map_err(PlacementError::BadOption)?;
         }
         if !(self.floor.height > 0.0 && self.floor.height.is_finite()) {
@@ -281,13 +301,13 @@ impl<'a> PlacementRequest<'a> {
         if self.k == 0 {
             return Err(PlacementError::BadOption("k must be at least 1".into()));
         }
-        if !(1..=MAX_PARTITIONS).contains(&self.partitions) {
+        if !(1..=MAX_PARTITIONS).contains(&self.tuning.partitions) {
             return Err(PlacementError::BadOption(format!(
                 "the number of search partitions must lie in 1..={MAX_PARTITIONS}, got {}",
-                self.partitions
+                self.tuning.partitions
             )));
         }
-        if self.node_budget == 0 {
+        if self.tuning.node_budget == 0 {
             return Err(PlacementError::BadOption("the node budget must be at least 1".into()));
         }
         match self.cost {

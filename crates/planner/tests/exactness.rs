@@ -51,7 +51,7 @@ fn request<'a>(c: &'a Case) -> PlacementRequest<'a> {
     let floor = FloorVolume::rectangle(-20.0, -20.0, 100.0, 100.0, 150.0);
     let mut req = PlacementRequest::new(&c.part, stack, floor);
     req.thetas = uniform_thetas(c.n_theta);
-    req.use_symmetry = false;
+    req.tuning.use_symmetry = false;
     req.cost = match c.w {
         Some(w) => Cost::Stacking { w, origin: DVec3::new(40.0, 40.0, 0.0) },
         None => Cost::Target { target: DVec3::new(40.0, 40.0, 5.0) },

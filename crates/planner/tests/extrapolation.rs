@@ -94,7 +94,7 @@ proptest! {
         request.cost = Cost::Stacking { w, origin: DVec3::new(40.0, 40.0, 0.0) };
         request.k = 3;
         let with = place(&request).expect("search");
-        request.extrapolate = false;
+        request.tuning.extrapolate = false;
         let without = place(&request).expect("search");
         prop_assert_eq!(without.stats.obstacles_extrapolated, 0);
         prop_assert_eq!(with.placements.len(), without.placements.len());
@@ -122,7 +122,7 @@ fn most_obstacles_of_a_fine_theta_set_are_extrapolated() {
     request.cost = Cost::Target { target: DVec3::new(30.0, 20.0, 0.0) };
     request.k = 5;
     let with = place(&request).expect("search");
-    request.extrapolate = false;
+    request.tuning.extrapolate = false;
     let without = place(&request).expect("search");
     assert!(
         with.stats.obstacles_extrapolated > with.stats.obstacles_constructed,

@@ -56,7 +56,7 @@ fn request<'a>(c: &'a Case) -> PlacementRequest<'a> {
     let (x0, y0, x1, y1, h) = FLOOR;
     let mut req = PlacementRequest::new(&c.part, stack, FloorVolume::rectangle(x0, y0, x1, y1, h));
     req.thetas = uniform_thetas(c.n_theta);
-    req.use_symmetry = false;
+    req.tuning.use_symmetry = false;
     req.fixed_z = Some(c.fixed_z);
     req.cost = match c.w {
         Some(w) => Cost::Stacking { w, origin: DVec3::new(40.0, 40.0, 0.0) },

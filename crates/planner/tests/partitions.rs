@@ -1,4 +1,4 @@
-//! The partitioned search ([`PlacementRequest::partitions`], "Partitions" in `search.rs`): the orientations split
+//! The partitioned search ([`SearchTuning::partitions`](stackplan_planner::request::SearchTuning::partitions), "Partitions" in `search.rs`): the orientations split
 //! into fixed partitions searched in rounds on rayon and merged in the heap's order give the sequential search's
 //! placements (bit for bit when every obstacle is constructed, to rounding when obstacles are extrapolated from
 //! structures each partition builds itself), whatever the thread count; a cost limit applies to every partition and
@@ -17,8 +17,8 @@ use stackplan_planner::{
 fn request<'a>(sc: &'a Scenario, k: usize, partitions: usize, extrapolate: bool) -> PlacementRequest<'a> {
     let mut req = sc.request();
     req.k = k;
-    req.partitions = partitions;
-    req.extrapolate = extrapolate;
+    req.tuning.partitions = partitions;
+    req.tuning.extrapolate = extrapolate;
     req
 }
 
@@ -126,7 +126,8 @@ fn plans_do_not_depend_on_the_thread_count() {
     let part = part_by_name("l-corner", Decomposition::ConvexMerge).expect("example");
     let floor = FloorVolume::rectangle(-150.0, -150.0, 150.0, 150.0, 300.0);
     for partitions in [1, 2] {
-        let options = PlanOptions { dtheta: 15f64.to_radians(), partitions, ..PlanOptions::new(5, floor.clone()) };
+        let mut options = PlanOptions { dtheta: 15f64.to_radians(), ..PlanOptions::new(5, floor.clone()) };
+        options.tuning.partitions = partitions;
         let one = in_pool(1, || plan_stack(&part, &options)).expect("plan");
         let two = in_pool(2, || plan_stack(&part, &options)).expect("plan");
         assert!(one.parts.len() >= 3, "{partitions}: placed {}", one.parts.len());

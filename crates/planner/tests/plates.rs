@@ -193,7 +193,7 @@ proptest! {
         req.cost = Cost::Stacking { w, origin: DVec3::new(150.0, 60.0, 0.0) };
         req.k = 3;
         let merged = place(&req).expect("merged search");
-        req.merge_plates = false;
+        req.tuning.merge_plates = false;
         let pieces = place(&req).expect("search by pieces");
         let (m, p) = (merged.placements.first().expect("placed"), pieces.placements.first().expect("placed"));
         prop_assert!((m.cost - p.cost).abs() <= 1e-9 * p.cost.abs().max(1.0), "optimum {} against {}", m.cost, p.cost);

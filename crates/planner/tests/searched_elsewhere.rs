@@ -1,4 +1,4 @@
-//! A search that leaves a region to another search ([`PlacementRequest::searched_elsewhere`], the stacking planner's
+//! A search that leaves a region to another search ([`SearchTuning::searched_elsewhere`](stackplan_planner::request::SearchTuning::searched_elsewhere), the stacking planner's
 //! stage 2 outside stage 1's region): its placements never lie inside the region, and together with a search of the
 //! region it finds the exact optimum of the whole floor; also when both carry their frontiers into a growing stack
 //! and a growing region, as the planner's searches do.
@@ -43,7 +43,7 @@ fn a_region_and_the_floor_outside_it_find_the_whole_floors_optimum() {
         let inner =
             carried_placements(&growing_stack_request(&part, stack.clone(), region.clone()), &cache, &mut carrying);
         let mut outer_request = growing_stack_request(&part, stack.clone(), whole.clone());
-        outer_request.searched_elsewhere = Some(region.polygon.clone());
+        outer_request.tuning.searched_elsewhere = Some(region.polygon.clone());
         let outer = carried_placements(&outer_request, &cache, &mut carrying);
         outside_found += outer.len();
         let best = inner.iter().chain(&outer).map(|p| p.cost).fold(f64::INFINITY, f64::min);
@@ -86,7 +86,7 @@ fn a_bad_region_is_a_typed_error() {
     ];
     for polygon in bad {
         let mut req = growing_stack_request(&part, Vec::new(), floor.clone());
-        req.searched_elsewhere = Some(polygon.clone());
+        req.tuning.searched_elsewhere = Some(polygon.clone());
         match place_with_caches(&req, &ObstacleCache::new(), &mut SearchCaches::new()) {
             Err(PlacementError::BadOption(msg)) => assert!(msg.contains("searched-elsewhere"), "{msg}"),
             other => panic!("{polygon:?}: expected a bad-option error, got {other:?}"),

@@ -160,13 +160,13 @@ impl PlannerArgs {
         options.dtheta = self.dtheta_deg.to_radians();
         options.mu = self.mu;
         options.cup_diameter = self.cup_diameter;
-        options.candidates = self.candidates;
-        options.partitions = self.search_partitions;
-        options.node_budget = self.node_budget;
+        options.tuning.candidates = self.candidates;
+        options.tuning.partitions = self.search_partitions;
+        options.tuning.node_budget = self.node_budget;
         options.grasp_tilt = self.grasp_tilt_deg.to_radians();
         options.time_limit = self.time_limit;
         // (the repeated search never asks for fewer than the user's own candidate count)
-        options.max_candidates = options.max_candidates.max(self.candidates);
+        options.tuning.max_candidates = options.tuning.max_candidates.max(self.candidates);
         Ok(options)
     }
 }

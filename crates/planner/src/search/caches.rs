@@ -19,7 +19,7 @@ use std::sync::Arc;
 /// obstacles are pure functions of those inputs; an extrapolated obstacle depends (in its last bits) on which angle its
 /// structure was built at, so a plan's results depend on its search history, deterministically.
 ///
-/// With several partitions of the orientations ([`PlacementRequest::partitions`]) each partition keeps its own
+/// With several partitions of the orientations ([`crate::request::SearchTuning::partitions`]) each partition keeps its own
 /// caches (its orientations' derived obstacles, structures and obstacle ids).
 #[derive(Debug, Default)]
 pub struct SearchCaches {
@@ -112,7 +112,7 @@ impl FrontierSignature {
     pub(super) fn of(request: &PlacementRequest<'_>) -> Self {
         Self {
             floor: request.floor.clone(),
-            searched_elsewhere: request.searched_elsewhere.clone(),
+            searched_elsewhere: request.tuning.searched_elsewhere.clone(),
             fixed_z: request.fixed_z.map(f64::to_bits),
             // `Debug` of an f64 round-trips: equal strings iff equal values
             cost: format!("{:?}", request.cost),

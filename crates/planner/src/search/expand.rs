@@ -66,9 +66,9 @@ impl Search<'_, '_> {
             round_pops += 1;
             let Some(popped) = state.heap.pop() else { break };
             state.pops += 1;
-            if state.pops > self.request.node_budget as u64 {
+            if state.pops > self.request.tuning.node_budget as u64 {
                 let found = state.found_points.len();
-                return Err(PlacementError::NodeBudget { budget: self.request.node_budget, found });
+                return Err(PlacementError::NodeBudget { budget: self.request.tuning.node_budget, found });
             }
             if state.pops.is_multiple_of(1024) && self.request.deadline.is_some_and(|d| Instant::now() >= d) {
                 return Err(PlacementError::TimeLimit { found: state.found_points.len() });
@@ -159,7 +159,7 @@ impl Search<'_, '_> {
         for (moving, fixed) in shared {
             self.obstacle_id(orientation, moving, fixed)?;
         }
-        if let Some(polygon) = &self.request.searched_elsewhere {
+        if let Some(polygon) = &self.request.tuning.searched_elsewhere {
             let region = DerivedObstacle::searched_elsewhere(&self.orientations[orientation], polygon);
             self.elsewhere[orientation] = Some(self.obstacles.len() as u32);
             self.obstacles.push(Arc::new(region));
@@ -413,7 +413,7 @@ impl Search<'_, '_> {
         let raw = if let Some(pair) = &merged {
             crate::plates::merged_obstacle(self.request, &self.scene, self.cache, pair, o.rotation)
                 .map_err(|e| to_error(format!("the merged plates' obstacle: {e}")))?
-        } else if self.request.extrapolate {
+        } else if self.request.tuning.extrapolate {
             let rest_rotation = self.request.resting_rotations[o.rest];
             let (raw, route) = self
                 .intervals

@@ -6,7 +6,7 @@
 //!
 //! 1. pop the cheapest node (costs compared rounded to about `1e-12` relative, so that exact ties do not depend
 //!    on the optima's last bits; ties: lower orientation index, then lower cell id — deterministic);
-//! 2. if the request leaves a region to another search ([`PlacementRequest::searched_elsewhere`]) and `p*` lies in
+//! 2. if the request leaves a region to another search ([`crate::request::SearchTuning::searched_elsewhere`]) and `p*` lies in
 //!    its interior at `theta_k` (not applied on the node's path), take that region as the obstacle
 //!    (`DerivedObstacle::searched_elsewhere`); else if an obstacle of `theta_k` built earlier holds `p*` in its
 //!    interior by more than the tolerance (not one applied on the node's path), take the deepest such (any obstacle
@@ -60,7 +60,7 @@
 //! **Cost.** One QP per node; per popped node one interference detection (O(m_part m_stack) box tests plus the
 //! narrow phase on overlapping boxes) and at most one obstacle construction. Root QPs run in parallel (rayon).
 //!
-//! **Partitions** ([`PlacementRequest::partitions`] = `P`, default 2). Every node belongs to one orientation, and
+//! **Partitions** ([`crate::request::SearchTuning::partitions`] = `P`, default 2). Every node belongs to one orientation, and
 //! what the loop learns is per orientation (the known obstacles, the derived obstacles, the found points), so the
 //! orientations are split into `P` fixed partitions, blocks of `LANE_BLOCK` consecutive orientations dealt
 //! round-robin (`lane_of`; `P` is a number of the request, never the thread count), and each partition runs the
@@ -373,7 +373,7 @@ impl<'r, 'a, 'c> PlacementSearch<'r, 'a, 'c> {
     }
 
     /// The statistics of each partition of the orientations so far (one entry per
-    /// [`PlacementRequest::partitions`]; [`Self::stats`] sums them): the balance of the partitioned search.
+    /// [`crate::request::SearchTuning::partitions`]; [`Self::stats`] sums them): the balance of the partitioned search.
     pub fn partition_stats(&self) -> Vec<PlacementStats> {
         self.searches.iter().map(|s| s.stats.clone()).collect()
     }

@@ -53,7 +53,8 @@ pub(super) fn prepare<'r, 'a>(
     let mut orientations = Vec::new();
     let mut symmetry_orders = Vec::new();
     for (rest, r) in request.resting_rotations.iter().enumerate() {
-        let order = if request.use_symmetry { rotational_order(part, *r, 10.0 * part.tolerance().linear) } else { 1 };
+        let order =
+            if request.tuning.use_symmetry { rotational_order(part, *r, 10.0 * part.tolerance().linear) } else { 1 };
         symmetry_orders.push(order);
         let count = if uniform { period_length(n_theta, order) } else { n_theta };
         for (ti, &theta) in request.thetas.iter().enumerate().take(count) {
@@ -107,14 +108,14 @@ pub(super) fn prepare<'r, 'a>(
         clearance: request.clearance.to_bits(),
         insertion: request.insertion,
         horizontal: request.horizontal_clearance,
-        extrapolate: request.extrapolate,
-        merge_plates: request.merge_plates,
-        partitions: request.partitions,
+        extrapolate: request.tuning.extrapolate,
+        merge_plates: request.tuning.merge_plates,
+        partitions: request.tuning.partitions,
         moving,
         stack: keys,
     });
     let n_orientations = orientations.len();
-    let lanes = request.partitions;
+    let lanes = request.tuning.partitions;
     let mut searches = Vec::with_capacity(lanes);
     let caches_events = caches.events.clone();
     let moving_plate_of: Arc<[Option<u32>]> = crate::plates::moving_plates(request).into();

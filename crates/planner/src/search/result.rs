@@ -83,12 +83,12 @@ pub struct PlacementStats {
     /// m_part x m_stack x orientations searched.
     pub total_pairs_searched: u64,
     /// Distinct (orientation, component pair) whose obstacle was built or extrapolated (an obstacle that stands for
-    /// the pairs of a merged plate's pieces, [`crate::PlacementRequest::merge_plates`], counts once).
+    /// the pairs of a merged plate's pieces, [`crate::request::SearchTuning::merge_plates`], counts once).
     pub pairs_evaluated: u64,
     /// Obstacles constructed from scratch (Gauss-map overlay).
     pub obstacles_constructed: u64,
     /// Obstacles extrapolated within a constant-topology interval (`interval_obstacles.rs`; 0 with
-    /// `PlacementRequest::extrapolate` off).
+    /// `SearchTuning::extrapolate` off).
     pub obstacles_extrapolated: u64,
     /// Obstacle lookups answered by the cache.
     pub obstacle_cache_hits: u64,

@@ -162,7 +162,7 @@ pub(super) struct Search<'r, 'a> {
     /// built (indexed once per search; taken when the orientation is first expanded).
     pub(super) shared_pairs: Vec<Vec<(usize, usize)>>,
     /// Per orientation, the id of this search's region searched elsewhere
-    /// ([`PlacementRequest::searched_elsewhere`], [`DerivedObstacle::searched_elsewhere`]), added to the obstacle
+    /// ([`crate::request::SearchTuning::searched_elsewhere`], [`DerivedObstacle::searched_elsewhere`]), added to the obstacle
     /// table when the orientation is first expanded; it cuts before any known obstacle.
     pub(super) elsewhere: Vec<Option<u32>>,
     pub(super) rotated: HashMap<[u64; 9], RotatedComponents>,

@@ -9,7 +9,7 @@
 //!    theta set;
 //! 2. the best-first placement search ([`crate::search::PlacementSearch`]) gives interference-free positions one at
 //!    a time in the order of the part's term of cost (1), one per free-space cell, up to
-//!    [`PlanOptions::candidates`] per stage (the search stops at the first that passes step 3, so later ones are
+//!    [`PlanTuning::candidates`] per stage (the search stops at the first that passes step 3, so later ones are
 //!    never searched for); with `insertion` every candidate can be lowered straight down into place (insertion
 //!    obstacles). The searches of a plan carry their open cells to the next part's search with the same floor
 //!    (or a floor that grew: stage 1's footprint), [`crate::search::SearchCaches::carrying_frontiers`];
@@ -25,21 +25,21 @@
 //! 4. the seed's two stages: stage 1 searches within the stack's current floor footprint (its bounding rectangle
 //!    grown by `nest_allowance`, clipped to the floor), so the stack's bounding box is not enlarged, or only
 //!    slightly to nest; stage 2 searches the whole floor, and when stage 1 accepted a part it searches only outside
-//!    stage 1's region ([`crate::PlacementRequest::searched_elsewhere`]: the positions at which the part lies inside that
+//!    stage 1's region ([`crate::request::SearchTuning::searched_elsewhere`]: the positions at which the part lies inside that
 //!    region were stage 1's, whose candidates cheaper than its part all failed the checks, so stage 2 does not search
 //!    the stack's footprint a second time). Stage 1's part is taken unless stage 2's is strictly
 //!    cheaper (the seed takes stage 1 whenever it succeeds; with `w = 0` that would stack parts on top of each other
 //!    instead of spreading them on the floor as its own Fig. 2 shows, so here the footprint limit breaks ties and
 //!    near-ties of cost (1) in favour of a compact stack, and never overrides the cost). So that it never does,
 //!    stage 2 after an accepted stage 1 tests every candidate cheaper than stage 1's part (up to
-//!    [`PlanOptions::max_candidates`]), not only [`PlanOptions::candidates`]: with 8, Complex at `w 0.1` put its
+//!    [`PlanTuning::max_candidates`]), not only [`PlanTuning::candidates`]: with 8, Complex at `w 0.1` put its
 //!    9th part on top of the stack at cost 134 304 while a floor position at 45 758 passed;
-//! 5. the floor as a bound: when the last stage's first [`PlanOptions::candidates`] candidates have all failed, the
+//! 5. the floor as a bound: when the last stage's first [`PlanTuning::candidates`] candidates have all failed, the
 //!    cheapest position on the floor itself that passes is searched (per resting pose a 2-D search at the height
 //!    where the pose rests on the floor, \[A\] VII-A-2, its first candidates tested; `part.rs`, `FloorSearch`). A
 //!    part resting on the floor in a stable pose is stable by itself, so this position bounds the rest of the stage:
 //!    the stage tests only candidates strictly cheaper than it, and takes it when none of them passes or
-//!    [`PlanOptions::max_candidates`] is reached. On a stack of bent parts most of the cheapest 3-D positions are
+//!    [`PlanTuning::max_candidates`] is reached. On a stack of bent parts most of the cheapest 3-D positions are
 //!    perched on rims and edges and fail the stability test, thousands in a row, while the floor beside the stack is
 //!    free (and a cell whose optimum is perched can hold floor positions that its optimum hides): without the bound,
 //!    15-part plans of the real parts `bendfm_0` and `bendfm_1` (`fixtures/realparts/`) ended after 8 and 9 parts.
@@ -85,28 +85,10 @@ pub struct PlanOptions {
     pub cup_diameter: f64,
     /// Require top-down insertion (insertion obstacles in the search, and the check).
     pub insertion: bool,
-    /// Interference-free candidates per part and stage, tested in cost order (a stage 2 after an accepted stage 1
-    /// tests every candidate cheaper than stage 1's part, up to `max_candidates`).
-    pub candidates: usize,
-    /// When every candidate of the last stage fails the checks (and no stage accepted one), the search there
-    /// continues with more candidates, up to this many in all: a part fits nowhere only when the search is exhausted
-    /// or this limit is reached. Equal to `candidates`: no continuation. [`PlanOptions::new`]:
-    /// [`DEFAULT_MAX_CANDIDATES`]; a plan file without it was made with 1024.
-    #[serde(default = "legacy_max_candidates")]
-    pub max_candidates: usize,
     /// Resting poses considered (lowest c.g. first).
     pub max_resting_poses: usize,
     /// How far stage 1 may grow the stack's footprint to nest a part (mm).
     pub nest_allowance: f64,
-    /// Partitions of the orientations each placement search splits into, searched in parallel
-    /// ([`crate::request::PlacementRequest::partitions`]; the plan depends on this number, never on the thread
-    /// count; 1: the sequential search).
-    #[serde(default = "default_partitions")]
-    pub partitions: usize,
-    /// Largest number of nodes one placement search may pop (per partition): past it the plan ends with the parts
-    /// placed so far and says why. [`crate::request::DEFAULT_NODE_BUDGET`].
-    #[serde(default = "default_node_budget")]
-    pub node_budget: usize,
     /// Seconds the whole plan may take: past them the plan ends with the parts placed so far and says why. `None`:
     /// no limit.
     #[serde(default)]
@@ -116,19 +98,61 @@ pub struct PlanOptions {
     /// [`stackplan_stability::grasp::DEFAULT_MAX_TILT`]; a plan file without it was made with level faces only (0).
     #[serde(default)]
     pub grasp_tilt: f64,
+    /// How the planner searches: candidate counts and the search's limits and partitions ([`PlanTuning`]; written
+    /// into plan files beside the other options).
+    #[doc(hidden)]
+    #[serde(flatten)]
+    pub tuning: PlanTuning,
+}
+
+/// How the stacking planner searches: limits and counts that decide how much work it does before it gives up, and
+/// the partitions that the plan depends on (never on the thread count). [`PlanTuning::default`] is what the
+/// command line uses unless told otherwise.
+#[doc(hidden)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlanTuning {
+    /// Interference-free candidates per part and stage, tested in cost order (a stage 2 after an accepted stage 1
+    /// tests every candidate cheaper than stage 1's part, up to `max_candidates`).
+    pub candidates: usize,
+    /// When every candidate of the last stage fails the checks (and no stage accepted one), the search there
+    /// continues with more candidates, up to this many in all: a part fits nowhere only when the search is exhausted
+    /// or this limit is reached. Equal to `candidates`: no continuation. [`PlanOptions::new`]:
+    /// [`DEFAULT_MAX_CANDIDATES`]; a plan file without it was made with 1024.
+    #[serde(default = "legacy_max_candidates")]
+    pub max_candidates: usize,
+    /// Partitions of the orientations each placement search splits into, searched in parallel
+    /// ([`crate::request::SearchTuning::partitions`]; the plan depends on this number, never on the thread
+    /// count; 1: the sequential search).
+    #[serde(default = "default_partitions")]
+    pub partitions: usize,
+    /// Largest number of nodes one placement search may pop (per partition): past it the plan ends with the parts
+    /// placed so far and says why. [`crate::request::DEFAULT_NODE_BUDGET`].
+    #[serde(default = "default_node_budget")]
+    pub node_budget: usize,
+}
+
+impl Default for PlanTuning {
+    fn default() -> Self {
+        Self {
+            candidates: 8,
+            max_candidates: DEFAULT_MAX_CANDIDATES,
+            partitions: default_partitions(),
+            node_budget: default_node_budget(),
+        }
+    }
 }
 
 fn default_node_budget() -> usize {
     crate::request::DEFAULT_NODE_BUDGET
 }
 
-/// The default of [`PlanOptions::max_candidates`]. Some plans reject more than 1024 candidates in a row while the
+/// The default of [`PlanTuning::max_candidates`]. Some plans reject more than 1024 candidates in a row while the
 /// floor beside the stack is free: candidates on and around a full-height column at `w = 1`, or the 13th part of
 /// the `plan-l-corner-w0.1` scenario, which passes at its 1109th candidate. With candidates found not stable
 /// remembered (`GrowingStack`), a repeated one costs a few µs.
 pub const DEFAULT_MAX_CANDIDATES: usize = 4096;
 
-/// [`PlanOptions::max_candidates`] of a plan file written before the field existed.
+/// [`PlanTuning::max_candidates`] of a plan file written before the field existed.
 fn legacy_max_candidates() -> usize {
     1024
 }
@@ -152,14 +176,11 @@ impl PlanOptions {
             mu: 0.5,
             cup_diameter: 10.0,
             insertion: true,
-            candidates: 8,
-            max_candidates: DEFAULT_MAX_CANDIDATES,
             max_resting_poses: 3,
             nest_allowance: 5.0,
-            partitions: default_partitions(),
-            node_budget: default_node_budget(),
             time_limit: None,
             grasp_tilt: stackplan_stability::grasp::DEFAULT_MAX_TILT,
+            tuning: PlanTuning::default(),
         }
     }
 }
@@ -395,10 +416,10 @@ fn validate(options: &PlanOptions) -> Result<(), PlanError> {
     if options.count == 0 {
         return Err(PlanError::BadOption("the number of parts must be at least 1".into()));
     }
-    if !(options.candidates >= 1 && options.max_resting_poses >= 1) {
+    if !(options.tuning.candidates >= 1 && options.max_resting_poses >= 1) {
         return Err(PlanError::BadOption("candidates and max_resting_poses must be at least 1".into()));
     }
-    if options.max_candidates < options.candidates {
+    if options.tuning.max_candidates < options.tuning.candidates {
         return Err(PlanError::BadOption("max_candidates must be at least candidates".into()));
     }
     if !(options.cup_diameter > 0.0 && options.cup_diameter.is_finite()) {
@@ -413,11 +434,11 @@ fn validate(options: &PlanOptions) -> Result<(), PlanError> {
     if !(options.nest_allowance >= 0.0 && options.nest_allowance.is_finite()) {
         return Err(PlanError::BadOption("the nesting allowance must be non-negative and finite".into()));
     }
-    if !(1..=crate::request::MAX_PARTITIONS).contains(&options.partitions) {
+    if !(1..=crate::request::MAX_PARTITIONS).contains(&options.tuning.partitions) {
         return Err(PlanError::BadOption(format!(
             "the number of search partitions must lie in 1..={}, got {}",
             crate::request::MAX_PARTITIONS,
-            options.partitions
+            options.tuning.partitions
         )));
     }
     Ok(())
@@ -549,7 +570,8 @@ mod tests {
         let full = plan_stack(&part, &options(6, 0.5, floor.clone())).expect("plan");
         assert_eq!(full.parts.len(), 6, "{:?}", full.stopped);
         // a node budget below what the later parts need
-        let tight = PlanOptions { node_budget: 1, ..options(6, 0.5, floor.clone()) };
+        let mut tight = options(6, 0.5, floor.clone());
+        tight.tuning.node_budget = 1;
         let plan = plan_stack(&part, &tight).expect("a limit is no error");
         assert!(plan.parts.len() < 6);
         let reason = plan.stopped.as_deref().unwrap_or_default();
@@ -605,16 +627,16 @@ mod tests {
                 .expect("example");
         let floor = FloorVolume::rectangle(-200.0, -200.0, 200.0, 200.0, 400.0);
         let mut options = PlanOptions { w: 0.9, dtheta: 15f64.to_radians(), ..PlanOptions::new(4, floor) };
-        options.candidates = 1;
-        options.max_candidates = 1;
+        options.tuning.candidates = 1;
+        options.tuning.max_candidates = 1;
         let once = plan_stack(&part, &options).expect("plan");
         assert_eq!(once.parts.len(), 3, "the cheapest candidate of the fourth part fails");
         assert!(once.stopped.as_deref().is_some_and(|r| r.contains("part 4 of 4")), "{:?}", once.stopped);
-        options.max_candidates = 1024;
+        options.tuning.max_candidates = 1024;
         let repeated = plan_stack(&part, &options).expect("plan");
         assert_eq!(repeated.parts.len(), 4, "{:?}", repeated.stopped);
         assert!(repeated.stats.repeated_searches >= 1);
-        assert!(repeated.parts[3].rejected_candidates >= options.candidates);
+        assert!(repeated.parts[3].rejected_candidates >= options.tuning.candidates);
         assert_eq!(&repeated.parts[..3], &once.parts[..3]);
         // the rejections are proofs of instability, not solver failures
         assert!(repeated.stats.rejected_not_stable + repeated.stats.rejected_stack_not_stable >= 1);
@@ -633,11 +655,11 @@ mod tests {
                 .expect("example");
         let floor = FloorVolume::rectangle(-300.0, -300.0, 300.0, 300.0, 400.0);
         let mut options = PlanOptions { w: 0.9, dtheta: 15f64.to_radians(), ..PlanOptions::new(8, floor) };
-        options.candidates = 1;
-        options.max_candidates = 1;
+        options.tuning.candidates = 1;
+        options.tuning.max_candidates = 1;
         let cut = plan_stack(&part, &options).expect("plan");
         assert!(cut.stopped.as_deref().is_some_and(|r| r.contains("part 4 of 8")), "{:?}", cut.stopped);
-        options.max_candidates = 2;
+        options.tuning.max_candidates = 2;
         let plan = plan_stack(&part, &options).expect("plan");
         assert!(plan.stopped.is_none() && plan.parts.len() == 8 && plan.stack_stable, "{:?}", plan.stopped);
         assert_eq!(&plan.parts[..3], &cut.parts[..3]);
@@ -662,9 +684,9 @@ mod tests {
                 .expect("example");
         let floor = FloorVolume::rectangle(-305.0, -305.0, 305.0, 305.0, 612.0);
         let mut options = PlanOptions { w: 0.9, dtheta: 15f64.to_radians(), ..PlanOptions::new(8, floor) };
-        options.candidates = 1;
+        options.tuning.candidates = 1;
         let one = plan_stack(&part, &options).expect("plan");
-        options.candidates = 8;
+        options.tuning.candidates = 8;
         let eight = plan_stack(&part, &options).expect("plan");
         assert_eq!(one.parts.len(), 8, "{:?}", one.stopped);
         let beyond_budget: Vec<&PlannedPart> =
@@ -720,7 +742,8 @@ mod tests {
             Err(PlanError::BadOption(_))
         ));
         for partitions in [0, crate::request::MAX_PARTITIONS + 1] {
-            let bad = PlanOptions { partitions, ..options(1, 0.5, FloorVolume::rectangle(0.0, 0.0, 50.0, 50.0, 50.0)) };
+            let mut bad = options(1, 0.5, FloorVolume::rectangle(0.0, 0.0, 50.0, 50.0, 50.0));
+            bad.tuning.partitions = partitions;
             let error = plan_stack(&part, &bad);
             assert!(
                 matches!(&error, Err(PlanError::BadOption(m)) if m.contains("partitions")),

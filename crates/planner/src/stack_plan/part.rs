@@ -180,7 +180,7 @@ impl<'p> Planner<'p> {
         let request = self.request(floor, elsewhere);
         // `beaten_at` is set iff a part was accepted, so both cases of the longer limit are "last stage, or beaten"
         let beaten_at = accepted.iter().map(|a| a.candidate.cost).reduce(f64::min);
-        let limit = if last || beaten_at.is_some() { options.max_candidates } else { options.candidates };
+        let limit = if last || beaten_at.is_some() { options.tuning.max_candidates } else { options.tuning.candidates };
         let started = Instant::now();
         let mut search = match PlacementSearch::new(&request, &self.cache, &mut self.caches) {
             Ok(search) => search,
@@ -208,7 +208,7 @@ impl<'p> Planner<'p> {
                 let e = PlacementError::TimeLimit { found: tested };
                 return Ok(StageEnd::Limit(limit_reason(index, options, &e, self.started)));
             }
-            if tested == options.candidates {
+            if tested == options.tuning.candidates {
                 self.stats.repeated_searches += 1;
                 tracing::debug!(index, "every candidate failed the checks: searching for more");
                 if last {
@@ -353,15 +353,15 @@ impl<'p> Planned<'_, 'p> {
         let (part, options) = (self.part, self.options);
         let stack: Vec<StackPart<'p>> = self.placed.iter().map(|&pose| StackPart { part, pose }).collect();
         let mut request = PlacementRequest::new(part, stack, floor);
-        request.searched_elsewhere = searched_elsewhere;
+        request.tuning.searched_elsewhere = searched_elsewhere;
         request.resting_rotations = self.rests.to_vec();
         request.thetas = thetas.to_vec();
         request.clearance = options.clearance;
         request.horizontal_clearance = true;
         request.cost = Cost::Stacking { w: options.w, origin };
         request.insertion = options.insertion;
-        request.partitions = options.partitions;
-        request.node_budget = options.node_budget;
+        request.tuning.partitions = options.tuning.partitions;
+        request.tuning.node_budget = options.tuning.node_budget;
         request.deadline = deadline;
         request
     }
@@ -415,7 +415,7 @@ impl FloorSearch<'_, '_> {
             };
             self.stats.searches += 1;
             self.stats.seconds_search += started.elapsed().as_secs_f64();
-            for tested in 0..options.candidates {
+            for tested in 0..options.tuning.candidates {
                 let started = Instant::now();
                 let next = match search.next_placements_within(1, limit) {
                     Ok(next) => next,
@@ -488,7 +488,7 @@ fn limit_reason(index: usize, options: &PlanOptions, e: &PlacementError, started
         PlacementError::TimeLimit { .. } => {
             format!("the time limit of {} s was reached", options.time_limit.unwrap_or(0.0))
         }
-        _ => format!("the search exceeded its node budget of {} nodes", options.node_budget),
+        _ => format!("the search exceeded its node budget of {} nodes", options.tuning.node_budget),
     };
     format!(
         "part {} of {} could not be placed: {limit} after {:.1} s; the {index} parts placed before it are kept",
