@@ -355,8 +355,7 @@ fn check_plan_with(
     use stackplan::stability::check::{CheckOptions, check_stack};
     use stackplan::stability::grasp::GraspOptions;
     use stackplan::stability::world::PlacedPart;
-    let stack: Vec<PlacedPart<'_>> =
-        poses.iter().map(|p| PlacedPart { part, rotation: p.rotation, position: p.position }).collect();
+    let stack: Vec<PlacedPart<'_>> = poses.iter().map(|p| PlacedPart { part, pose: *p }).collect();
     let check = CheckOptions {
         mu: options.mu,
         clearance: (options.clearance - 1e-6).max(0.0),

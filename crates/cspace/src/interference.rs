@@ -30,7 +30,7 @@ use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 use serde::{Deserialize, Serialize};
 use stackplan_geom::polytope::ConvexPolytope;
-use stackplan_geom::{Part, Tolerance};
+use stackplan_geom::{Part, PlacedPart, Tolerance};
 
 /// A convex component placed in the world, prepared for separating-axis tests.
 #[derive(Debug, Clone)]
@@ -357,17 +357,6 @@ pub fn gjk_distance(a: &PlacedConvex, b: &PlacedConvex) -> Option<f64> {
     pair_distance(a, b)
 }
 
-/// A part placed in the world: `world = rotation . part + position`.
-#[derive(Debug, Clone, Copy)]
-pub struct Placement<'a> {
-    /// The part.
-    pub part: &'a Part,
-    /// Rotation.
-    pub rotation: DMat3,
-    /// Position.
-    pub position: DVec3,
-}
-
 /// One interfering (or, with clearance, too close) component pair.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct InterferencePair {
@@ -396,14 +385,14 @@ fn aabb_of(lo: DVec3, hi: DVec3, grow: f64) -> Aabb {
 impl PlacedScene {
     /// Places every component of every part and builds the BVH. The tolerance is the policy's for the largest part
     /// (or the moving part, passed later, whichever is larger). O(n log n) in the number of components.
-    pub fn new(parts: &[Placement<'_>]) -> Self {
+    pub fn new(parts: &[PlacedPart<'_>]) -> Self {
         let mut components = Vec::new();
         let mut scale: f64 = 0.0;
         for (pi, placement) in parts.iter().enumerate() {
             let (lo, hi) = placement.part.aabb();
             scale = scale.max((hi - lo).length());
             for (ci, c) in placement.part.components.iter().enumerate() {
-                components.push((pi, ci, PlacedConvex::new(c, placement.rotation, placement.position)));
+                components.push((pi, ci, PlacedConvex::new(c, placement.pose.rotation, placement.pose.position)));
             }
         }
         let bvh = Bvh::from_iter(

@@ -25,6 +25,6 @@ mod types;
 mod z_prism;
 
 pub use cache::{CacheStats, ObstacleCache};
-pub use interference::{InterferencePair, PairContact, PlacedConvex, PlacedScene, Placement};
+pub use interference::{InterferencePair, PairContact, PlacedConvex, PlacedScene};
 pub use minkowski::{FaceKind, Feature, Obstacle, ObstacleError, Route, facet_bound, obstacle, obstacle_by_hull};
 pub use offset::{HalfSpaces, clearance, insertion, insertion_polytope, slice};

@@ -8,9 +8,7 @@ use crate::common;
 use common::*;
 use glam::{DMat3, DVec3};
 use proptest::prelude::*;
-use stackplan_cspace::interference::{
-    PairContact, PlacedConvex, PlacedScene, Placement, classify_pair, pair_distance, sat_gap,
-};
+use stackplan_cspace::interference::{PairContact, PlacedConvex, PlacedScene, classify_pair, pair_distance, sat_gap};
 use stackplan_cspace::minkowski::obstacle_by_hull;
 use stackplan_geom::{ConvexPolytope, Decomposition, Part, PartOrigin, Tolerance};
 
@@ -119,7 +117,7 @@ proptest! {
         }
         let moving = Part::from_components("a", vec![a.clone()], 1.0, PartOrigin::ConvexPieces).expect("part");
         let fixed = Part::from_components("b", vec![b.clone()], 1.0, PartOrigin::ConvexPieces).expect("part");
-        let scene = PlacedScene::new(&[Placement { part: &fixed, rotation: DMat3::IDENTITY, position: DVec3::ZERO }]);
+        let scene = PlacedScene::new(&[stackplan_geom::PlacedPart::new(&fixed, stackplan_geom::Pose::IDENTITY)]);
         let scene_tol = scene.tolerance().linear.max(moving.tolerance().linear);
         prop_assume!(delta > 3.0 * scene_tol);
         let found = scene.interference_pairs(&moving, r, p, clearance);

@@ -6,8 +6,9 @@ use crate::common;
 use common::*;
 use glam::{DMat3, DVec3};
 use proptest::prelude::*;
-use stackplan_cspace::interference::{PairContact, PlacedConvex, PlacedScene, Placement, classify_pair};
+use stackplan_cspace::interference::{PairContact, PlacedConvex, PlacedScene, classify_pair};
 use stackplan_geom::{ConvexPolytope, Part, PartOrigin};
+use stackplan_geom::{PlacedPart, Pose};
 
 fn box_part() -> impl Strategy<Value = Part> {
     prop::collection::vec(any_box(), 1..4)
@@ -54,8 +55,8 @@ proptest! {
         p in grid_position(),
         clearance in prop_oneof![Just(0.0f64), Just(0.3f64)],
     ) {
-        let placements: Vec<Placement<'_>> =
-            fixed.iter().map(|(part, rot, pos)| Placement { part, rotation: *rot, position: *pos }).collect();
+        let placements: Vec<PlacedPart<'_>> =
+            fixed.iter().map(|(part, rot, pos)| PlacedPart::new(part, Pose { rotation: *rot, position: *pos })).collect();
         let scene = PlacedScene::new(&placements);
         let found = scene.interference_pairs(&moving, r, p, clearance);
         let brute = scene.interference_pairs_brute_force(&moving, r, p, clearance);

@@ -42,7 +42,7 @@ pub use io::{IoError, ReadOptions, read_part, write_part};
 pub use mass::MassProperties;
 pub use part::{BoundaryFace, Part, PartError, PartOrigin};
 pub use polytope::{Containment, ConvexPolytope, Edge, Face, Plane, PolytopeError};
-pub use pose::{Pose, PoseError};
+pub use pose::{PlacedPart, Pose, PoseError};
 pub use sheet_metal::{Decomposition, SheetFace, SheetMetal, SheetMetalError};
 pub use tolerance::Tolerance;
 pub use vertex_cycle::VertexCycle;

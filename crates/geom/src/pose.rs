@@ -241,3 +241,19 @@ mod tests {
         assert_eq!(Pose::new(DMat3::IDENTITY, DVec3::new(f64::INFINITY, 0.0, 0.0)), Err(PoseError::NonFinite));
     }
 }
+
+/// A part at a pose: a part in a stack, or a part placed in a scene (`world = pose.rotation . v + pose.position`).
+#[derive(Debug, Clone, Copy)]
+pub struct PlacedPart<'a> {
+    /// The part, in its own coordinates.
+    pub part: &'a crate::Part,
+    /// Its pose (a proper rotation, and the translation in mm).
+    pub pose: Pose,
+}
+
+impl<'a> PlacedPart<'a> {
+    /// `part` at `pose`.
+    pub fn new(part: &'a crate::Part, pose: Pose) -> Self {
+        Self { part, pose }
+    }
+}

@@ -173,7 +173,7 @@ fn broken_stack_files() {
     assert!(e.to_string().contains("stack_reflection.json: placement 1"), "{e}");
 
     let e = read_stack(broken("stack_missing_part_file.json")).expect_err("the part file does not exist");
-    let IoError::StackPart { source, .. } = &e else { panic!("{e:?}") };
+    let IoError::PlacedPart { source, .. } = &e else { panic!("{e:?}") };
     assert!(matches!(**source, IoError::Os { .. }), "{source:?}");
     assert!(e.to_string().contains("stack_missing_part_file.json: key `part`"), "{e}");
     assert!(e.to_string().contains("no_such_part.json"), "{e}");

@@ -2,7 +2,7 @@
 
 use proptest::prelude::*;
 use stackplan_geom::io::glb::{GlbItem, glb_bytes};
-use stackplan_geom::io::stack::{StackPart, read_stack, write_stack, write_stack_with_extras};
+use stackplan_geom::io::stack::{PlacedPart, read_stack, write_stack, write_stack_with_extras};
 use stackplan_geom::io::{self, IoError, ReadOptions, atomic};
 use stackplan_geom::{
     ConvexPolytope, DMat3, DVec3, Part, PartOrigin, Pose, convex_hull, convex_hull_merged, convex_hull_merged_within,
@@ -538,7 +538,7 @@ fn stack_file_round_trip_and_row_convention() {
         Pose::new(DMat3::from_rotation_x(std::f64::consts::FRAC_PI_2), DVec3::new(0.0, 0.0, 40.0)).expect("pose"),
     ];
     let stack = dir.path().join("stack.json");
-    write_stack(&stack, StackPart::Path(Path::new("bracket.json")), &poses).expect("write");
+    write_stack(&stack, PlacedPart::Path(Path::new("bracket.json")), &poses).expect("write");
     let read = read_stack(&stack).expect("read");
     assert_eq!(read.placements, poses);
     assert_eq!(read.part_path.as_deref(), Some(dir.path().join("bracket.json").as_path()));
@@ -549,7 +549,7 @@ fn stack_file_round_trip_and_row_convention() {
     extra.insert("cost".into(), serde_json::json!(12.5));
     extra.insert("theta_deg".into(), serde_json::json!(14));
     let inline = dir.path().join("inline.json");
-    write_stack_with_extras(&inline, StackPart::Inline(&part), &poses, &[serde_json::Map::new(), extra.clone()])
+    write_stack_with_extras(&inline, PlacedPart::Inline(&part), &poses, &[serde_json::Map::new(), extra.clone()])
         .expect("write");
     let read = read_stack(&inline).expect("read inline");
     assert_eq!(read.part_path, None);

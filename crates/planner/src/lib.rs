@@ -39,8 +39,7 @@ pub mod stack_plan;
 mod symmetry;
 
 pub use request::{
-    Cost, FloorVolume, PlacementError, PlacementRequest, StackPart, polygon_side_planes, thetas_with_step,
-    uniform_thetas,
+    Cost, FloorVolume, PlacementError, PlacementRequest, polygon_side_planes, thetas_with_step, uniform_thetas,
 };
 pub use search::{
     Contact, NoPlacement, Placement, PlacementResult, PlacementSearch, PlacementStats, SearchCaches, place,
@@ -49,3 +48,4 @@ pub use search::{
 pub use stack_plan::{
     DEFAULT_MAX_CANDIDATES, Plan, PlanError, PlanOptions, PlanStats, PlannedPart, plan_stack, plan_stack_with_progress,
 };
+pub use stackplan_stability::world::PlacedPart;

@@ -8,14 +8,15 @@
 //!   component pair through `PlacedScene::interference_pairs_brute_force`; containment in the floor volume; the
 //!   vertical path for insertion), reporting every violated condition.
 
+use crate::PlacedPart;
 use crate::detect::StackScene;
 use crate::obstacles::DerivedObstacle;
 use crate::orientation::Orientation;
 use crate::qp::{Quadratic, minimise};
-use crate::request::{PlacementRequest, StackPart};
+use crate::request::PlacementRequest;
 use glam::{DMat3, DVec3};
 use stackplan_cspace::ObstacleCache;
-use stackplan_cspace::interference::{PairContact, PlacedScene, Placement as CsPlacement};
+use stackplan_cspace::interference::{PairContact, PlacedScene};
 use stackplan_freespace::cell::{Cell, Halfspace, Tag};
 use stackplan_geom::{Part, Tolerance};
 
@@ -108,16 +109,13 @@ pub fn violations(
     part: &Part,
     rotation: DMat3,
     position: DVec3,
-    stack: &[StackPart<'_>],
+    stack: &[PlacedPart<'_>],
     request: &PlacementRequest<'_>,
     tol: f64,
     insertion_step: f64,
 ) -> Vec<String> {
     let mut out = Vec::new();
-    let placements: Vec<CsPlacement<'_>> = stack
-        .iter()
-        .map(|s| CsPlacement { part: s.part, rotation: s.pose.rotation, position: s.pose.position })
-        .collect();
+    let placements: Vec<stackplan_geom::PlacedPart<'_>> = stack.iter().map(|s| *s).collect();
     let scene = PlacedScene::new(&placements);
     for pair in scene.interference_pairs_brute_force(part, rotation, position, request.clearance) {
         let bad = match pair.contact {

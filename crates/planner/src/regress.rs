@@ -11,7 +11,8 @@
 //! (the seed nests them "by flipping alternate parts"); Triangle parts keep one resting pose (they nest as they are).
 //! All parts use the seed's plain triangulation (3, 6 and 79 components). 1-degree steps, no clearance.
 
-use crate::request::{Cost, FloorVolume, PlacementError, PlacementRequest, StackPart, uniform_thetas};
+use crate::PlacedPart;
+use crate::request::{Cost, FloorVolume, PlacementError, PlacementRequest, uniform_thetas};
 use crate::search::{PlacementResult, place};
 use glam::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
@@ -71,7 +72,7 @@ fn lowest_z(part: &Part, r: DMat3) -> f64 {
 }
 
 fn request_for<'a>(sc: &'a Scenario, part: &'a Part, stack: &[Pose], rest: DMat3) -> PlacementRequest<'a> {
-    let stack_parts: Vec<StackPart<'a>> = stack.iter().map(|p| StackPart { part, pose: *p }).collect();
+    let stack_parts: Vec<PlacedPart<'a>> = stack.iter().map(|p| PlacedPart { part, pose: *p }).collect();
     let mut req = PlacementRequest::new(part, stack_parts, sc.floor.clone());
     req.resting_rotations = vec![rest];
     req.thetas = uniform_thetas(360);

@@ -7,6 +7,7 @@
 use glam::{DMat3, DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 use stackplan_geom::{Part, Pose};
+use stackplan_stability::world::PlacedPart;
 
 /// The floor volume `Sigma`: a convex floor polygon (counter-clockwise seen from above, in the plane `z = 0`) times
 /// `[0, height]`.
@@ -72,15 +73,6 @@ pub enum Cost {
     },
 }
 
-/// A part already in the stack: never moves during a placement.
-#[derive(Debug, Clone, Copy)]
-pub struct StackPart<'a> {
-    /// The part.
-    pub part: &'a Part,
-    /// Its pose (`world = rotation . v + position`).
-    pub pose: Pose,
-}
-
 /// Everything a placement needs. See the module documentation; [`PlacementRequest::new`] gives the defaults.
 #[derive(Debug, Clone)]
 pub struct PlacementRequest<'a> {
@@ -91,8 +83,8 @@ pub struct PlacementRequest<'a> {
     pub resting_rotations: Vec<DMat3>,
     /// The discrete rotation angles about world `z` (radians; default 1-degree steps over a full turn).
     pub thetas: Vec<f64>,
-    /// The stack.
-    pub stack: Vec<StackPart<'a>>,
+    /// The stack: parts already placed, which never move during a placement.
+    pub stack: Vec<PlacedPart<'a>>,
     /// The floor volume `Sigma`.
     pub floor: FloorVolume,
     /// `Some(z)`: the 2-D permissible set at `p_z = z` (\[A\] VII-A-2); `None`: the 3-D one.
@@ -236,7 +228,7 @@ fn check_convex_polygon(poly: &[DVec2], what: &str) -> Result<(), String> {
 impl<'a> PlacementRequest<'a> {
     /// Defaults: the part as it lies, 1-degree steps, no clearance, cost (1) with `w = 0.5` about the floor centre,
     /// no insertion, `k = 1`, 3-D permissible set, [`SearchTuning::default`].
-    pub fn new(part: &'a Part, stack: Vec<StackPart<'a>>, floor: FloorVolume) -> Self {
+    pub fn new(part: &'a Part, stack: Vec<PlacedPart<'a>>, floor: FloorVolume) -> Self {
         let origin = floor.centre();
         Self {
             part,

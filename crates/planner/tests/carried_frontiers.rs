@@ -9,7 +9,7 @@ use stackplan_cspace::ObstacleCache;
 use stackplan_geom::Pose;
 use stackplan_geom::examples::part_by_name;
 use stackplan_geom::sheet_metal::Decomposition;
-use stackplan_planner::{FloorVolume, PlacementRequest, PlacementSearch, SearchCaches, StackPart, place_with_caches};
+use stackplan_planner::{FloorVolume, PlacedPart, PlacementRequest, PlacementSearch, SearchCaches, place_with_caches};
 
 /// Searches into a growing stack through caches that carry their frontiers (as the stacking planner's): at every
 /// step the first placement costs what a fresh search's does (the exact optimum), also on a floor that grew since the
@@ -25,7 +25,7 @@ fn carried_frontiers_find_the_exact_best_placement_into_a_growing_stack() {
     let mut poses: Vec<Pose> = Vec::new();
     let mut widened = 0;
     for step in 0..6 {
-        let stack: Vec<StackPart<'_>> = poses.iter().map(|&pose| StackPart { part: &part, pose }).collect();
+        let stack: Vec<PlacedPart<'_>> = poses.iter().map(|&pose| PlacedPart { part: &part, pose }).collect();
         // a footprint-like floor that grows with the steps (as stage 1's), then the whole floor (as stage 2's)
         let grow = 90.0 + 20.0 * step as f64;
         let floors = [FloorVolume::rectangle(-grow, -grow, grow, grow, 300.0), whole.clone()];
@@ -78,7 +78,7 @@ fn caches_reused_for_another_stack_search_that_stack() {
     let stacks = [vec![at(0.0, 0.0)], vec![at(40.0, -30.0)], vec![at(40.0, -30.0), at(-60.0, 50.0)], vec![]];
     for mut caches in [SearchCaches::new(), SearchCaches::carrying_frontiers()] {
         for poses in &stacks {
-            let stack: Vec<StackPart<'_>> = poses.iter().map(|&pose| StackPart { part: &part, pose }).collect();
+            let stack: Vec<PlacedPart<'_>> = poses.iter().map(|&pose| PlacedPart { part: &part, pose }).collect();
             let req = growing_stack_request(&part, stack, floor.clone());
             let fresh = place_with_caches(&req, &ObstacleCache::new(), &mut SearchCaches::new()).expect("fresh");
             let reused = place_with_caches(&req, &ObstacleCache::new(), &mut caches).expect("reused caches");

@@ -7,11 +7,11 @@ use common::boxes;
 
 use glam::{DMat3, DVec3};
 use proptest::prelude::*;
-use stackplan_cspace::interference::{PairContact, PlacedScene, Placement as CsPlacement};
+use stackplan_cspace::interference::{PairContact, PlacedScene};
 use stackplan_geom::{Part, Pose};
 use stackplan_planner::orientation::Orientation;
 use stackplan_planner::reference::{complete_optimum, violations};
-use stackplan_planner::{Cost, FloorVolume, PlacementRequest, StackPart, place, uniform_thetas};
+use stackplan_planner::{Cost, FloorVolume, PlacedPart, PlacementRequest, place, uniform_thetas};
 
 /// A box or an L of two boxes (concave, two components).
 fn part_strategy() -> impl Strategy<Value = Part> {
@@ -46,8 +46,8 @@ fn case_strategy() -> impl Strategy<Value = Case> {
 }
 
 fn request<'a>(c: &'a Case) -> PlacementRequest<'a> {
-    let stack: Vec<StackPart<'a>> =
-        c.stack_parts.iter().zip(&c.poses).map(|(p, pose)| StackPart { part: p, pose: *pose }).collect();
+    let stack: Vec<PlacedPart<'a>> =
+        c.stack_parts.iter().zip(&c.poses).map(|(p, pose)| PlacedPart { part: p, pose: *pose }).collect();
     let floor = FloorVolume::rectangle(-20.0, -20.0, 100.0, 100.0, 150.0);
     let mut req = PlacementRequest::new(&c.part, stack, floor);
     req.thetas = uniform_thetas(c.n_theta);
@@ -98,8 +98,8 @@ proptest! {
             prop_assert!(v.is_empty(), "{:?}", v);
         }
         // dense sample: no free position of any orientation beats the optimum
-        let placements: Vec<CsPlacement<'_>> =
-            req.stack.iter().map(|s| CsPlacement { part: s.part, rotation: s.pose.rotation, position: s.pose.position }).collect();
+        let placements: Vec<stackplan_geom::PlacedPart<'_>> =
+            req.stack.iter().map(|s| *s).collect();
         let scene = PlacedScene::new(&placements);
         let best = res.placements.first().map(|b| b.cost).unwrap_or(f64::INFINITY);
         for (ti, &theta) in req.thetas.iter().enumerate() {

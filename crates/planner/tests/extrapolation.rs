@@ -13,7 +13,7 @@ use stackplan_geom::{Part, Pose};
 use stackplan_orient_interval::structure::relative_difference;
 use stackplan_planner::detect::StackScene;
 use stackplan_planner::interval_obstacles::{IntervalObstacles, ObstacleRoute};
-use stackplan_planner::{Cost, FloorVolume, PlacementRequest, StackPart, place, thetas_with_step};
+use stackplan_planner::{Cost, FloorVolume, PlacedPart, PlacementRequest, place, thetas_with_step};
 
 /// A wedge (a prism with an inclined face): extrapolation of edge-edge and inclined faces, not only boxes.
 fn wedge(a: f64, b: f64, h: f64) -> Part {
@@ -89,7 +89,7 @@ proptest! {
     ) {
         let pose = Pose { rotation: DMat3::from_rotation_z(turn as f64 * 0.4), position: DVec3::new(x, y, 0.0) };
         let floor = FloorVolume::rectangle(-20.0, -20.0, 100.0, 100.0, 150.0);
-        let mut request = PlacementRequest::new(&part, vec![StackPart { part: &stack_part, pose }], floor);
+        let mut request = PlacementRequest::new(&part, vec![PlacedPart { part: &stack_part, pose }], floor);
         request.thetas = thetas_with_step(5f64.to_radians()).expect("step");
         request.cost = Cost::Stacking { w, origin: DVec3::new(40.0, 40.0, 0.0) };
         request.k = 3;
@@ -117,7 +117,7 @@ fn most_obstacles_of_a_fine_theta_set_are_extrapolated() {
     let part = wedge(30.0, 20.0, 15.0);
     let pose = Pose { rotation: DMat3::IDENTITY, position: DVec3::ZERO };
     let floor = FloorVolume::rectangle(-10.0, -10.0, 70.0, 50.0, 100.0);
-    let mut request = PlacementRequest::new(&part, vec![StackPart { part: &stack_part, pose }], floor);
+    let mut request = PlacementRequest::new(&part, vec![PlacedPart { part: &stack_part, pose }], floor);
     request.thetas = thetas_with_step(1f64.to_radians()).expect("step");
     request.cost = Cost::Target { target: DVec3::new(30.0, 20.0, 0.0) };
     request.k = 5;

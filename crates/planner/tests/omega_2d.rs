@@ -8,11 +8,11 @@ use crate::common;
 
 use glam::{DMat3, DVec3};
 use proptest::prelude::*;
-use stackplan_cspace::interference::{PairContact, PlacedScene, Placement as CsPlacement};
+use stackplan_cspace::interference::{PairContact, PlacedScene};
 use stackplan_geom::{Part, Pose};
 use stackplan_planner::orientation::Orientation;
 use stackplan_planner::reference::violations;
-use stackplan_planner::{Cost, FloorVolume, NoPlacement, PlacementRequest, StackPart, place, uniform_thetas};
+use stackplan_planner::{Cost, FloorVolume, NoPlacement, PlacedPart, PlacementRequest, place, uniform_thetas};
 
 /// A box or an L of two boxes (concave, two components).
 fn part_strategy() -> impl Strategy<Value = Part> {
@@ -51,8 +51,8 @@ fn case_strategy() -> impl Strategy<Value = Case> {
 }
 
 fn request<'a>(c: &'a Case) -> PlacementRequest<'a> {
-    let stack: Vec<StackPart<'a>> =
-        c.stack_parts.iter().zip(&c.poses).map(|(p, pose)| StackPart { part: p, pose: *pose }).collect();
+    let stack: Vec<PlacedPart<'a>> =
+        c.stack_parts.iter().zip(&c.poses).map(|(p, pose)| PlacedPart { part: p, pose: *pose }).collect();
     let (x0, y0, x1, y1, h) = FLOOR;
     let mut req = PlacementRequest::new(&c.part, stack, FloorVolume::rectangle(x0, y0, x1, y1, h));
     req.thetas = uniform_thetas(c.n_theta);
@@ -88,10 +88,10 @@ proptest! {
             let v = violations(&c.part, pose.rotation, pose.position, &req.stack, &req, 1e-6, 2.0);
             prop_assert!(v.is_empty(), "{:?}", v);
         }
-        let placements: Vec<CsPlacement<'_>> = req
+        let placements: Vec<PlacedPart<'_>> = req
             .stack
             .iter()
-            .map(|s| CsPlacement { part: s.part, rotation: s.pose.rotation, position: s.pose.position })
+            .map(|s| *s)
             .collect();
         let scene = PlacedScene::new(&placements);
         let best = res.placements.first().map_or(f64::INFINITY, |b| b.cost);

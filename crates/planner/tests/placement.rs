@@ -4,7 +4,7 @@ use glam::{DMat3, DVec3};
 use stackplan_geom::{ConvexPolytope, Part, PartOrigin, Pose};
 use stackplan_planner::reference::violations;
 use stackplan_planner::{
-    Contact, Cost, FloorVolume, NoPlacement, PlacementError, PlacementRequest, StackPart, place, uniform_thetas,
+    Contact, Cost, FloorVolume, NoPlacement, PlacedPart, PlacementError, PlacementRequest, place, uniform_thetas,
 };
 
 fn cuboid_part(lo: DVec3, hi: DVec3) -> Part {
@@ -17,7 +17,7 @@ fn box_goes_on_top_of_a_box() {
     let base = cuboid_part(DVec3::ZERO, DVec3::new(100.0, 100.0, 50.0));
     let small = cuboid_part(DVec3::ZERO, DVec3::new(50.0, 50.0, 50.0));
     let floor = FloorVolume::rectangle(-200.0, -200.0, 300.0, 300.0, 400.0);
-    let stack = vec![StackPart { part: &base, pose: Pose::IDENTITY }];
+    let stack = vec![PlacedPart { part: &base, pose: Pose::IDENTITY }];
     let mut req = PlacementRequest::new(&small, stack.clone(), floor);
     req.thetas = uniform_thetas(4);
     req.cost = Cost::Target { target: DVec3::new(50.0, 50.0, 0.0) };
@@ -49,7 +49,7 @@ fn w_zero_puts_it_on_the_floor_beside() {
     let base = cuboid_part(DVec3::ZERO, DVec3::new(100.0, 100.0, 50.0));
     let small = cuboid_part(DVec3::ZERO, DVec3::new(40.0, 20.0, 10.0));
     let floor = FloorVolume::rectangle(0.0, 0.0, 200.0, 100.0, 300.0);
-    let stack = vec![StackPart { part: &base, pose: Pose::IDENTITY }];
+    let stack = vec![PlacedPart { part: &base, pose: Pose::IDENTITY }];
     let mut req = PlacementRequest::new(&small, stack, floor);
     req.thetas = uniform_thetas(8);
     req.cost = Cost::Stacking { w: 0.0, origin: DVec3::ZERO };
@@ -74,7 +74,7 @@ fn errors_and_empty_results() {
     let small = cuboid_part(DVec3::ZERO, DVec3::new(10.0, 10.0, 10.0));
     let blocker = cuboid_part(DVec3::ZERO, DVec3::new(50.0, 50.0, 300.0));
     let mut req =
-        PlacementRequest::new(&small, vec![StackPart { part: &blocker, pose: Pose::IDENTITY }], floor.clone());
+        PlacementRequest::new(&small, vec![PlacedPart { part: &blocker, pose: Pose::IDENTITY }], floor.clone());
     req.thetas = uniform_thetas(4);
     let res = place(&req).expect("runs");
     assert!(res.placements.is_empty());
@@ -118,7 +118,7 @@ fn shared_search_caches_change_no_result() {
     let mut caches = SearchCaches::new();
     let mut poses: Vec<Pose> = Vec::new();
     for step in 0..5 {
-        let stack: Vec<StackPart<'_>> = poses.iter().map(|&pose| StackPart { part: &part, pose }).collect();
+        let stack: Vec<PlacedPart<'_>> = poses.iter().map(|&pose| PlacedPart { part: &part, pose }).collect();
         let mut req = PlacementRequest::new(&part, stack, floor.clone());
         req.thetas = uniform_thetas(12);
         req.cost = Cost::Stacking { w: 0.6, origin: DVec3::new(60.0, 50.0, 0.0) };
@@ -143,10 +143,10 @@ fn shared_search_caches_change_no_result() {
         poses.push(best.pose());
     }
     // a different stack (the parts moved): cleared, same answers
-    let moved: Vec<StackPart<'_>> = poses
+    let moved: Vec<PlacedPart<'_>> = poses
         .iter()
         .rev()
-        .map(|&pose| StackPart { part: &part, pose: Pose { position: pose.position + DVec3::X, ..pose } })
+        .map(|&pose| PlacedPart { part: &part, pose: Pose { position: pose.position + DVec3::X, ..pose } })
         .collect();
     let mut req = PlacementRequest::new(&part, moved, floor);
     req.thetas = uniform_thetas(12);
@@ -173,8 +173,8 @@ fn an_obstacle_cache_serves_one_part_and_one_growing_stack() {
         req.k = 2;
         req
     };
-    let one = vec![StackPart { part: &base, pose: Pose::IDENTITY }];
-    let two = vec![StackPart { part: &base, pose: Pose::IDENTITY }, StackPart { part: &small, pose: on_base }];
+    let one = vec![PlacedPart { part: &base, pose: Pose::IDENTITY }];
+    let two = vec![PlacedPart { part: &base, pose: Pose::IDENTITY }, PlacedPart { part: &small, pose: on_base }];
     let cache = ObstacleCache::new();
     let fresh = |req: &PlacementRequest<'_>| place(req).expect("placement").placements;
     for req in [request(&small, one.clone()), request(&small, two.clone()), request(&small, one.clone())] {
@@ -184,7 +184,7 @@ fn an_obstacle_cache_serves_one_part_and_one_growing_stack() {
     let err = place_with_cache(&request(&plank, one.clone()), &cache);
     assert_eq!(err.map(|r| r.placements), Err(PlacementError::ForeignCache));
     // another stack: part 0 moved
-    let moved = vec![StackPart { part: &base, pose: Pose { rotation: DMat3::IDENTITY, position: DVec3::X } }];
+    let moved = vec![PlacedPart { part: &base, pose: Pose { rotation: DMat3::IDENTITY, position: DVec3::X } }];
     let err = place_with_cache(&request(&small, moved.clone()), &cache);
     assert_eq!(err.map(|r| r.placements), Err(PlacementError::ForeignCache));
     // once the cache forgets the moved part, it serves the new stack

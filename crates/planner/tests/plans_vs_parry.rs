@@ -451,7 +451,6 @@ fn horizontal_distance_of_boxes() {
 #[test]
 fn a_plan_passes_its_own_clearance_check_near_a_tilted_resting_face() {
     use stackplan_stability::check::{CheckOptions, check_stack};
-    use stackplan_stability::world::PlacedPart;
     let (t, w, h) = (2.713867334328786, 21.12362052239483, 20.636605753348576);
     let part = common::boxes(
         "sheet",
@@ -469,15 +468,7 @@ fn a_plan_passes_its_own_clearance_check_near_a_tilted_resting_face() {
     };
     let plan = plan_stack(&part, &options).expect("plan");
     assert_eq!(plan.parts.len(), 2, "{:?}", plan.stopped);
-    let stack: Vec<PlacedPart<'_>> = plan
-        .parts
-        .iter()
-        .map(|p| PlacedPart {
-            part: &part,
-            rotation: DMat3::from_cols_array_2d(&p.rotation).transpose(),
-            position: DVec3::from_array(p.position),
-        })
-        .collect();
+    let stack = plan.stack(&part);
     let check = CheckOptions {
         clearance: options.clearance,
         release_drops: plan.parts.iter().map(|p| p.release_drop).collect(),

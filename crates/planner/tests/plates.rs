@@ -6,12 +6,12 @@
 
 use glam::{DMat3, DVec3};
 use proptest::prelude::*;
-use stackplan_cspace::interference::{PairContact, PlacedScene, Placement as CsPlacement};
+use stackplan_cspace::interference::{PairContact, PlacedScene};
 use stackplan_cspace::obstacle;
 use stackplan_geom::plate::merges_exactly;
 use stackplan_geom::sheet_metal::{Decomposition, SheetFace, SheetMetal};
 use stackplan_geom::{ConvexPolytope, Part, Pose};
-use stackplan_planner::{Cost, FloorVolume, PlacementRequest, StackPart, place, uniform_thetas};
+use stackplan_planner::{Cost, FloorVolume, PlacedPart, PlacementRequest, place, uniform_thetas};
 
 /// A flat plate `a x b` (mm, 2 mm thick, in the plane z = 0) with rectangular holes `(x, y, w, h)`.
 fn plate(a: f64, b: f64, holes: &[(f64, f64, f64, f64)]) -> Part {
@@ -159,10 +159,8 @@ fn a_plate_that_fits_into_a_hole_leaves_a_pocket_and_is_not_merged() {
 }
 
 fn free(part: &Part, stack: &[(&Part, Pose)], r: DMat3, p: DVec3, tol: f64) -> bool {
-    let placements: Vec<CsPlacement<'_>> = stack
-        .iter()
-        .map(|(part, pose)| CsPlacement { part, rotation: pose.rotation, position: pose.position })
-        .collect();
+    let placements: Vec<stackplan_geom::PlacedPart<'_>> =
+        stack.iter().map(|(part, pose)| stackplan_geom::PlacedPart::new(part, *pose)).collect();
     let scene = PlacedScene::new(&placements);
     !scene
         .interference_pairs_brute_force(part, r, p, 0.0)
@@ -186,7 +184,7 @@ proptest! {
             Pose { rotation: DMat3::IDENTITY, position: DVec3::new(0.0, 0.0, 1.0) },
             Pose { rotation: DMat3::from_rotation_z(turn as f64 * 0.5), position: DVec3::new(x + 150.0, y, 1.0) },
         ];
-        let stack: Vec<StackPart<'_>> = poses.iter().map(|pose| StackPart { part: &part, pose: *pose }).collect();
+        let stack: Vec<PlacedPart<'_>> = poses.iter().map(|pose| PlacedPart { part: &part, pose: *pose }).collect();
         let floor = FloorVolume::rectangle(-100.0, -100.0, 400.0, 300.0, 60.0);
         let mut req = PlacementRequest::new(&part, stack, floor);
         req.thetas = uniform_thetas(12);

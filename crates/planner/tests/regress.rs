@@ -2,13 +2,13 @@
 
 use stackplan_planner::reference::violations;
 use stackplan_planner::regress::{run, scenario};
-use stackplan_planner::{PlacementRequest, StackPart};
+use stackplan_planner::{PlacedPart, PlacementRequest};
 
 fn check(name: &str) -> stackplan_planner::regress::ScenarioReport {
     let sc = scenario(name).expect("stack built").expect("known scenario");
     let (result, report) = run(&sc).expect("placement");
     let best = result.placements.first().expect("a placement");
-    let stack: Vec<StackPart<'_>> = sc.stack.iter().map(|p| StackPart { part: &sc.part, pose: *p }).collect();
+    let stack: Vec<PlacedPart<'_>> = sc.stack.iter().map(|p| PlacedPart { part: &sc.part, pose: *p }).collect();
     let mut req = PlacementRequest::new(&sc.part, stack.clone(), sc.floor.clone());
     req.fixed_z = sc.fixed_z;
     let pose = best.pose();

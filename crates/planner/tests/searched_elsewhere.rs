@@ -13,7 +13,7 @@ use stackplan_geom::sheet_metal::Decomposition;
 use stackplan_geom::{Part, Pose};
 use stackplan_planner::reference::violations;
 use stackplan_planner::{
-    FloorVolume, Placement, PlacementError, PlacementRequest, PlacementSearch, SearchCaches, StackPart,
+    FloorVolume, PlacedPart, Placement, PlacementError, PlacementRequest, PlacementSearch, SearchCaches,
     place_with_caches,
 };
 
@@ -31,7 +31,7 @@ fn a_region_and_the_floor_outside_it_find_the_whole_floors_optimum() {
     let mut poses: Vec<Pose> = Vec::new();
     let mut outside_found = 0;
     for step in 0..6 {
-        let stack: Vec<StackPart<'_>> = poses.iter().map(|&pose| StackPart { part: &part, pose }).collect();
+        let stack: Vec<PlacedPart<'_>> = poses.iter().map(|&pose| PlacedPart { part: &part, pose }).collect();
         let grow = 90.0 + 20.0 * step as f64;
         let region = FloorVolume::rectangle(-grow, -grow, grow, grow, 300.0);
         let fresh_whole = place_with_caches(

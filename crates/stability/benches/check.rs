@@ -11,6 +11,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{DMat3, DVec3};
+use stackplan_geom::Pose;
 use stackplan_geom::examples::part_by_name;
 use stackplan_geom::io::stack::read_stack;
 use stackplan_geom::sheet_metal::Decomposition;
@@ -45,7 +46,10 @@ fn brick_pyramid(part: &Part) -> Vec<PlacedPart<'_>> {
     for row in 0..5 {
         for k in 0..(5 - row) {
             let x = 100.0 * row as f64 + 200.0 * k as f64;
-            stack.push(PlacedPart { part, rotation: DMat3::IDENTITY, position: DVec3::new(x, 0.0, 50.0 * row as f64) });
+            stack.push(PlacedPart {
+                part,
+                pose: Pose { rotation: DMat3::IDENTITY, position: DVec3::new(x, 0.0, 50.0 * row as f64) },
+            });
         }
     }
     stack
@@ -55,7 +59,10 @@ fn brick_pyramid(part: &Part) -> Vec<PlacedPart<'_>> {
 /// the contact analysis' interference test): the nesting height of a column of copies.
 fn nesting_height(part: &Part, placed: PlacedPart<'_>, upper_bound: f64) -> f64 {
     let interferes = |dz: f64| {
-        let top = PlacedPart { position: placed.position + DVec3::new(0.0, 0.0, dz), ..placed };
+        let top = PlacedPart {
+            pose: Pose { position: placed.pose.position + DVec3::new(0.0, 0.0, dz), ..placed.pose },
+            ..placed
+        };
         let parts = world_stack(&[PlacedPart { part, ..placed }, top]).expect("world");
         let tol = stack_tolerance(&parts).linear;
         !analyse_contacts(&parts, tol, |_| true).interferences.is_empty()
@@ -76,7 +83,7 @@ fn nesting_height(part: &Part, placed: PlacedPart<'_>, upper_bound: f64) -> f64 
 /// lowered straight onto the one below until they touch (nested when the shape allows it).
 fn columns(part: &Part) -> Vec<PlacedPart<'_>> {
     let pose = resting_poses(part).expect("poses").into_iter().next().expect("a resting pose");
-    let placed = PlacedPart { part, rotation: pose.rotation, position: pose.position };
+    let placed = PlacedPart { part, pose: Pose { rotation: pose.rotation, position: pose.position } };
     let world: Vec<DVec3> = part.all_vertices().map(|v| pose.rotation * v + pose.position).collect();
     let lo = world.iter().fold(DVec3::splat(f64::INFINITY), |a, b| a.min(*b));
     let hi = world.iter().fold(DVec3::splat(f64::NEG_INFINITY), |a, b| a.max(*b));
@@ -86,7 +93,7 @@ fn columns(part: &Part) -> Vec<PlacedPart<'_>> {
         .map(|k| {
             let (column, level) = (k % 5, k / 5);
             let shift = DVec3::new((size.x + 10.0) * column as f64, 0.0, rise * level as f64);
-            PlacedPart { position: pose.position + shift, ..placed }
+            PlacedPart { pose: Pose { position: pose.position + shift, ..placed.pose }, ..placed }
         })
         .collect()
 }
@@ -100,11 +107,8 @@ fn bench_fixtures(c: &mut Criterion) {
     let l_corner = part_by_name("l-corner", Decomposition::ConvexMerge).expect("l-corner");
     let block = part_by_name("block", Decomposition::ConvexMerge).expect("block");
     let plan = read_stack(concat!(env!("CARGO_MANIFEST_DIR"), "/benches/stacks/channel-plan-15.json")).expect("plan");
-    let planned: Vec<PlacedPart<'_>> = plan
-        .placements
-        .iter()
-        .map(|p| PlacedPart { part: &plan.part, rotation: p.rotation, position: p.position })
-        .collect();
+    let planned: Vec<PlacedPart<'_>> =
+        plan.placements.iter().map(|p| PlacedPart { part: &plan.part, pose: *p }).collect();
     let cases = [
         ("check_stack 15 Channel (planned, w = 0.5)", planned),
         ("check_stack 15 Channel (5 columns of 3)", columns(&channel)),
@@ -166,8 +170,7 @@ fn bench_clearance(c: &mut Criterion) {
         (plan.placements.iter().enumerate())
             .map(|(k, p)| PlacedPart {
                 part: &plan.part,
-                rotation: p.rotation,
-                position: p.position + DVec3::Z * lift(k),
+                pose: Pose { rotation: p.rotation, position: p.position + DVec3::Z * lift(k) },
             })
             .collect()
     };

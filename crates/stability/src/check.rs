@@ -35,6 +35,7 @@ use crate::insertion::{Obstruction, insertion_obstruction};
 use crate::world::{PlacedPart, WorldPart, aabb_overlap, stack_tolerance, world_stack};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use stackplan_geom::Pose;
 
 /// Options of [`check_stack`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -186,7 +187,7 @@ pub(crate) fn analyse(stack: &[PlacedPart<'_>], options: &CheckOptions) -> Resul
         let lifted: Vec<PlacedPart<'_>> = stack
             .iter()
             .zip(&options.release_drops)
-            .map(|(p, d)| PlacedPart { position: p.position + glam::DVec3::Z * *d, ..*p })
+            .map(|(p, d)| PlacedPart { pose: Pose { position: p.pose.position + glam::DVec3::Z * *d, ..p.pose }, ..*p })
             .collect();
         Some(world_stack(&lifted)?)
     };
@@ -340,7 +341,7 @@ fn check_stack_with(
     for i in 0..n {
         let same = |&r: &usize| {
             std::ptr::eq(stack[r].part, stack[i].part)
-                && stack[r].rotation.to_cols_array() == stack[i].rotation.to_cols_array()
+                && stack[r].pose.rotation.to_cols_array() == stack[i].pose.rotation.to_cols_array()
         };
         grasp_class[i] = match representatives.iter().position(same) {
             Some(c) => c,

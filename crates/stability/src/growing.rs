@@ -53,6 +53,7 @@ use crate::equilibrium::{EquilibriumOptions, SolveCache, Verdict, solve_equilibr
 use crate::insertion::{Obstruction, insertion_obstruction};
 use crate::world::{PlacedPart, WorldPart, aabb_overlap};
 use glam::DVec3;
+use stackplan_geom::Pose;
 use stackplan_geom::Tolerance;
 use std::collections::HashMap;
 
@@ -259,7 +260,10 @@ impl<'a> GrowingStack<'a> {
                 Tolerance::for_scale((hi - lo).length()).linear
             }
         };
-        let released = PlacedPart { position: candidate.position + DVec3::Z * release_drop, ..candidate };
+        let released = PlacedPart {
+            pose: Pose { position: candidate.pose.position + DVec3::Z * release_drop, ..candidate.pose },
+            ..candidate
+        };
         let released = WorldPart::new(&released, self.world.len())?;
         Ok(crate::check::clearance_of(&released, self.world.iter(), delta, tol).1)
     }
@@ -278,8 +282,8 @@ impl<'a> GrowingStack<'a> {
         let part = candidate.part.fingerprint();
         let key: UnstableKey = (
             part,
-            candidate.rotation.to_cols_array().map(f64::to_bits),
-            candidate.position.to_array().map(f64::to_bits),
+            candidate.pose.rotation.to_cols_array().map(f64::to_bits),
+            candidate.pose.position.to_array().map(f64::to_bits),
             tol.to_bits(),
         );
         if let Some((then, verdict)) = self.unstable.get(&key)
@@ -333,7 +337,7 @@ fn test_last(
     // the grasp: a memoised radius of the same rotation decides a clear verdict; else the grasp at this pose
     let mut exact: Option<(f64, bool)> = None;
     if options.grasp.pattern.is_empty() {
-        let key = (part, candidate.rotation.to_cols_array().map(f64::to_bits));
+        let key = (part, candidate.pose.rotation.to_cols_array().map(f64::to_bits));
         let radius = match grasps.get(&key) {
             Some(r) => *r,
             None => {

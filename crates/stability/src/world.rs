@@ -6,18 +6,9 @@
 
 use crate::StabilityError;
 use glam::{DMat3, DVec3};
-use stackplan_geom::{ConvexPolytope, Part, Tolerance};
+use stackplan_geom::{ConvexPolytope, Tolerance};
 
-/// A part in a stack: the part and its pose (`world = rotation * v + position`).
-#[derive(Debug, Clone, Copy)]
-pub struct PlacedPart<'a> {
-    /// The part, in its own coordinates.
-    pub part: &'a Part,
-    /// Rotation matrix (proper, orthonormal).
-    pub rotation: DMat3,
-    /// Translation (mm).
-    pub position: DVec3,
-}
+pub use stackplan_geom::PlacedPart;
 
 /// One convex component in world coordinates with the data the separating-axis test needs.
 #[derive(Debug, Clone)]
@@ -89,8 +80,8 @@ pub fn check_rotation(rotation: DMat3, part: usize) -> Result<(), StabilityError
 /// The errors of a placed part (index `index` in its stack) that [`WorldPart::new`] and [`WorldPart::aabb_of`]
 /// refuse: a rotation that is not one, a position that is not finite, a part without components.
 fn check_placed(placed: &PlacedPart<'_>, index: usize) -> Result<(), StabilityError> {
-    check_rotation(placed.rotation, index)?;
-    if !placed.position.is_finite() {
+    check_rotation(placed.pose.rotation, index)?;
+    if !placed.pose.position.is_finite() {
         return Err(StabilityError::NonFinitePosition { part: index });
     }
     if placed.part.components.is_empty() {
@@ -107,7 +98,7 @@ impl WorldPart {
             .part
             .components
             .iter()
-            .map(|c| WorldComponent::new(c.transformed(placed.rotation, placed.position)))
+            .map(|c| WorldComponent::new(c.transformed(placed.pose.rotation, placed.pose.position)))
             .collect();
         let aabb =
             components.iter().fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), c| {
@@ -116,7 +107,7 @@ impl WorldPart {
         Ok(Self {
             name: placed.part.name.clone(),
             components,
-            center_of_gravity: placed.rotation * placed.part.mass.center_of_gravity + placed.position,
+            center_of_gravity: placed.pose.rotation * placed.part.mass.center_of_gravity + placed.pose.position,
             mass: placed.part.mass.mass,
             aabb,
         })
@@ -130,7 +121,7 @@ impl WorldPart {
             (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
             |(lo, hi), v| {
                 // `ConvexPolytope::transformed`'s arithmetic
-                let w = placed.rotation * *v + placed.position;
+                let w = placed.pose.rotation * *v + placed.pose.position;
                 (lo.min(w), hi.max(w))
             },
         ))
@@ -173,6 +164,7 @@ pub fn aabb_overlap(a: &(DVec3, DVec3), b: &(DVec3, DVec3), margin: f64) -> bool
 mod tests {
     use super::*;
     use glam::EulerRot;
+    use stackplan_geom::Pose;
 
     /// `aabb_of` is the box `WorldPart::new` builds, bit for bit, at turned poses far from the origin; and it fails
     /// where `new` fails.
@@ -183,7 +175,7 @@ mod tests {
             let t = k as f64;
             let rotation = DMat3::from_euler(EulerRot::ZYX, 0.37 * t, 0.11 * t - 2.0, 0.05 * t);
             let position = DVec3::new(1e5 * (t - 25.0).sin(), 13.7 * t, -0.3 * t);
-            let placed = PlacedPart { part: &part, rotation, position };
+            let placed = PlacedPart { part: &part, pose: Pose { rotation, position } };
             let boxed = WorldPart::aabb_of(&placed, k).expect("pose");
             let built = WorldPart::new(&placed, k).expect("pose").aabb;
             assert_eq!(boxed.0.to_array().map(f64::to_bits), built.0.to_array().map(f64::to_bits), "{k}");
@@ -191,11 +183,13 @@ mod tests {
         }
         let bad = PlacedPart {
             part: &part,
-            rotation: DMat3::from_diagonal(DVec3::new(1.0, 1.0, -1.0)),
-            position: DVec3::ZERO,
+            pose: Pose { rotation: DMat3::from_diagonal(DVec3::new(1.0, 1.0, -1.0)), position: DVec3::ZERO },
         };
         assert!(WorldPart::aabb_of(&bad, 3).is_err() && WorldPart::new(&bad, 3).is_err());
-        let nan = PlacedPart { part: &part, rotation: DMat3::IDENTITY, position: DVec3::new(f64::NAN, 0.0, 0.0) };
+        let nan = PlacedPart {
+            part: &part,
+            pose: Pose { rotation: DMat3::IDENTITY, position: DVec3::new(f64::NAN, 0.0, 0.0) },
+        };
         assert!(WorldPart::aabb_of(&nan, 3).is_err() && WorldPart::new(&nan, 3).is_err());
     }
 }

@@ -4,6 +4,7 @@
 //! separating axes' lower bound (`clearance::horizontal_distance_bound_by_axes`) against both.
 
 use crate::common;
+use stackplan_geom::Pose;
 
 use glam::{DMat3, DVec3};
 use proptest::prelude::*;
@@ -49,8 +50,8 @@ proptest! {
         let (Some(a), Some(b)) = (hull_part(&pa), hull_part(&pb)) else { return Ok(()) };
         let rotation = DMat3::from_rotation_z(turn) * DMat3::from_rotation_x(tilt);
         let stack = [
-            PlacedPart { part: &a, rotation: DMat3::IDENTITY, position: DVec3::ZERO },
-            PlacedPart { part: &b, rotation, position: DVec3::new(shift.0, shift.1, shift.2) },
+            PlacedPart { part: &a, pose: Pose { rotation: DMat3::IDENTITY, position: DVec3::ZERO } },
+            PlacedPart { part: &b, pose: Pose { rotation: rotation, position: DVec3::new(shift.0, shift.1, shift.2) } },
         ];
         let parts = world_stack(&stack).expect("world");
         let (ca, cb) = (&parts[0].components[0], &parts[1].components[0]);
@@ -77,8 +78,8 @@ proptest! {
 fn pair_distances(pa: &[DVec3], pb: &[DVec3], turn: f64, shift: DVec3) -> (f64, f64) {
     let (a, b) = (hull_part(pa).expect("hull"), hull_part(pb).expect("hull"));
     let stack = [
-        PlacedPart { part: &a, rotation: DMat3::IDENTITY, position: DVec3::ZERO },
-        PlacedPart { part: &b, rotation: DMat3::from_rotation_z(turn), position: shift },
+        PlacedPart { part: &a, pose: Pose { rotation: DMat3::IDENTITY, position: DVec3::ZERO } },
+        PlacedPart { part: &b, pose: Pose { rotation: DMat3::from_rotation_z(turn), position: shift } },
     ];
     let parts = world_stack(&stack).expect("world");
     let (ca, cb) = (&parts[0].components[0], &parts[1].components[0]);

@@ -1,6 +1,7 @@
 //! Contact patches and interference depths against analytic values.
 
 use crate::common;
+use stackplan_geom::Pose;
 
 use common::{at, box_part, cuboid};
 use glam::{DMat3, DVec2, DVec3};
@@ -59,8 +60,10 @@ fn edge_on_face_gives_a_segment() {
     // a cube standing on one edge (rotated 45 degrees about x), edge along x at height 2
     let cube = box_part("cube", DVec3::splat(4.0));
     let r = DMat3::from_rotation_x(std::f64::consts::FRAC_PI_4);
-    let c =
-        analyse(&[at(&a, DVec3::ZERO), PlacedPart { part: &cube, rotation: r, position: DVec3::new(5.0, 10.0, 2.0) }]);
+    let c = analyse(&[
+        at(&a, DVec3::ZERO),
+        PlacedPart { part: &cube, pose: Pose { rotation: r, position: DVec3::new(5.0, 10.0, 2.0) } },
+    ]);
     let ab: Vec<_> = c.patches.iter().filter(|p| p.a == Body::Part(0)).collect();
     assert_eq!(ab.len(), 1, "{c:?}");
     assert_eq!(ab[0].kind, PatchKind::Segment);
@@ -199,8 +202,14 @@ fn seam_contacts_are_vertical_and_do_not_pinch() {
     for quarter in 0..4 {
         let turn = DMat3::from_rotation_z(f64::from(quarter) * std::f64::consts::FRAC_PI_2);
         let stack = [
-            PlacedPart { part: &part, rotation: turn * rest, position: turn * DVec3::new(0.0, 65.0, 60.0) },
-            PlacedPart { part: &part, rotation: turn * rest, position: turn * DVec3::new(-75.0, 65.0, 210.0) },
+            PlacedPart {
+                part: &part,
+                pose: Pose { rotation: turn * rest, position: turn * DVec3::new(0.0, 65.0, 60.0) },
+            },
+            PlacedPart {
+                part: &part,
+                pose: Pose { rotation: turn * rest, position: turn * DVec3::new(-75.0, 65.0, 210.0) },
+            },
         ];
         let analysis = analyse(&stack);
         let between: Vec<_> = analysis.patches.iter().filter(|p| p.a == Body::Part(0) && p.b == 1).collect();

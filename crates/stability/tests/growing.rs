@@ -7,6 +7,7 @@
 //! memo per rotation).
 
 use crate::common;
+use stackplan_geom::Pose;
 
 use common::{at, box_layers, box_part, build, for_each_fixture_column, placements, planned_channels};
 use glam::{DMat3, DVec3};
@@ -176,15 +177,18 @@ fn the_grasp_memo_decides_like_the_grasp_at_each_pose() {
     // tipped on its side: the top face is 60 x 5
     let side = PlacedPart {
         part: &plank,
-        rotation: DMat3::from_rotation_x(std::f64::consts::FRAC_PI_2),
-        position: DVec3::new(0.0, 5.0, 0.0),
+        pose: Pose {
+            rotation: DMat3::from_rotation_x(std::f64::consts::FRAC_PI_2),
+            position: DVec3::new(0.0, 5.0, 0.0),
+        },
     };
     let o = options(0.5, 10.0);
     let report = check_added_part(&[side], &o).expect("added");
     assert!(!report.graspable);
     let mut growing = GrowingStack::new(&o).expect("options");
     assert_eq!(growing.check_candidate(side).expect("candidate"), Err(Rejection::NotGraspable));
-    let moved = PlacedPart { position: side.position + DVec3::new(3.0, 0.0, 0.0), ..side };
+    let moved =
+        PlacedPart { pose: Pose { position: side.pose.position + DVec3::new(3.0, 0.0, 0.0), ..side.pose }, ..side };
     assert_eq!(growing.check_candidate(moved).expect("candidate"), Err(Rejection::NotGraspable));
 }
 

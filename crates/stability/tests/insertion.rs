@@ -1,6 +1,7 @@
 //! Insertion straight down, removal straight up.
 
 use crate::common;
+use stackplan_geom::Pose;
 
 use common::{at, box_part, boxes_part};
 use glam::DVec3;
@@ -103,8 +104,8 @@ fn horizontal_distance_of_interlocking_wedges_needs_the_socp() {
     let a = prism([DVec3::ZERO, DVec3::new(l, 0.0, 0.0), DVec3::new(0.0, 0.0, h)]);
     let b = prism([DVec3::new(l + g, 0.0, 0.0), DVec3::new(l + g, 0.0, h), DVec3::new(g, 0.0, h)]);
     let stack = [
-        PlacedPart { part: &a, rotation: DMat3::IDENTITY, position: DVec3::ZERO },
-        PlacedPart { part: &b, rotation: DMat3::IDENTITY, position: DVec3::ZERO },
+        PlacedPart { part: &a, pose: Pose { rotation: DMat3::IDENTITY, position: DVec3::ZERO } },
+        PlacedPart { part: &b, pose: Pose { rotation: DMat3::IDENTITY, position: DVec3::ZERO } },
     ];
     let parts = world_stack(&stack).expect("world");
     let d = horizontal_distance(&parts[0].components[0], &parts[1].components[0]).expect("solved");

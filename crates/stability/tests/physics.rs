@@ -199,8 +199,10 @@ fn incline_sticks_or_slides_as_predicted() {
         at(&wedge, DVec3::ZERO),
         PlacedPart {
             part: &cube,
-            rotation: DMat3::from_rotation_y(beta),
-            position: DVec3::new(length, 20.0, 0.0) + up_slope * 120.0,
+            pose: stackplan_geom::Pose {
+                rotation: DMat3::from_rotation_y(beta),
+                position: DVec3::new(length, 20.0, 0.0) + up_slope * 120.0,
+            },
         },
     ];
     for (factor, stable) in [(1.3, true), (0.6, false)] {
@@ -244,7 +246,10 @@ fn example_parts_rest_in_their_poses() {
         let poses = resting_poses(&part).expect("poses");
         assert!(!poses.is_empty(), "{name}: no resting pose");
         for (k, pose) in poses.iter().enumerate() {
-            let stack = [PlacedPart { part: &part, rotation: pose.rotation, position: pose.position }];
+            let stack = [PlacedPart {
+                part: &part,
+                pose: stackplan_geom::Pose { rotation: pose.rotation, position: pose.position },
+            }];
             let report = check_stack(&stack, &opts_with_margin(0.5)).expect("check");
             assert_eq!(report.stack.verdict, Verdict::Stable, "{name} pose {k}");
             assert_eq!(report.parts[0].stable, Verdict::Stable, "{name} pose {k}");

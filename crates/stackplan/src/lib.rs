@@ -10,7 +10,7 @@
 //! ```
 //! use stackplan::geom::{DMat3, Decomposition, examples};
 //! use stackplan::planner::{FloorVolume, PlanOptions, plan_stack};
-//! use stackplan::stability::{CheckOptions, PlacedPart, check_stack};
+//! use stackplan::stability::check_stack;
 //!
 //! // the seed's Channel part (three convex components), density 1
 //! let part = examples::part_by_name("channel", Decomposition::ConvexMerge).expect("a built-in example");
@@ -22,21 +22,12 @@
 //! let plan = plan_stack(&part, &options)?;
 //! assert!(plan.stopped.is_none() && plan.parts.len() == 6 && plan.stack_stable);
 //!
-//! // world vertex = rotation . v + position (rotation given by rows)
-//! let stack: Vec<PlacedPart<'_>> = plan
-//!     .parts
-//!     .iter()
-//!     .map(|p| PlacedPart {
-//!         part: &part,
-//!         rotation: DMat3::from_cols_array_2d(&p.rotation).transpose(),
-//!         position: p.position.into(),
-//!     })
-//!     .collect();
-//! // checked with the planner's friction and cup, each part raised by its release drop
-//! let mut check = CheckOptions { mu: options.mu, ..CheckOptions::default() };
-//! check.grasp.cup_diameter = options.cup_diameter;
-//! check.release_drops = plan.parts.iter().map(|p| p.release_drop).collect();
-//! let report = check_stack(&stack, &check)?;
+//! // each planned part's pose (world vertex = rotation . v + position)
+//! let first = plan.parts[0].pose();
+//! assert!(first.position.z >= 0.0);
+//!
+//! // the plan checked again as `stackplan check` checks it: its friction, clearance, cup and release drops
+//! let report = check_stack(&plan.stack(&part), &plan.check_options())?;
 //! assert!(report.ok, "{report:?}");
 //!
 //! // the c-space obstacle of component 0 turned by 30 degrees about z against component 1 (both unplaced):

@@ -94,7 +94,7 @@ fn floor_check(stack: &[PlacedPart<'_>], floor: &FloorVolume, tolerance: f64) ->
         .filter_map(|(index, p)| {
             let (mut beyond, mut top) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
             for v in p.part.all_vertices() {
-                let w = p.rotation * v + p.position;
+                let w = p.pose.rotation * v + p.pose.position;
                 top = top.max(w.z);
                 for &(n, d) in &sides {
                     beyond = beyond.max(n.x * w.x + n.y * w.y - d);
@@ -143,11 +143,8 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let file =
         stackplan::geom::io::stack::read_stack_with(&args.stack, &crate::input::read_options(Default::default()))
             .with_context(|| format!("reading the stack {}", args.stack.display()))?;
-    let stack: Vec<PlacedPart<'_>> = file
-        .placements
-        .iter()
-        .map(|pose| PlacedPart { part: &file.part, rotation: pose.rotation, position: pose.position })
-        .collect();
+    let stack: Vec<PlacedPart<'_>> =
+        file.placements.iter().map(|pose| PlacedPart { part: &file.part, pose: *pose }).collect();
     // a plan file is checked with the planner's own friction, clearance and cup unless the command line says otherwise;
     // a `plan` that is not a summary object is an error, as for `stackplan render` (`plan_summary`)
     let plan = plan_summary(file.plan.as_ref(), &args.stack)?;

@@ -7,7 +7,8 @@ use crate::input::{PartPair, load_pair};
 use crate::output;
 use anyhow::Context;
 use serde::Serialize;
-use stackplan::cspace::interference::{PairContact, PlacedScene, Placement};
+use stackplan::cspace::interference::{PairContact, PlacedScene};
+use stackplan::geom::{PlacedPart, Pose};
 use stackplan_geom::{DMat3, DVec3};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -95,7 +96,8 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let PartPair { moving, fixed, fixed_pose, .. } =
         load_pair(&args.moving, &args.fixed, args.triangulate, args.fixed_pose.as_deref(), None)?;
     let (fixed_rotation, fixed_position) = (fixed_pose.rotation, fixed_pose.position);
-    let scene = PlacedScene::new(&[Placement { part: &fixed, rotation: fixed_rotation, position: fixed_position }]);
+    let scene =
+        PlacedScene::new(&[PlacedPart::new(&fixed, Pose { rotation: fixed_rotation, position: fixed_position })]);
     let rotation = DMat3::from_rotation_z(stackplan_geom::pose::radians_mod_turn(args.theta_deg));
     let found = scene.interference_pairs(&moving, rotation, position, args.clearance);
     let pairs: Vec<PairJson> = found

@@ -9,7 +9,7 @@ use crate::input::{PartArgs, load_part};
 use crate::output;
 use anyhow::{Context, bail};
 use serde::Serialize;
-use stackplan::planner::{Cost, FloorVolume, PlacementRequest, StackPart, place, thetas_with_step};
+use stackplan::planner::{Cost, FloorVolume, PlacedPart, PlacementRequest, place, thetas_with_step};
 use stackplan_geom::io::stack::read_stack_with;
 use stackplan_geom::{DVec2, DVec3};
 use std::path::PathBuf;
@@ -153,8 +153,8 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     };
     let height = args.height.unwrap_or(hi.z.max(0.0) + 2.0 * diag);
     let floor = FloorVolume { polygon, height };
-    let stack: Vec<StackPart<'_>> =
-        stack_file.placements.iter().map(|pose| StackPart { part: &stack_file.part, pose: *pose }).collect();
+    let stack: Vec<PlacedPart<'_>> =
+        stack_file.placements.iter().map(|pose| PlacedPart { part: &stack_file.part, pose: *pose }).collect();
     let mut request = PlacementRequest::new(&part, stack, floor.clone());
     request.thetas = thetas_with_step(args.dtheta_deg.to_radians()).context("--dtheta-deg")?;
     request.clearance = args.clearance;

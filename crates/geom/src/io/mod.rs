@@ -39,7 +39,7 @@ pub use atomic::{write_all_atomic, write_atomic};
 pub use glb::{GlbItem, write_glb};
 pub use json::{parse_part_json, part_json_string, read_part_json, write_part_json};
 pub use obj::{obj_scene_string, obj_string, parse_obj, read_obj, write_obj, write_obj_scene};
-pub use stack::{StackFile, StackPart, read_stack, read_stack_with, write_stack};
+pub use stack::{PlacedPart, StackFile, read_stack, read_stack_with, write_stack};
 pub use stl::{parse_stl, read_stl, stl_ascii_string, stl_binary_bytes, write_stl_ascii, write_stl_binary};
 
 /// Largest accepted coordinate magnitude (mm): 10^9 mm = 1000 km. Larger values are certainly input errors and would
@@ -372,7 +372,7 @@ pub enum IoError {
     },
     /// The part referenced by a stack file could not be read.
     #[error("{}: key `part`: {source}", file.display())]
-    StackPart {
+    PlacedPart {
         /// The stack file.
         file: PathBuf,
         /// The part file's error (names the part file).
@@ -408,7 +408,7 @@ impl IoError {
             | IoError::MissingReference { file, .. }
             | IoError::SeveralSolids { file, .. }
             | IoError::NoSuchSolid { file, .. }
-            | IoError::StackPart { file, .. } => file,
+            | IoError::PlacedPart { file, .. } => file,
         }
     }
 

@@ -37,7 +37,7 @@ pub struct StackFile {
 
 /// How [`write_stack`] refers to the part.
 #[derive(Debug, Clone, Copy)]
-pub enum StackPart<'a> {
+pub enum PlacedPart<'a> {
     /// A path, written as given (it should be relative to the stack file's directory).
     Path(&'a Path),
     /// The part inline, in the convex-pieces form.
@@ -82,7 +82,7 @@ pub fn parse_stack(bytes: &[u8], file: &Path, options: &ReadOptions) -> Result<S
             let dir = file.parent().unwrap_or_else(|| Path::new(""));
             let part_path = dir.join(&relative);
             let part = super::read_part(&part_path, options)
-                .map_err(|e| IoError::StackPart { file: file.to_path_buf(), source: Box::new(e) })?;
+                .map_err(|e| IoError::PlacedPart { file: file.to_path_buf(), source: Box::new(e) })?;
             (part, Some(part_path))
         }
         value @ Value::Object(_) => {
@@ -116,10 +116,10 @@ pub fn parse_stack(bytes: &[u8], file: &Path, options: &ReadOptions) -> Result<S
 }
 
 /// The stack file text. `extras[i]` (if present) is merged into placement `i` (it cannot override the pose keys).
-pub fn stack_json_string(part: StackPart<'_>, placements: &[Pose], extras: &[Map<String, Value>]) -> String {
+pub fn stack_json_string(part: PlacedPart<'_>, placements: &[Pose], extras: &[Map<String, Value>]) -> String {
     let part_text = match part {
-        StackPart::Path(p) => Value::String(p.to_string_lossy().into_owned()).to_string(),
-        StackPart::Inline(part) => part_json_value_string(part, "  "),
+        PlacedPart::Path(p) => Value::String(p.to_string_lossy().into_owned()).to_string(),
+        PlacedPart::Inline(part) => part_json_value_string(part, "  "),
     };
     let mut lines = Vec::with_capacity(placements.len());
     for (i, pose) in placements.iter().enumerate() {
@@ -140,14 +140,14 @@ pub fn stack_json_string(part: StackPart<'_>, placements: &[Pose], extras: &[Map
 }
 
 /// Writes a stack file atomically.
-pub fn write_stack(path: impl AsRef<Path>, part: StackPart<'_>, placements: &[Pose]) -> Result<(), IoError> {
+pub fn write_stack(path: impl AsRef<Path>, part: PlacedPart<'_>, placements: &[Pose]) -> Result<(), IoError> {
     write_stack_with_extras(path, part, placements, &[])
 }
 
 /// Writes a stack file with extra keys per placement, atomically.
 pub fn write_stack_with_extras(
     path: impl AsRef<Path>,
-    part: StackPart<'_>,
+    part: PlacedPart<'_>,
     placements: &[Pose],
     extras: &[Map<String, Value>],
 ) -> Result<(), IoError> {

@@ -41,7 +41,7 @@ pub struct SearchCaches {
 pub(super) type SceneKey = (u64, [u64; 12]);
 
 /// The [`SceneKey`]s of a stack (the fingerprint computed once per distinct part).
-pub(super) fn scene_keys(stack: &[crate::request::StackPart<'_>]) -> Vec<SceneKey> {
+pub(super) fn scene_keys(stack: &[crate::PlacedPart<'_>]) -> Vec<SceneKey> {
     let mut fingerprints: Vec<(*const stackplan_geom::Part, u64)> = Vec::new();
     stack
         .iter()

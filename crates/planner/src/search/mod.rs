@@ -208,11 +208,11 @@ impl std::fmt::Debug for States {
 /// use glam::DVec3;
 /// use stackplan_cspace::ObstacleCache;
 /// use stackplan_geom::{ConvexPolytope, Part, PartOrigin, Pose};
-/// use stackplan_planner::{FloorVolume, PlacementRequest, PlacementSearch, SearchCaches, StackPart, uniform_thetas};
+/// use stackplan_planner::{FloorVolume, PlacementRequest, PlacementSearch, SearchCaches, PlacedPart, uniform_thetas};
 ///
 /// let block = ConvexPolytope::cuboid(DVec3::ZERO, DVec3::new(40.0, 20.0, 10.0))?;
 /// let part = Part::from_components("block", vec![block], 1.0, PartOrigin::ConvexPieces)?;
-/// let stack = vec![StackPart { part: &part, pose: Pose::IDENTITY }];
+/// let stack = vec![PlacedPart { part: &part, pose: Pose::IDENTITY }];
 /// let mut request = PlacementRequest::new(&part, stack, FloorVolume::rectangle(-50.0, -50.0, 90.0, 70.0, 100.0));
 /// request.thetas = uniform_thetas(8);
 /// let (cache, mut caches) = (ObstacleCache::new(), SearchCaches::new());

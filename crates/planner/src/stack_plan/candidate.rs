@@ -89,7 +89,7 @@ impl Candidate<'_> {
         // (should the check's measure and the search's obstacles disagree within their tolerances) at the search's
         // own
         if matches!(verdict, Verdict::Passed { .. }) && options.clearance > 0.0 {
-            let placed = PlacedPart { part, rotation: pose.rotation, position: pose.position };
+            let placed = PlacedPart { part, pose };
             let keeps = |drop: f64, growing: &mut GrowingStack<'_>| {
                 growing.keeps_clearance(placed, drop, options.clearance).map_err(|e| PlanError::Check(e.to_string()))
             };
@@ -144,9 +144,7 @@ fn accept(
     stats: &mut PlanStats,
 ) -> Result<Verdict, PlanError> {
     let pose = candidate.pose();
-    let tested = growing
-        .check_candidate(PlacedPart { part, rotation: pose.rotation, position: pose.position })
-        .map_err(|e| PlanError::Check(e.to_string()))?;
+    let tested = growing.check_candidate(PlacedPart { part, pose }).map_err(|e| PlanError::Check(e.to_string()))?;
     if let Err(
         Rejection::NotStable(Equilibrium::Unknown(status)) | Rejection::StackNotStable(Equilibrium::Unknown(status)),
     ) = &tested

@@ -57,7 +57,7 @@ use glam::{DMat3, DVec2, DVec3};
 use part::Planner;
 use serde::{Deserialize, Serialize};
 use stackplan_cspace::cache::ObstacleCache;
-use stackplan_geom::{Part, Tolerance};
+use stackplan_geom::{Part, Pose, Tolerance};
 use stackplan_stability::check::{CheckOptions, check_stack};
 use stackplan_stability::grasp::{GraspOptions, grasp_faces, is_graspable};
 use stackplan_stability::growing::{GrowingStack, ToleranceScale};
@@ -219,6 +219,13 @@ pub struct PlannedPart {
     pub grasp_radius: f64,
 }
 
+impl PlannedPart {
+    /// Its pose: world vertex = `rotation . v + position`.
+    pub fn pose(&self) -> Pose {
+        Pose { rotation: DMat3::from_cols_array_2d(&self.rotation).transpose(), position: DVec3::from(self.position) }
+    }
+}
+
 /// Counters and timings of a plan.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct PlanStats {
@@ -289,6 +296,27 @@ pub struct Plan {
     pub stack_stable: bool,
     /// Counters and timings.
     pub stats: PlanStats,
+}
+
+impl Plan {
+    /// The planned parts as a stack of copies of `part` (the part the plan was made for), in placing order: the
+    /// input of [`check_stack`].
+    pub fn stack<'a>(&self, part: &'a Part) -> Vec<PlacedPart<'a>> {
+        self.parts.iter().map(|p| PlacedPart::new(part, p.pose())).collect()
+    }
+
+    /// The options that check this plan as `stackplan check` does: its friction, clearance, suction cup and grasp
+    /// tilt, each part raised by its release drop, with robustness margins and every intermediate stack checked.
+    pub fn check_options(&self) -> CheckOptions {
+        let o = &self.options;
+        CheckOptions {
+            mu: o.mu,
+            clearance: o.clearance,
+            grasp: GraspOptions { cup_diameter: o.cup_diameter, max_tilt: o.grasp_tilt, ..GraspOptions::default() },
+            release_drops: self.parts.iter().map(|p| p.release_drop).collect(),
+            ..CheckOptions::default()
+        }
+    }
 }
 
 /// Why no plan could be made at all.
@@ -476,8 +504,7 @@ fn graspable_rests(part: &Part, options: &PlanOptions, grasp: &GraspOptions) -> 
 fn finish(planner: Planner<'_>, check_options: &CheckOptions, stopped: Option<String>) -> Result<Plan, PlanError> {
     let Planner { part, options, rests, cache, caches, floor_caches, placed, mut planned, mut stats, .. } = planner;
     let started = std::time::Instant::now();
-    let world: Vec<PlacedPart<'_>> =
-        placed.iter().map(|p| PlacedPart { part, rotation: p.rotation, position: p.position }).collect();
+    let world: Vec<PlacedPart<'_>> = placed.iter().map(|p| PlacedPart { part, pose: *p }).collect();
     let final_check =
         check_stack(&world, &CheckOptions { margin_directions: 8, prefix_stability: true, ..check_options.clone() })
             .map_err(|e| PlanError::Check(e.to_string()))?;
@@ -610,7 +637,7 @@ mod tests {
             .iter()
             .map(|p| {
                 let pose = Pose::from_rows(p.rotation, DVec3::from_array(p.position)).expect("a proper rotation");
-                PlacedPart { part, rotation: pose.rotation, position: pose.position }
+                PlacedPart { part, pose }
             })
             .collect();
         let report = check_stack(&world, &CheckOptions::default()).expect("check");

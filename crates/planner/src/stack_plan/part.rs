@@ -9,7 +9,7 @@ use super::candidate::{Candidate, Verdict};
 use super::floor::{clip_to_rectangle, footprint};
 use super::{PlanError, PlanOptions, PlanStats, PlannedPart};
 use crate::orientation::Orientation;
-use crate::request::{Cost, FloorVolume, PlacementError, PlacementRequest, StackPart};
+use crate::request::{Cost, FloorVolume, PlacementError, PlacementRequest};
 use crate::search::{NoPlacement, Placement, PlacementSearch, SearchCaches};
 use glam::{DMat3, DVec2, DVec3};
 use stackplan_cspace::cache::ObstacleCache;
@@ -111,9 +111,7 @@ impl<'p> Planner<'p> {
         let (part, candidate) = (self.part, &best.candidate);
         let pose = candidate.pose();
         self.placed.push(pose);
-        self.growing
-            .push(PlacedPart { part, rotation: pose.rotation, position: pose.position })
-            .map_err(|e| PlanError::Check(e.to_string()))?;
+        self.growing.push(PlacedPart { part, pose }).map_err(|e| PlanError::Check(e.to_string()))?;
         self.planned.push(PlannedPart {
             position: candidate.position,
             rotation: candidate.rotation,
@@ -351,7 +349,7 @@ impl<'p> Planned<'_, 'p> {
         searched_elsewhere: Option<Vec<DVec2>>,
     ) -> PlacementRequest<'p> {
         let (part, options) = (self.part, self.options);
-        let stack: Vec<StackPart<'p>> = self.placed.iter().map(|&pose| StackPart { part, pose }).collect();
+        let stack: Vec<PlacedPart<'p>> = self.placed.iter().map(|&pose| PlacedPart { part, pose }).collect();
         let mut request = PlacementRequest::new(part, stack, floor);
         request.tuning.searched_elsewhere = searched_elsewhere;
         request.resting_rotations = self.rests.to_vec();

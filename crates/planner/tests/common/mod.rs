@@ -31,7 +31,7 @@ pub fn box_or_l(
 /// steps, 2 mm horizontal clearance, insertion, cost (1) with `w = 0.3` about the origin, the four best.
 pub fn growing_stack_request<'a>(
     part: &'a Part,
-    stack: Vec<stackplan_planner::StackPart<'a>>,
+    stack: Vec<stackplan_planner::PlacedPart<'a>>,
     floor: stackplan_planner::FloorVolume,
 ) -> stackplan_planner::PlacementRequest<'a> {
     let mut req = stackplan_planner::PlacementRequest::new(part, stack, floor);

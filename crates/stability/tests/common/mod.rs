@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 use glam::{DMat3, DVec3};
+use stackplan_geom::Pose;
 use stackplan_geom::{ConvexPolytope, Part, PartOrigin, convex_hull};
 use stackplan_stability::PlacedPart;
 use stackplan_stability::contacts::analyse_contacts;
@@ -53,7 +54,7 @@ pub fn wedge_part(name: &str, length: f64, height: f64, width: f64) -> Part {
 
 /// A placement with identity rotation.
 pub fn at(part: &Part, position: DVec3) -> PlacedPart<'_> {
-    PlacedPart { part, rotation: DMat3::IDENTITY, position }
+    PlacedPart { part, pose: Pose { rotation: DMat3::IDENTITY, position: position } }
 }
 
 /// Margins agree within 1e-6 relative (both absent, or both present).
@@ -68,7 +69,10 @@ pub fn same_margin(fast: Option<f64>, plain: Option<f64>) -> bool {
 /// (bisection on the interference test): the copy then rests on (or nests in) the one below.
 pub fn nesting_height(placed: PlacedPart<'_>, dx: f64, dy: f64, upper: f64) -> f64 {
     let interferes = |dz: f64| {
-        let top = PlacedPart { position: placed.position + DVec3::new(dx, dy, dz), ..placed };
+        let top = PlacedPart {
+            pose: Pose { position: placed.pose.position + DVec3::new(dx, dy, dz), ..placed.pose },
+            ..placed
+        };
         let parts = world_stack(&[placed, top]).expect("world");
         let tol = stack_tolerance(&parts).linear;
         !analyse_contacts(&parts, tol, |_| true).interferences.is_empty()
@@ -107,7 +111,7 @@ pub fn fixture_parts() -> Vec<(std::path::PathBuf, Part)> {
 pub fn fixture_columns(part: &Part, pose: usize, dx: f64, dy: f64) -> Vec<PlacedPart<'_>> {
     let poses = resting_poses(part).expect("poses");
     let pose = &poses[pose.min(poses.len() - 1)];
-    let base = PlacedPart { part, rotation: pose.rotation, position: pose.position };
+    let base = PlacedPart { part, pose: Pose { rotation: pose.rotation, position: pose.position } };
     let parts = world_stack(&[base]).expect("world");
     let size = parts[0].aabb.1 - parts[0].aabb.0;
     let rise = nesting_height(base, dx, dy, size.z + 1.0);
@@ -116,7 +120,7 @@ pub fn fixture_columns(part: &Part, pose: usize, dx: f64, dy: f64) -> Vec<Placed
         for column in 0..2 {
             let shift =
                 DVec3::new((size.x + 20.0) * column as f64 + dx * level as f64, dy * level as f64, rise * level as f64);
-            out.push(PlacedPart { position: base.position + shift, ..base });
+            out.push(PlacedPart { pose: Pose { position: base.pose.position + shift, ..base.pose }, ..base });
         }
     }
     out
@@ -163,8 +167,5 @@ pub fn planned_channels() -> stackplan_geom::io::stack::StackFile {
 
 /// The placements of a stack file.
 pub fn placements(plan: &stackplan_geom::io::stack::StackFile) -> Vec<PlacedPart<'_>> {
-    plan.placements
-        .iter()
-        .map(|p| PlacedPart { part: &plan.part, rotation: p.rotation, position: p.position })
-        .collect()
+    plan.placements.iter().map(|p| PlacedPart { part: &plan.part, pose: *p }).collect()
 }
