@@ -64,12 +64,12 @@ fn part(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
     let p = load_part(scenario, "part", dir)?;
     let (lo, hi) = p.aabb();
     let mut f = Fields::new();
-    f.insert("components".into(), p.components.len().into());
-    f.insert("volume".into(), p.mass.volume.into());
-    f.insert("center_of_gravity".into(), p.mass.center_of_gravity.to_array().to_vec().into());
+    f.insert("components".into(), p.components().len().into());
+    f.insert("volume".into(), p.mass().volume.into());
+    f.insert("center_of_gravity".into(), p.mass().center_of_gravity.to_array().to_vec().into());
     f.insert("bounding_box_min".into(), lo.to_array().to_vec().into());
     f.insert("bounding_box_max".into(), hi.to_array().to_vec().into());
-    f.insert("boundary_faces".into(), p.boundary.len().into());
+    f.insert("boundary_faces".into(), p.boundary().len().into());
     f.insert("vertices".into(), p.vertex_count().into());
     // a part recognised from CAD: what was recognised
     if let stackplan_geom::PartOrigin::RecognisedSheet { thickness, plates, bends, solid_volume, max_deviation } =
@@ -141,8 +141,8 @@ fn contacts(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
     let moving = load_part(scenario, "moving", dir)?;
     let fixed = load_part(scenario, "fixed", dir)?;
     let (rotation, position) = fixed_pose(scenario)?;
-    let placed = fixed.components.iter().map(|c| c.transformed(rotation, position)).collect();
-    let fixed = Part::from_components(fixed.name.clone(), placed, fixed.density, fixed.origin.clone())?;
+    let placed = fixed.components().iter().map(|c| c.transformed(rotation, position)).collect();
+    let fixed = Part::from_components(fixed.name.clone(), placed, fixed.density(), fixed.origin.clone())?;
     let bound = |key: &str| -> anyhow::Result<[f64; 6]> {
         let v: [f64; 6] = serde_json::from_value(scenario.get(key).cloned().with_context(|| format!("no {key:?}"))?)?;
         Ok([v[0], v[1], v[2], v[3].to_radians(), v[4].to_radians(), v[5].to_radians()])
@@ -188,7 +188,7 @@ fn obstacle(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
     let moving = load_part(scenario, "moving", dir)?;
     let fixed = load_part(scenario, "fixed", dir)?;
     let (rotation, translation) = fixed_pose(scenario)?;
-    let placed: Vec<_> = fixed.components.iter().map(|c| c.transformed(rotation, translation)).collect();
+    let placed: Vec<_> = fixed.components().iter().map(|c| c.transformed(rotation, translation)).collect();
     let angles: Vec<f64> = scenario
         .get("theta_deg")
         .map(|v| serde_json::from_value(v.clone()))
@@ -200,7 +200,7 @@ fn obstacle(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
     for theta in &angles {
         let r = stackplan_geom::DMat3::from_rotation_z(stackplan_geom::pose::radians_mod_turn(*theta));
         let (mut v_row, mut f_row, mut vol_row) = (Vec::new(), Vec::new(), Vec::new());
-        for (i, a) in moving.components.iter().enumerate() {
+        for (i, a) in moving.components().iter().enumerate() {
             for (j, b) in placed.iter().enumerate() {
                 let o = obstacle(a, r, b).with_context(|| format!("theta {theta} deg, pair ({i}, {j})"))?;
                 o.polytope().validate().with_context(|| format!("theta {theta} deg, pair ({i}, {j}): invalid"))?;
@@ -291,7 +291,9 @@ fn layer_counts(part: &Part, poses: &[Pose]) -> Vec<usize> {
     let gap = 0.01 * (hi.z - lo.z);
     let mut bottoms: Vec<f64> = poses
         .iter()
-        .map(|p| part.components.iter().flat_map(|c| c.vertices()).map(|v| p.apply(*v).z).fold(f64::INFINITY, f64::min))
+        .map(|p| {
+            part.components().iter().flat_map(|c| c.vertices()).map(|v| p.apply(*v).z).fold(f64::INFINITY, f64::min)
+        })
         .collect();
     bottoms.sort_by(f64::total_cmp);
     let mut counts = Vec::new();

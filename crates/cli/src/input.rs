@@ -241,11 +241,15 @@ pub fn load_pair(
     let only = pair.map(parse_pair).transpose()?;
     if let Some((i, j)) = only {
         anyhow::ensure!(
-            i < moving.components.len(),
+            i < moving.components().len(),
             "--pair: the moving part has {} components",
-            moving.components.len()
+            moving.components().len()
         );
-        anyhow::ensure!(j < fixed.components.len(), "--pair: the fixed part has {} components", fixed.components.len());
+        anyhow::ensure!(
+            j < fixed.components().len(),
+            "--pair: the fixed part has {} components",
+            fixed.components().len()
+        );
     }
     Ok(PartPair { moving, fixed, fixed_pose, only })
 }

@@ -365,14 +365,14 @@ fn frame_scene(file: &PlanFile, count: usize, new_from: usize, floor: Vec<DVec3>
     for (i, pose) in file.poses.iter().enumerate().take(count) {
         let new = i >= new_from;
         let color = if new { part_color(i) } else { MUTED };
-        for c in &file.part.components {
+        for c in file.part.components() {
             scene.solids.push(Solid { polytope: c.transformed(pose.rotation, pose.position), color, part: i });
         }
         // every new part is numbered in the stack picture and in one-part frames; a frame adding several parts
         // numbers only its last one (small parts' numbers would cover each other)
         let numbered = new && (number_all || i + 1 == count);
         if numbered {
-            let cg = pose.apply(file.part.mass.center_of_gravity);
+            let cg = pose.apply(file.part.mass().center_of_gravity);
             scene.labels.push((i + 1, cg));
             scene.markers.push(Marker { position: cg, color: CG_MARK });
         }
@@ -623,7 +623,7 @@ Plan: <a href="plan.json">plan.json</a> (a stack file: <code>stackplan check pla
         origin = file
             .part_origin
             .as_ref()
-            .and_then(|o| crate::input::origin_note(o, part.mass.volume))
+            .and_then(|o| crate::input::origin_note(o, part.mass().volume))
             .map(|n| format!("<p id=\"origin\">Part: {}.</p>\n", esc(&n)))
             .unwrap_or_default(),
         placed = file.poses.len(),

@@ -22,7 +22,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         seed: args.get(3).copied().unwrap_or(2004),
     };
     let l = stackplan_geom::examples::l_corner_part();
-    let shifted: Vec<_> = l.components.iter().map(|c| c.transformed(DMat3::IDENTITY, DVec3::splat(-20.0))).collect();
+    let shifted: Vec<_> = l.components().iter().map(|c| c.transformed(DMat3::IDENTITY, DVec3::splat(-20.0))).collect();
     let l = Part::from_components("l-corner", shifted, 1.0, PartOrigin::ConvexPieces)?;
     let fixed = ContactPart::from_part(&l)?;
     let moving = ContactPart::from_part(&stackplan_geom::examples::block_part())?;

@@ -55,7 +55,7 @@ impl ContactPart {
     /// From a geometry-kernel part (its components are the convex pieces).
     pub fn from_part(part: &Part) -> Result<Self, SurfaceError> {
         let surface = SurfaceElements::from_part(part)?;
-        let pieces = part.components.iter().map(ConvexPiece::from_polytope).collect();
+        let pieces = part.components().iter().map(ConvexPiece::from_polytope).collect();
         Ok(Self::new(part.name.clone(), surface, pieces))
     }
 

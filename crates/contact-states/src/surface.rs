@@ -225,7 +225,7 @@ impl SurfaceElements {
     /// The surface of a part: the boundary of the union of its convex components.
     pub fn from_part(part: &Part) -> Result<Self, SurfaceError> {
         let facets: Vec<Vec<DVec3>> = part
-            .components
+            .components()
             .iter()
             .flat_map(|c| c.faces().iter().map(move |f| f.vertices.iter().map(|&v| c.vertices()[v]).collect()))
             .collect();

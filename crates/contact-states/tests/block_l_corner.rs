@@ -31,7 +31,7 @@ use crate::common;
 
 fn geom_parts() -> (Part, Part) {
     let l = stackplan_geom::examples::l_corner_part();
-    let shifted: Vec<_> = l.components.iter().map(|c| c.transformed(DMat3::IDENTITY, DVec3::splat(-20.0))).collect();
+    let shifted: Vec<_> = l.components().iter().map(|c| c.transformed(DMat3::IDENTITY, DVec3::splat(-20.0))).collect();
     let l = Part::from_components("l-corner", shifted, 1.0, PartOrigin::ConvexPieces).expect("part");
     (l, stackplan_geom::examples::block_part())
 }

@@ -30,7 +30,7 @@ fn polytopes() -> Vec<ConvexPolytope> {
     for decomposition in [Decomposition::ConvexMerge, Decomposition::Triangulation] {
         for path in &names {
             let part = read_part(path, &ReadOptions { decomposition, ..Default::default() }).expect("part");
-            for (k, c) in part.components.into_iter().enumerate() {
+            for (k, c) in part.components().iter().cloned().enumerate() {
                 if decomposition == Decomposition::ConvexMerge || k % 5 == 0 {
                     out.push(c);
                 }

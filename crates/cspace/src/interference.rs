@@ -391,7 +391,7 @@ impl PlacedScene {
         for (pi, placement) in parts.iter().enumerate() {
             let (lo, hi) = placement.part.aabb();
             scale = scale.max((hi - lo).length());
-            for (ci, c) in placement.part.components.iter().enumerate() {
+            for (ci, c) in placement.part.components().iter().enumerate() {
                 components.push((pi, ci, PlacedConvex::new(c, placement.pose.rotation, placement.pose.position)));
             }
         }
@@ -452,7 +452,7 @@ impl PlacedScene {
         let (lo, hi) = moving.aabb();
         let tol = self.tolerance.linear.max(Tolerance::for_scale((hi - lo).length()).linear);
         let mut out = Vec::new();
-        for (mi, c) in moving.components.iter().enumerate() {
+        for (mi, c) in moving.components().iter().enumerate() {
             let placed = PlacedConvex::new(c, rotation, position);
             for k in candidates(&placed, tol) {
                 let (fixed_part, fixed_piece, other) = &self.components[k];

@@ -23,7 +23,7 @@ fn sheet_piece(scale: f64) -> ConvexPolytope {
 fn example_piece() -> impl Strategy<Value = ConvexPolytope> {
     (prop::sample::select(vec!["triangle", "channel", "complex"]), 0usize..64).prop_map(|(name, k)| {
         let part = stackplan_geom::examples::part_by_name(name, Decomposition::ConvexMerge).expect("example");
-        part.components[k % part.components.len()].clone()
+        part.components()[k % part.components().len()].clone()
     })
 }
 
@@ -174,8 +174,8 @@ fn triangle_parts_a_few_tolerances_apart() {
     let (mut checked, mut wrong) = (0, Vec::new());
     for theta in [0.0f64, 17.3] {
         let r = DMat3::from_rotation_z(theta.to_radians());
-        for a in &part.components {
-            for b in &part.components {
+        for a in part.components() {
+            for b in part.components() {
                 let c = obstacle_by_hull(a, r, b).expect("obstacle");
                 let placed_b = PlacedConvex::new(b, DMat3::IDENTITY, DVec3::ZERO);
                 for face in c.polytope().faces() {

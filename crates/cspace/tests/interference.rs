@@ -61,9 +61,9 @@ proptest! {
         let found = scene.interference_pairs(&moving, r, p, clearance);
         let brute = scene.interference_pairs_brute_force(&moving, r, p, clearance);
         prop_assert_eq!(&found, &brute, "BVH result differs from the brute-force SAT");
-        for (mi, a) in moving.components.iter().enumerate() {
+        for (mi, a) in moving.components().iter().enumerate() {
             for (fp, (part, rot, pos)) in fixed.iter().enumerate() {
-                for (fi, b) in part.components.iter().enumerate() {
+                for (fi, b) in part.components().iter().enumerate() {
                     let world_b = b.transformed(*rot, *pos);
                     let Some((expected, t)) = lp_contact(a, r, p, &world_b) else { continue };
                     let hit = found.iter().find(|x| x.moving_piece == mi && x.fixed_part == fp && x.fixed_piece == fi);

@@ -327,8 +327,8 @@ fn triangle_pieces_just_off_critical_orientations() {
     for base in [0.0, std::f64::consts::FRAC_PI_2] {
         for turn in [1e-9, 1e-8, 1e-7f64.to_radians(), 1e-7, 1e-6, 1e-5, -1e-7, -1e-6] {
             let r = DMat3::from_rotation_z(base + turn);
-            for a in &part.components {
-                for b in &part.components {
+            for a in part.components() {
+                for b in part.components() {
                     let o = obstacle(a, r, b).expect("obstacle");
                     let pts = differences(a, r, b);
                     let tol = Tolerance::for_scale(stackplan_geom::tolerance::bounding_diagonal(&pts)).linear;

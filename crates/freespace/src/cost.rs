@@ -175,7 +175,7 @@ impl RotatedExtents {
 
     /// Extents of `part` rotated by `rotation` (uniform density c.g. from the part's mass properties).
     pub fn of_part(part: &Part, rotation: DMat3) -> Result<Self, CostError> {
-        Self::from_points(part.all_vertices().map(|v| rotation * v), rotation * part.mass.center_of_gravity)
+        Self::from_points(part.all_vertices().map(|v| rotation * v), rotation * part.mass().center_of_gravity)
     }
 }
 

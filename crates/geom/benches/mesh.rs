@@ -32,7 +32,7 @@ fn bench(c: &mut Criterion) {
     let complex = stackplan_geom::examples::part_by_name("complex", Default::default()).expect("complex");
     let turn = DMat3::from_euler(glam::EulerRot::ZYX, 0.3, 0.7, 1.1);
     let turned: Vec<_> = complex
-        .components
+        .components()
         .iter()
         .map(|c| {
             let pts: Vec<DVec3> = c.vertices().iter().map(|&v| turn * v + DVec3::new(12.5, -7.0, 30.0)).collect();

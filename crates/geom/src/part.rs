@@ -75,26 +75,28 @@ pub enum PartError {
     ZeroVolume(usize),
 }
 
-/// A rigid part: convex components with disjoint interiors, mass properties and boundary faces.
+/// A rigid part: convex components with disjoint interiors, mass properties and boundary faces. The components are
+/// fixed at construction and everything derived from them (boundary, mass, plates, and the cache keys built from
+/// them) is read through accessors, so it cannot drift from them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Part {
     /// Name of the part (from the file).
     pub name: String,
     /// Convex components, in the part's own coordinates.
-    pub components: Vec<ConvexPolytope>,
+    pub(crate) components: Vec<ConvexPolytope>,
     /// Boundary faces of the union of the components.
-    pub boundary: Vec<BoundaryFace>,
+    pub(crate) boundary: Vec<BoundaryFace>,
     /// Mass properties (uniform density).
-    pub mass: MassProperties,
+    pub(crate) mass: MassProperties,
     /// Density used for the mass (1.0 when the file gives none: mass = volume).
-    pub density: f64,
+    pub(crate) density: f64,
     /// How the part was made.
     pub origin: PartOrigin,
     /// Flat plates: the components that came from one sheet-metal face with a convex outline (empty for other
     /// parts). A search may let a plate's pieces stand for its filled outline where that is exact
     /// ([`crate::plate::merges_exactly`], [`crate::plate::slices_clear_holes`]); nothing else depends on them.
     #[serde(default)]
-    pub plates: Vec<Plate>,
+    pub(crate) plates: Vec<Plate>,
 }
 
 /// The point a part's moments are summed about (see `mass`: about the origin, a part far from it loses digits of
@@ -117,6 +119,32 @@ fn moment_reference(components: &[ConvexPolytope]) -> DVec3 {
 }
 
 impl Part {
+    /// The convex components, in the part's own coordinates.
+    pub fn components(&self) -> &[ConvexPolytope] {
+        &self.components
+    }
+
+    /// The boundary faces of the union of the components.
+    pub fn boundary(&self) -> &[BoundaryFace] {
+        &self.boundary
+    }
+
+    /// The mass properties (uniform density).
+    pub fn mass(&self) -> &MassProperties {
+        &self.mass
+    }
+
+    /// The density the mass was computed with (1.0 when the file gives none: mass = volume).
+    pub fn density(&self) -> f64 {
+        self.density
+    }
+
+    /// The flat plates: the components that came from one sheet-metal face with a convex outline (empty for other
+    /// parts).
+    pub fn plates(&self) -> &[Plate] {
+        &self.plates
+    }
+
     /// Builds a part from its convex components. O(total size) plus a hash of faces for the boundary.
     pub fn from_components(
         name: impl Into<String>,

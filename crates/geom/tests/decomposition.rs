@@ -44,7 +44,7 @@ fn perimeter(face: &SheetFace) -> f64 {
 }
 
 fn boundary_area(part: &stackplan_geom::Part) -> f64 {
-    part.boundary.iter().map(|b| ring_area(&b.outline) - b.holes.iter().map(|h| ring_area(h)).sum::<f64>()).sum()
+    part.boundary().iter().map(|b| ring_area(&b.outline) - b.holes.iter().map(|h| ring_area(h)).sum::<f64>()).sum()
 }
 
 fn face_area(face: &SheetFace) -> f64 {
@@ -178,7 +178,7 @@ fn example_component_counts_match_the_seed() {
         let counts = check_model(&model, Decomposition::Triangulation);
         assert_eq!(counts.iter().sum::<usize>(), expected, "{name}");
         let part = model.build_part(name, 1.0, Decomposition::Triangulation).expect("part");
-        assert_eq!(part.components.len(), expected, "{name}");
+        assert_eq!(part.components().len(), expected, "{name}");
         assert_eq!(part.origin, PartOrigin::SheetMetal { thickness: 2.0 });
         let merged = check_model(&model, Decomposition::ConvexMerge);
         assert!(merged.iter().sum::<usize>() <= expected, "{name}: merging gave more pieces");
@@ -208,31 +208,31 @@ fn complex_part_counts() {
 fn example_volumes_and_shapes() {
     let channel = examples::channel().build_part("channel", 1.0, Decomposition::ConvexMerge).expect("channel");
     // three plates: 200 x 100 + 2 x (200 x 50), thickness 2
-    assert!((channel.mass.volume - 2.0 * (20000.0 + 20000.0)).abs() < 1e-6);
+    assert!((channel.mass().volume - 2.0 * (20000.0 + 20000.0)).abs() < 1e-6);
     let (lo, hi) = channel.aabb();
     assert!(
         (lo - DVec3::new(0.0, -1.0, -1.0)).length() < 1e-12 && (hi - DVec3::new(200.0, 101.0, 50.0)).length() < 1e-12
     );
 
     let triangle = examples::triangle().build_part("triangle", 1.0, Decomposition::ConvexMerge).expect("triangle");
-    assert_eq!(triangle.components.len(), 6);
+    assert_eq!(triangle.components().len(), 6);
     let (lo, hi) = triangle.aabb();
     assert!(lo.z < 0.0 && hi.z > 40.0 && hi.z < 42.0);
 
     let cube = examples::cube();
-    assert_eq!(cube.components.len(), 1);
-    assert!((cube.mass.volume - 1.0).abs() < 1e-15);
+    assert_eq!(cube.components().len(), 1);
+    assert!((cube.mass().volume - 1.0).abs() < 1e-15);
     let corner = examples::l_corner_part();
-    assert_eq!(corner.components.len(), 3);
-    assert!((corner.mass.volume - (150.0 * 150.0 * 20.0 + 20.0 * 150.0 * 100.0 + 130.0 * 20.0 * 100.0)).abs() < 1e-6);
+    assert_eq!(corner.components().len(), 3);
+    assert!((corner.mass().volume - (150.0 * 150.0 * 20.0 + 20.0 * 150.0 * 100.0 + 130.0 * 20.0 * 100.0)).abs() < 1e-6);
     let block = examples::block_part();
-    assert!((block.mass.volume - 80.0 * 80.0 * 100.0).abs() < 1e-6);
+    assert!((block.mass().volume - 80.0 * 80.0 * 100.0).abs() < 1e-6);
     // every name resolves, both decompositions
     for name in examples::NAMES {
         for d in [Decomposition::ConvexMerge, Decomposition::Triangulation] {
             let part = examples::part_by_name(name, d).expect("known example");
             assert_eq!(part.name, name);
-            for c in &part.components {
+            for c in part.components() {
                 c.validate().expect("valid component");
             }
         }
@@ -247,10 +247,10 @@ fn triangle_parts_nest_in_one_orientation() {
     // a copy 4.5 mm higher (> t * sqrt(5) = 4.47) touches nothing; 4.4 mm is too little (the walls' 2 mm slabs are
     // then 4.4 / sqrt(5) = 1.97 mm apart). The separating-axis test is complete for convex pairs.
     let shifted = |dz: f64| -> Vec<ConvexPolytope> {
-        part.components.iter().map(|c| c.transformed(DMat3::IDENTITY, DVec3::new(0.0, 0.0, dz))).collect()
+        part.components().iter().map(|c| c.transformed(DMat3::IDENTITY, DVec3::new(0.0, 0.0, dz))).collect()
     };
     let all_separated =
-        |upper: &[ConvexPolytope]| upper.iter().all(|a| part.components.iter().all(|b| separated_sat(a, b, 1e-9)));
+        |upper: &[ConvexPolytope]| upper.iter().all(|a| part.components().iter().all(|b| separated_sat(a, b, 1e-9)));
     let dz = 4.5;
     assert!(all_separated(&shifted(dz)));
     assert!(!all_separated(&shifted(4.4)));
@@ -281,14 +281,14 @@ fn boundary_faces_with_t_junctions_and_partial_contact() {
     let part = stackplan_geom::Part::from_components("t", vec![a.clone(), b1, b2], 1.0, PartOrigin::ConvexPieces)
         .expect("part");
     assert!((boundary_area(&part) - 14.0).abs() < 1e-12, "{}", boundary_area(&part));
-    assert!(part.boundary.iter().all(|f| f.outline.iter().any(|p| p.x != 2.0) || f.plane.normal.x.abs() < 0.5));
+    assert!(part.boundary().iter().all(|f| f.outline.iter().any(|p| p.x != 2.0) || f.plane.normal.x.abs() < 0.5));
     // partial contact: B covers the upper half of A's face x = 2 only; the lower half stays boundary
     let b = cuboid(DVec3::new(2.0, 0.0, 0.5), DVec3::new(3.0, 1.0, 1.0));
     let part = stackplan_geom::Part::from_components("p", vec![a, b], 1.0, PartOrigin::ConvexPieces).expect("part");
     // surface of A (10) + surface of B (2 x (1 x 0.5) + 2 x (1 x 0.5) + 2 x (1 x 1) = 4) - 2 x 0.5 (contact)
     assert!((boundary_area(&part) - 13.0).abs() < 1e-12, "{}", boundary_area(&part));
     let at_x2: f64 = part
-        .boundary
+        .boundary()
         .iter()
         .filter(|f| f.plane.normal.x > 0.5 && f.outline.iter().all(|p| (p.x - 2.0).abs() < 1e-12))
         .map(|f| ring_area(&f.outline))
@@ -690,8 +690,8 @@ fn orientation_and_duplicates_do_not_matter() {
         assert_eq!(counts, vec![4]);
         assert_eq!(check_model(&m, Decomposition::ConvexMerge), vec![2]);
         let part = m.build_part("l", 1.0, Decomposition::ConvexMerge).expect("part");
-        assert!((part.mass.volume - 2.0 * 1200.0).abs() < 1e-9);
-        assert!((part.mass.center_of_gravity.z - 5.0).abs() < 1e-12);
+        assert!((part.mass().volume - 2.0 * 1200.0).abs() < 1e-9);
+        assert!((part.mass().center_of_gravity.z - 5.0).abs() < 1e-12);
     }
 }
 

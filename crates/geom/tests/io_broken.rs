@@ -155,7 +155,7 @@ fn every_broken_part_file_gives_its_located_error() {
         let path = broken(name);
         assert!(path.exists(), "corpus file {name} is missing");
         let err = match read_part(&path, &ReadOptions::default()) {
-            Ok(part) => panic!("{name} was accepted: {} components", part.components.len()),
+            Ok(part) => panic!("{name} was accepted: {} components", part.components().len()),
             Err(e) => e,
         };
         let message = err.to_string();
@@ -195,14 +195,14 @@ fn decomposition_accepts_a_non_convex_shell_and_marks_it_approximate() {
             matches!(part.origin, stackplan_geom::PartOrigin::ApproximateDecomposition { mesh_volume: Some(v) } if v > 0.0),
             "{name}"
         );
-        assert!(part.components.len() >= 2, "{name}: {} components", part.components.len());
+        assert!(part.components().len() >= 2, "{name}: {} components", part.components().len());
         // valid within the tolerance: a piece's rounding creases are merged, so its faces are planar to rounding
-        for c in &part.components {
+        for c in part.components() {
             c.validate().expect("decomposed components are valid polytopes");
         }
         // the dented cube has volume 8 - 4/3 (plus the tetrahedron in the OBJ); VHACD approximates it
         let expected = if name.ends_with(".obj") { 8.0 - 4.0 / 3.0 + 1.0 / 6.0 } else { 8.0 - 4.0 / 3.0 };
-        let volume = part.mass.volume;
+        let volume = part.mass().volume;
         assert!((volume - expected).abs() < 0.25 * expected, "{name}: volume {volume} vs {expected}");
     }
     // an open or inside-out shell is not convex either, but a flat one cannot be decomposed

@@ -33,17 +33,17 @@ fn key(c: &ConvexPolytope) -> Vec<[u64; 3]> {
 }
 
 fn same_components(a: &Part, b: &Part) {
-    let mut ka: Vec<_> = a.components.iter().map(key).collect();
-    let mut kb: Vec<_> = b.components.iter().map(key).collect();
+    let mut ka: Vec<_> = a.components().iter().map(key).collect();
+    let mut kb: Vec<_> = b.components().iter().map(key).collect();
     ka.sort();
     kb.sort();
     assert_eq!(ka, kb, "components differ");
-    for (x, y) in a.components.iter().zip(&b.components) {
+    for (x, y) in a.components().iter().zip(b.components()) {
         assert_eq!(x.faces().len(), y.faces().len());
     }
-    let (va, vb) = (a.mass.volume, b.mass.volume);
+    let (va, vb) = (a.mass().volume, b.mass().volume);
     assert!((va - vb).abs() <= 1e-12 * va, "volume {va} vs {vb}");
-    assert!((a.mass.center_of_gravity - b.mass.center_of_gravity).length() <= 1e-9);
+    assert!((a.mass().center_of_gravity - b.mass().center_of_gravity).length() <= 1e-9);
 }
 
 /// The single-precision tolerance of the STL reader for `part`'s coordinates: 16 roundings to `f32` of the largest.
@@ -56,11 +56,11 @@ fn single_tolerance(part: &Part) -> f64 {
 /// (the reader moves the corners of faces planar only to single precision onto their planes, by at most `4 t`); and
 /// every vertex of what was read lies on the planes of its faces within `1e-12` of the part's largest coordinate.
 fn same_within(expected: &[(usize, Vec<DVec3>)], got: &Part, tol: f64, what: &str) {
-    assert_eq!(got.components.len(), expected.len(), "{what}: components");
+    assert_eq!(got.components().len(), expected.len(), "{what}: components");
     let mut used = vec![false; expected.len()];
     // the flattening's own scale: the part's largest coordinate
     let scale = got.all_vertices().map(|v| v.abs().max_element()).fold(1.0, f64::max);
-    for c in &got.components {
+    for c in got.components() {
         let found = expected.iter().enumerate().position(|(k, (faces, vertices))| {
             !used[k]
                 && *faces == c.faces().len()
@@ -82,23 +82,23 @@ fn same_within(expected: &[(usize, Vec<DVec3>)], got: &Part, tol: f64, what: &st
 fn sheet_metal_json_builds_and_round_trips() {
     let part = bracket();
     assert_eq!(part.name, "bracket");
-    assert_eq!(part.density, 7.85e-6);
-    assert!(part.components.len() >= 3, "a face with a hole needs several convex pieces");
+    assert_eq!(part.density(), 7.85e-6);
+    assert!(part.components().len() >= 3, "a face with a hole needs several convex pieces");
     // volume: (40 x 20 - 4 x 4) x 1 + (pentagon area) x 1
     let pentagon = 20.0 * 26.0 + 0.5 * 20.0 * 8.0;
     let expected = 800.0 - 16.0 + pentagon;
-    assert!((part.mass.volume - expected).abs() < 1e-9 * expected, "{} vs {expected}", part.mass.volume);
+    assert!((part.mass().volume - expected).abs() < 1e-9 * expected, "{} vs {expected}", part.mass().volume);
     let dir = tempfile::tempdir().expect("tempdir");
     let path = dir.path().join("b.json");
     io::write_part_json(&path, &part).expect("write");
     let back = io::read_part(&path, &ReadOptions::default()).expect("read back");
     assert_eq!(back.origin, PartOrigin::ConvexPieces);
     assert_eq!(back.name, "bracket");
-    assert_eq!(back.density, part.density);
+    assert_eq!(back.density(), part.density());
     same_components(&part, &back);
     // the options' density wins over the file's
     let heavy = io::read_part(&path, &ReadOptions { density: Some(2.0), ..Default::default() }).expect("read");
-    assert_eq!(heavy.density, 2.0);
+    assert_eq!(heavy.density(), 2.0);
 }
 
 #[test]
@@ -106,8 +106,8 @@ fn triangulation_option_reaches_the_sheet_metal_builder() {
     let merged = bracket();
     let options = ReadOptions { decomposition: stackplan_geom::Decomposition::Triangulation, ..Default::default() };
     let triangulated = io::parse_part_json(BRACKET.as_bytes(), Path::new("b.json"), &options).expect("bracket");
-    assert!(triangulated.components.len() > merged.components.len());
-    assert!((triangulated.mass.volume - merged.mass.volume).abs() < 1e-9 * merged.mass.volume);
+    assert!(triangulated.components().len() > merged.components().len());
+    assert!((triangulated.mass().volume - merged.mass().volume).abs() < 1e-9 * merged.mass().volume);
 }
 
 #[test]
@@ -124,14 +124,15 @@ fn obj_round_trip_is_exact() {
 /// A component as the readers rebuild it: the hull of its vertices with its rounding creases merged
 /// ([`convex_hull_merged`]).
 fn read_form(part: &Part) -> Part {
-    let components = part.components.iter().map(|c| convex_hull_merged(c.vertices()).expect("hull").polytope).collect();
-    Part::from_components(part.name.clone(), components, part.density, PartOrigin::ConvexPieces).expect("part")
+    let components =
+        part.components().iter().map(|c| convex_hull_merged(c.vertices()).expect("hull").polytope).collect();
+    Part::from_components(part.name.clone(), components, part.density(), PartOrigin::ConvexPieces).expect("part")
 }
 
 /// The number of faces of `part`'s components, and of the exact hulls of their vertices.
 fn face_counts(part: &Part) -> (usize, usize) {
-    let own = part.components.iter().map(|c| c.faces().len()).sum();
-    let exact = part.components.iter().map(|c| convex_hull(c.vertices()).expect("hull").polytope.faces().len()).sum();
+    let own = part.components().iter().map(|c| c.faces().len()).sum();
+    let exact = part.components().iter().map(|c| convex_hull(c.vertices()).expect("hull").polytope.faces().len()).sum();
     (own, exact)
 }
 
@@ -147,7 +148,7 @@ fn every_example_reads_back_from_every_format() {
     let opts = ReadOptions::default();
     let single = |part: &Part| {
         let components = part
-            .components
+            .components()
             .iter()
             .map(|c| {
                 let rounded: Vec<DVec3> = c.vertices().iter().map(|v| v.as_vec3().as_dvec3()).collect();
@@ -156,7 +157,7 @@ fn every_example_reads_back_from_every_format() {
                 convex_hull_merged_within(&rounded, 8.0 * f64::from(f32::EPSILON) * largest).expect("hull").polytope
             })
             .collect();
-        Part::from_components(part.name.clone(), components, part.density, PartOrigin::ConvexPieces).expect("part")
+        Part::from_components(part.name.clone(), components, part.density(), PartOrigin::ConvexPieces).expect("part")
     };
     let mut split_faces = 0;
     for name in stackplan_geom::examples::NAMES {
@@ -166,7 +167,7 @@ fn every_example_reads_back_from_every_format() {
             let (own, exact_facets) = face_counts(&part);
             split_faces += exact_facets - own;
             // merging the creases gives back the faces the part was built with
-            assert_eq!(exact.components.iter().map(|c| c.faces().len()).sum::<usize>(), own, "{name}");
+            assert_eq!(exact.components().iter().map(|c| c.faces().len()).sum::<usize>(), own, "{name}");
             let json = io::parse_part_json(io::part_json_string(&part).as_bytes(), Path::new("e.json"), &opts);
             same_components(&exact, &json.unwrap_or_else(|e| panic!("{name}: json: {e}")));
             let obj = io::parse_obj(io::obj_string(&part).as_bytes(), Path::new("e.obj"), &opts);
@@ -176,7 +177,7 @@ fn every_example_reads_back_from_every_format() {
             let binary = io::parse_stl(&io::stl_binary_bytes(&part), Path::new("e.stl"), &opts)
                 .unwrap_or_else(|e| panic!("{name}: binary stl: {e}"));
             let expected: Vec<(usize, Vec<DVec3>)> =
-                single(&part).components.iter().map(|c| (c.faces().len(), c.vertices().to_vec())).collect();
+                single(&part).components().iter().map(|c| (c.faces().len(), c.vertices().to_vec())).collect();
             same_within(&expected, &binary, 4.0 * single_tolerance(&part), &format!("{name}: binary stl"));
             // a stack export for viewers reads back too: one convex piece per component, in world coordinates
             let pose = Pose {
@@ -186,7 +187,7 @@ fn every_example_reads_back_from_every_format() {
             let scene = io::obj_scene_string(&[(&part, pose), (&part, Pose::IDENTITY)]);
             let back = io::parse_obj(scene.as_bytes(), Path::new("s.obj"), &opts)
                 .unwrap_or_else(|e| panic!("{name}: scene obj: {e}"));
-            assert_eq!(back.components.len(), 2 * part.components.len());
+            assert_eq!(back.components().len(), 2 * part.components().len());
         }
     }
     // the test has teeth: some example faces are coplanar only to rounding, and their exact hulls split them
@@ -206,7 +207,7 @@ fn stl_round_trips_separate_touching_components() {
             io::write_stl_binary(&path, &part).expect("write");
         }
         let back = io::read_part(&path, &ReadOptions::default()).expect("read");
-        assert_eq!(back.components.len(), part.components.len(), "ascii = {ascii}");
+        assert_eq!(back.components().len(), part.components().len(), "ascii = {ascii}");
         same_components(&part, &back); // coordinates are dyadic, so even f32 is exact
     }
 }
@@ -216,14 +217,14 @@ fn stl_round_trips_separate_touching_components() {
 fn turned(part: &Part, rotation: DMat3) -> Part {
     let offset = DVec3::new(123.25, -45.5, 7.0);
     let components = part
-        .components
+        .components()
         .iter()
         .map(|c| {
             let points: Vec<DVec3> = c.vertices().iter().map(|&v| rotation * v + offset).collect();
             convex_hull_merged(&points).expect("hull").polytope
         })
         .collect();
-    Part::from_components(part.name.clone(), components, part.density, PartOrigin::ConvexPieces).expect("part")
+    Part::from_components(part.name.clone(), components, part.density(), PartOrigin::ConvexPieces).expect("part")
 }
 
 /// Components touching along a face that is planar only to rounding: each component's exact hull splits the face
@@ -259,7 +260,7 @@ fn turned_parts_with_touching_components_round_trip_through_stl() {
             let back = io::parse_stl(text.as_bytes(), Path::new("turned.stl"), &opts)
                 .unwrap_or_else(|e| panic!("{} turned {i}: {e}", part.name));
             same_components(&turned, &back);
-            assert_eq!(back.components.len(), part.components.len(), "part {k}");
+            assert_eq!(back.components().len(), part.components().len(), "part {k}");
         }
     }
     assert!(split_shared_faces > 0, "the test has teeth: some turned faces are split by their exact hulls");
@@ -284,7 +285,7 @@ fn turned_parts_read_back_from_binary_stl_with_their_faces() {
             let back = io::parse_stl(&io::stl_binary_bytes(&turned), Path::new("turned.stl"), &opts)
                 .unwrap_or_else(|e| panic!("{} turned {i}: {e}", part.name));
             let expected: Vec<(usize, Vec<DVec3>)> = turned
-                .components
+                .components()
                 .iter()
                 .map(|c| {
                     let rounded: Vec<DVec3> = c.vertices().iter().map(|v| v.as_vec3().as_dvec3()).collect();
@@ -294,7 +295,7 @@ fn turned_parts_read_back_from_binary_stl_with_their_faces() {
                 .collect();
             let what = format!("{} turned {i}", part.name);
             same_within(&expected, &back, 4.0 * single_tolerance(&turned), &what);
-            let (v0, v1) = (turned.mass.volume, back.mass.volume);
+            let (v0, v1) = (turned.mass().volume, back.mass().volume);
             assert!((v0 - v1).abs() <= 1e-5 * v0, "{} turned {i}: volume {v0} vs {v1}", part.name);
         }
     }
@@ -325,7 +326,7 @@ fn obj_files_planar_only_to_single_precision_read_with_their_faces() {
             .collect()
     };
     let faces = |p: &Part| {
-        let mut f: Vec<usize> = p.components.iter().map(|c| c.faces().len()).collect();
+        let mut f: Vec<usize> = p.components().iter().map(|c| c.faces().len()).collect();
         f.sort_unstable();
         f
     };
@@ -377,10 +378,10 @@ fn a_turned_box_triangulated_along_either_diagonal_reads_as_a_box() {
         let part =
             io::parse_stl(ascii_stl(&points, &triangles).as_bytes(), Path::new("box.stl"), &ReadOptions::default())
                 .unwrap_or_else(|e| panic!("diagonals {diagonals:06b}: {e}"));
-        assert_eq!(part.components.len(), 1);
-        assert_eq!(part.components[0].faces().len(), 6, "diagonals {diagonals:06b}");
-        assert_eq!(part.components[0].vertices().len(), 8);
-        assert!((part.mass.volume - 3000.0).abs() < 1e-9, "{}", part.mass.volume);
+        assert_eq!(part.components().len(), 1);
+        assert_eq!(part.components()[0].faces().len(), 6, "diagonals {diagonals:06b}");
+        assert_eq!(part.components()[0].vertices().len(), 8);
+        assert!((part.mass().volume - 3000.0).abs() < 1e-9, "{}", part.mass().volume);
     }
     assert!(crossed_a_crease, "the test has teeth: some triangulations are not exactly convex");
 }
@@ -486,7 +487,8 @@ fn glb_parses_back() {
 
     let value: serde_json::Value = serde_json::from_slice(json).expect("json");
     for (i, item) in items.iter().enumerate() {
-        let triangles: usize = item.part.components.iter().flat_map(|c| c.faces()).map(|f| f.vertices.len() - 2).sum();
+        let triangles: usize =
+            item.part.components().iter().flat_map(|c| c.faces()).map(|f| f.vertices.len() - 2).sum();
         let positions = &value["accessors"][2 * i];
         let normals = &value["accessors"][2 * i + 1];
         assert_eq!(positions["count"], 3 * triangles);
@@ -701,10 +703,10 @@ proptest! {
     #[test]
     fn rotated_parts_read_back_from_every_format(part in random_part(), angles in prop::array::uniform3(-3.2f64..3.2)) {
         let rotation = DMat3::from_rotation_z(angles[0]) * DMat3::from_rotation_y(angles[1]) * DMat3::from_rotation_x(angles[2]);
-        let components = part.components.iter().map(|c| c.transformed(rotation, DVec3::new(3.0, -1.0, 2.0))).collect();
+        let components = part.components().iter().map(|c| c.transformed(rotation, DVec3::new(3.0, -1.0, 2.0))).collect();
         let turned = Part::from_components("turned", components, 1.0, PartOrigin::ConvexPieces).expect("part");
         let exact = read_form(&turned);
-        for (c, t) in exact.components.iter().zip(&turned.components) {
+        for (c, t) in exact.components().iter().zip(turned.components()) {
             prop_assert_eq!(c.faces().len(), t.faces().len(), "the turn's creases are merged");
         }
         let opts = ReadOptions::default();
@@ -718,7 +720,7 @@ proptest! {
         // folds merged within the single-precision tolerance) the faces of the part before it was turned
         let back = io::parse_stl(&io::stl_binary_bytes(&turned), Path::new("r.stl"), &opts).expect("binary stl");
         let expected: Vec<(usize, Vec<DVec3>)> = turned
-            .components
+            .components()
             .iter()
             .map(|c| (c.faces().len(), c.vertices().iter().map(|v| v.as_vec3().as_dvec3()).collect()))
             .collect();
@@ -731,17 +733,17 @@ fn every_good_seed_file_reads() {
     let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/good");
     let opts = ReadOptions::default();
     let two = io::read_part(dir.join("two_groups.obj"), &opts).expect("obj");
-    assert_eq!(two.components.len(), 2);
-    assert!((two.mass.volume - (1.0 / 6.0 + 8.0)).abs() < 1e-12);
+    assert_eq!(two.components().len(), 2);
+    assert!((two.mass().volume - (1.0 / 6.0 + 8.0)).abs() < 1e-12);
     let cube = io::read_part(dir.join("cube.stl"), &opts).expect("stl");
-    assert!((cube.mass.volume - 8.0).abs() < 1e-12);
+    assert!((cube.mass().volume - 8.0).abs() < 1e-12);
     let tetra = io::read_part(dir.join("tetra_binary.stl"), &opts).expect("binary stl with a solid header");
-    assert!((tetra.mass.volume - 1.0 / 6.0).abs() < 1e-12);
+    assert!((tetra.mass().volume - 1.0 / 6.0).abs() < 1e-12);
     let pieces = io::read_part(dir.join("pieces.json"), &opts).expect("pieces");
-    assert_eq!(pieces.density, 2.5);
-    assert!((pieces.mass.mass - 2.5 * (1.0 / 6.0 + 8.0)).abs() < 1e-12);
+    assert_eq!(pieces.density(), 2.5);
+    assert!((pieces.mass().mass - 2.5 * (1.0 / 6.0 + 8.0)).abs() < 1e-12);
     let sheet = io::read_part(dir.join("sheet.json"), &opts).expect("sheet");
-    assert!((sheet.mass.volume - 1.5 * (600.0 - 25.0 + 20.0 * 23.0)).abs() < 1e-9);
+    assert!((sheet.mass().volume - 1.5 * (600.0 - 25.0 + 20.0 * 23.0)).abs() < 1e-9);
     let stack = read_stack(dir.join("stack.json")).expect("stack");
     assert_eq!(stack.placements.len(), 2);
     assert_eq!(stack.extras[1]["cost"], 1.5);
@@ -803,7 +805,7 @@ proptest! {
         match &result {
             Ok(part) => {
                 prop_assert!(expected, "accepted a non-convex surface");
-                prop_assert_eq!(part.components.len(), 1);
+                prop_assert_eq!(part.components().len(), 1);
             }
             Err(e) => {
                 prop_assert!(!expected, "rejected a convex surface: {}", e);
@@ -844,8 +846,8 @@ fn obj_scene_of_placed_parts_reads_back_as_their_components() {
     let items: Vec<(&Part, Pose)> = poses.iter().map(|&p| (&part, p)).collect();
     let text = io::obj_scene_string(&items);
     let back = io::parse_obj(text.as_bytes(), Path::new("scene.obj"), &ReadOptions::default()).expect("scene");
-    assert_eq!(back.components.len(), 2 * part.components.len());
-    assert!((back.mass.volume - 2.0 * part.mass.volume).abs() < 1e-9 * part.mass.volume);
+    assert_eq!(back.components().len(), 2 * part.components().len());
+    assert!((back.mass().volume - 2.0 * part.mass().volume).abs() < 1e-9 * part.mass().volume);
     let (lo, hi) = back.aabb();
     let (plo, phi) = part.aabb();
     assert_eq!(lo, plo);

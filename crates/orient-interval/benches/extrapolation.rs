@@ -13,7 +13,7 @@ fn pairs() -> Vec<(String, ConvexPolytope, ConvexPolytope)> {
     let mut out = Vec::new();
     for name in ["channel", "triangle", "complex", "l-corner"] {
         let part = examples::part_by_name(name, Decomposition::Triangulation).expect("example");
-        let c = &part.components;
+        let c = &part.components();
         let (a, b) = (c[0].clone(), c[c.len() / 2].transformed(DMat3::from_rotation_z(0.3), DVec3::new(5.0, 3.0, 2.0)));
         out.push((name.to_string(), a, b));
     }

@@ -21,8 +21,8 @@ pub fn regress_summary(moving: &Part, fixed: &Part, fixed_pose: (DMat3, DVec3), 
     let angles = degree_steps(step_deg);
     let mut pairs = Vec::new();
     let (mut t_intervals, mut t_constructions, mut t_extrapolations, mut t_errors) = (0u64, 0u64, 0u64, 0u64);
-    for (i, a) in moving.components.iter().enumerate() {
-        for (j, b) in fixed.components.iter().enumerate() {
+    for (i, a) in moving.components().iter().enumerate() {
+        for (j, b) in fixed.components().iter().enumerate() {
             let placed = b.transformed(fixed_pose.0, fixed_pose.1);
             let events = PairEvents::new(a, &placed);
             let turn = events.full_turn();
@@ -62,7 +62,7 @@ pub fn regress_summary(moving: &Part, fixed: &Part, fixed_pose: (DMat3, DVec3), 
         "step_deg": step_deg,
         "pairs": pairs,
         "totals": {
-            "pairs": moving.components.len() * fixed.components.len(),
+            "pairs": moving.components().len() * fixed.components().len(),
             "intervals": t_intervals,
             "constructions": t_constructions,
             "extrapolations": t_extrapolations,

@@ -13,7 +13,7 @@ fn example_sweeps_count_constructions_and_extrapolations() {
     let angles = degree_steps(1.0);
     for name in ["channel", "triangle", "l-corner"] {
         let part = examples::part_by_name(name, Decomposition::Triangulation).expect("example");
-        let c = &part.components;
+        let c = &part.components();
         let mut total = (0u64, 0u64, 0usize);
         for (i, j) in [(0, c.len() - 1), (c.len() / 2, 0)] {
             let fixed = c[j].transformed(DMat3::from_rotation_z(0.3), DVec3::new(5.0, 3.0, 2.0));

@@ -89,8 +89,8 @@ impl StackScene {
         self.plate_first.push(self.plates_world.iter().map(Vec::len).sum());
         self.plate_of.extend(part.plate_of_components());
         self.plates_world
-            .push(part.plates.iter().map(|p| p.filled.transformed(pose.rotation, pose.position)).collect());
-        for (ci, c) in part.components.iter().enumerate() {
+            .push(part.plates().iter().map(|p| p.filled.transformed(pose.rotation, pose.position)).collect());
+        for (ci, c) in part.components().iter().enumerate() {
             let world = c.transformed(pose.rotation, pose.position);
             let turned = Arc::new(c.transformed(pose.rotation, DVec3::ZERO));
             let placed = PlacedConvex::new(c, pose.rotation, pose.position);
@@ -140,7 +140,7 @@ impl SweepAxes {
     /// The axes of each rotated component's upward sweep.
     pub fn new(part: &Part, rotation: DMat3, orientation: &Orientation) -> Self {
         let axes = part
-            .components
+            .components()
             .iter()
             .zip(orientation.components.iter())
             .map(|(c, placed)| {

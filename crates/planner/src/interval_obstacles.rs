@@ -175,7 +175,7 @@ impl IntervalObstacles {
         fixed: &StackComponent,
         cache: &ObstacleCache,
     ) -> Result<(Arc<Obstacle>, ObstacleRoute), String> {
-        let component = &part.components[moving];
+        let component = &part.components()[moving];
         let entry = self.pairs.entry((moving, rest, fixed_index)).or_insert_with(|| PairIntervals {
             moving_rest: component.transformed(rest_rotation, DVec3::ZERO),
             first: None,
@@ -248,14 +248,14 @@ mod tests {
         let store = EventStore::default();
         let mut computed = 0;
         for (moving, fixed) in [(0, 0), (3, 7), (12, 25), (29, 1)] {
-            let moving_rest = part.components[moving].transformed(rest, DVec3::ZERO);
-            let turned = Arc::new(part.components[fixed].transformed(pose, DVec3::ZERO));
+            let moving_rest = part.components()[moving].transformed(rest, DVec3::ZERO);
+            let turned = Arc::new(part.components()[fixed].transformed(pose, DVec3::ZERO));
             let mut shared = Vec::new();
             for offset in [DVec3::ZERO, DVec3::new(317.5, -81.25, 31.0), DVec3::new(-1003.0, 945.0, 364.0)] {
                 // each copy has its own turned polytope (the scene builds one per stack component)
-                let own = Arc::new(part.components[fixed].transformed(pose, DVec3::ZERO));
+                let own = Arc::new(part.components()[fixed].transformed(pose, DVec3::ZERO));
                 shared.push(shared_events(&store, &moving_rest, &own));
-                let world = part.components[fixed].transformed(pose, offset);
+                let world = part.components()[fixed].transformed(pose, offset);
                 let direct = PairEvents::new(&moving_rest, &world);
                 let from_turned = &shared[shared.len() - 1];
                 assert_eq!(direct.bands().len(), from_turned.bands().len(), "pair {moving}-{fixed} at {offset}");
@@ -276,10 +276,10 @@ mod tests {
         let entries: usize = store.0.lock().expect("lock").values().map(Vec::len).sum();
         assert_eq!(entries, computed);
         // another rotation of the same piece is another entry, and so is another moving component against it
-        let other = Arc::new(part.components[0].transformed(DMat3::IDENTITY, DVec3::ZERO));
-        let moving_rest = part.components[0].transformed(rest, DVec3::ZERO);
+        let other = Arc::new(part.components()[0].transformed(DMat3::IDENTITY, DVec3::ZERO));
+        let moving_rest = part.components()[0].transformed(rest, DVec3::ZERO);
         shared_events(&store, &moving_rest, &other);
-        shared_events(&store, &part.components[5].transformed(rest, DVec3::ZERO), &other);
+        shared_events(&store, &part.components()[5].transformed(rest, DVec3::ZERO), &other);
         let entries: usize = store.0.lock().expect("lock").values().map(Vec::len).sum();
         assert_eq!(entries, computed + 2);
         store.clear();

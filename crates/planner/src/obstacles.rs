@@ -90,7 +90,7 @@ impl DerivedObstacle {
     ) -> Result<Self, String> {
         let sc = &scene.components[fixed];
         let raw = cache
-            .get_or_build(moving, sc.part, sc.piece, &part.components[moving], orientation.rotation, &sc.world)
+            .get_or_build(moving, sc.part, sc.piece, &part.components()[moving], orientation.rotation, &sc.world)
             .map_err(|e| e.to_string())?;
         Ok(Self::from_obstacle(&raw, moving, fixed, clearance, horizontal_clearance, with_insertion))
     }

@@ -20,7 +20,7 @@ use std::sync::Arc;
 
 /// The components of `part` rotated by `rotation`, at position zero.
 pub fn rotated_components(part: &Part, rotation: DMat3) -> Arc<[PlacedConvex]> {
-    part.components.iter().map(|c| PlacedConvex::new(c, rotation, DVec3::ZERO)).collect()
+    part.components().iter().map(|c| PlacedConvex::new(c, rotation, DVec3::ZERO)).collect()
 }
 
 /// A separable convex quadratic `constant + sum_i h_i (p_i - c_i)^2` in three variables.
@@ -117,14 +117,14 @@ impl Orientation {
         let rotation = DMat3::from_rotation_z(theta) * rest_rotation;
         // the same arithmetic as `PlacedConvex::new(c, rotation, DVec3::ZERO)`, so the extents are bit-identical
         let vertices: Vec<DVec3> =
-            part.components.iter().flat_map(|c| c.vertices().iter().map(|v| rotation * *v + DVec3::ZERO)).collect();
+            part.components().iter().flat_map(|c| c.vertices().iter().map(|v| rotation * *v + DVec3::ZERO)).collect();
         let mut lo = DVec3::splat(f64::INFINITY);
         let mut hi = DVec3::splat(f64::NEG_INFINITY);
         for v in &vertices {
             lo = lo.min(*v);
             hi = hi.max(*v);
         }
-        let cg = rotation * part.mass.center_of_gravity;
+        let cg = rotation * part.mass().center_of_gravity;
         let quadratic = SeparableQuadratic::of_cost(cost, lo, hi, cg);
         Self { index, rest, theta_index, theta, rotation, lo, hi, cg, components: Arc::new([]), vertices, quadratic }
     }

@@ -62,7 +62,7 @@ pub(crate) struct MergedPair {
 /// For each component of the moving part, its plate (empty when the request does not merge plates or the part has
 /// none).
 pub(crate) fn moving_plates(request: &PlacementRequest<'_>) -> Vec<Option<u32>> {
-    if !request.tuning.merge_plates || request.part.plates.is_empty() {
+    if !request.tuning.merge_plates || request.part.plates().is_empty() {
         return Vec::new();
     }
     request.part.plate_of_components()
@@ -87,16 +87,16 @@ pub(crate) fn merged_pair(
     let stack_part = request.stack.get(sc.part)?;
     let moving_plate = moving_plate_of.get(moving).copied().flatten().map(|k| k as usize);
     let fixed_plate = scene.plate_of.get(fixed).copied().flatten().map(|k| k as usize);
-    let a = moving_plate.and_then(|k| request.part.plates.get(k));
-    let b = fixed_plate.and_then(|k| stack_part.part.plates.get(k));
+    let a = moving_plate.and_then(|k| request.part.plates().get(k));
+    let b = fixed_plate.and_then(|k| stack_part.part.plates().get(k));
     let several = |p: Option<&stackplan_geom::plate::Plate>| p.is_some_and(|p| p.pieces.len() >= 2);
     let fixed_key = |k: usize| VIRTUAL + scene.plate_first[sc.part] + k;
     let pair = |moving_plate: Option<usize>, fixed_plate: Option<usize>, key| MergedPair {
         moving_plate,
         fixed_plate,
         fixed_part: sc.part,
-        moving: moving_plate.and_then(|k| request.part.plates[k].pieces.first().copied()).unwrap_or(moving),
-        fixed: fixed_plate.map_or(fixed, |k| scene.part_first[sc.part] + stack_part.part.plates[k].pieces[0]),
+        moving: moving_plate.and_then(|k| request.part.plates()[k].pieces.first().copied()).unwrap_or(moving),
+        fixed: fixed_plate.map_or(fixed, |k| scene.part_first[sc.part] + stack_part.part.plates()[k].pieces[0]),
         key,
     };
     // 1. two parallel plates
@@ -117,7 +117,7 @@ pub(crate) fn merged_pair(
     if let (Some(pb), Some(kb)) = (b, fixed_plate)
         && several(b)
     {
-        let turned: Vec<DVec3> = request.part.components[moving].vertices().iter().map(|v| rotation * *v).collect();
+        let turned: Vec<DVec3> = request.part.components()[moving].vertices().iter().map(|v| rotation * *v).collect();
         if slices_clear_holes(&turned, stack_part.pose.rotation * pb.normal, pb.hole_diameter, tolerance) {
             return Some(pair(None, Some(kb), (moving, fixed_key(kb))));
         }
@@ -137,11 +137,11 @@ pub(crate) fn merged_obstacle(
     let part = request.part;
     let fixed_part = request.stack[pair.fixed_part].part;
     let (moving_index, moving) = match pair.moving_plate {
-        Some(k) => (part.components.len() + k, &part.plates[k].filled),
-        None => (pair.moving, &part.components[pair.moving]),
+        Some(k) => (part.components().len() + k, &part.plates()[k].filled),
+        None => (pair.moving, &part.components()[pair.moving]),
     };
     let (fixed_index, fixed) = match pair.fixed_plate {
-        Some(k) => (fixed_part.components.len() + k, &scene.plates_world[pair.fixed_part][k]),
+        Some(k) => (fixed_part.components().len() + k, &scene.plates_world[pair.fixed_part][k]),
         None => (scene.components[pair.fixed].piece, &scene.components[pair.fixed].world),
     };
     cache.get_or_build(moving_index, pair.fixed_part, fixed_index, moving, rotation, fixed)
@@ -169,12 +169,12 @@ pub(crate) fn touching_pieces(
         return Vec::new();
     };
     let first = scene.part_first[sc.part];
-    let ours: Vec<usize> = match moving_plate.and_then(|k| request.part.plates.get(k)) {
+    let ours: Vec<usize> = match moving_plate.and_then(|k| request.part.plates().get(k)) {
         Some(plate) => plate.pieces.clone(),
         None => vec![moving],
     };
     let theirs: Vec<usize> =
-        match fixed_plate.and_then(|k| request.stack.get(sc.part).and_then(|s| s.part.plates.get(k))) {
+        match fixed_plate.and_then(|k| request.stack.get(sc.part).and_then(|s| s.part.plates().get(k))) {
             Some(plate) => plate.pieces.iter().map(|&j| first + j).collect(),
             None => vec![fixed],
         };

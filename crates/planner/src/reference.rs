@@ -48,7 +48,7 @@ pub fn complete_optimum(request: &PlacementRequest<'_>) -> Result<Option<(f64, u
             continue;
         }
         let mut cells = vec![root];
-        for mi in 0..part.components.len() {
+        for mi in 0..part.components().len() {
             for fi in 0..scene.components.len() {
                 let ob = DerivedObstacle::build(
                     part,

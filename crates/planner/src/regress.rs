@@ -105,7 +105,7 @@ pub fn scenario(name: &str) -> Result<Option<Scenario>, PlacementError> {
     let floor = FloorVolume::rectangle(-500.0, -500.0, 500.0, 500.0, 1000.0);
     // first part: turned by 30 degrees, c.g. above the origin, on the floor
     let r0 = DMat3::from_rotation_z(30f64.to_radians());
-    let g0 = r0 * part.mass.center_of_gravity;
+    let g0 = r0 * part.mass().center_of_gravity;
     let first = Pose { rotation: r0, position: DVec3::new(-g0.x, -g0.y, -lowest_z(&part, r0)) };
     // desired position: c.g. at the centroid of the first part's base face (its lowest horizontal face)
     let target = DVec3::new(0.0, 0.0, 0.0);

@@ -121,7 +121,7 @@ pub fn settle(
     // the moving components' boxes at the release position (as `stackplan_cspace::PlacedConvex::new` computes them, without building
     // the rest of the placed component: only the boxes are needed here)
     let boxes: Vec<(DVec3, DVec3)> = part
-        .components
+        .components()
         .iter()
         .map(|component| {
             let mut world = component.vertices().iter().map(|v| rotation * *v + release);
@@ -130,7 +130,7 @@ pub fn settle(
         })
         .collect();
     let stop = |mi: usize, sc: &crate::detect::StackComponent| -> Result<Option<(f64, Contact)>, PlacementError> {
-        let component = &part.components[mi];
+        let component = &part.components()[mi];
         let obstacle = stack_obstacle(cache, mi, component, rotation, sc)?;
         let planes = obstacle.planes().map(|pl| (pl.normal, pl.offset));
         let Some((s, face)) = ray_entry(planes, release, tol) else {
@@ -236,7 +236,7 @@ pub fn lowest_release(
         if !insertion && slo.z > hi.z {
             continue;
         }
-        for (mi, component) in part.components.iter().enumerate() {
+        for (mi, component) in part.components().iter().enumerate() {
             let raw = stack_obstacle(cache, mi, component, rotation, sc)?;
             let derived = DerivedObstacle::from_obstacle(&raw, mi, fi, clearance, true, insertion);
             if let Some(interval) = line_interval(&derived.planes, rest, tol) {

@@ -20,10 +20,10 @@ pub const MAX_ORDER: usize = 12;
 /// axis through its c.g. maps it onto itself within `tol`.
 pub fn rotational_order(part: &Part, rest: DMat3, tol: f64) -> usize {
     let comps: Vec<Vec<DVec3>> =
-        part.components.iter().map(|c| c.vertices().iter().map(|v| rest * *v).collect()).collect();
+        part.components().iter().map(|c| c.vertices().iter().map(|v| rest * *v).collect()).collect();
     let centroids: Vec<DVec3> =
         comps.iter().map(|vs| vs.iter().fold(DVec3::ZERO, |a, b| a + *b) / vs.len().max(1) as f64).collect();
-    let axis = rest * part.mass.center_of_gravity;
+    let axis = rest * part.mass().center_of_gravity;
     (2..=MAX_ORDER).rev().find(|&k| maps_onto_itself(&comps, &centroids, axis, k, tol)).unwrap_or(1)
 }
 

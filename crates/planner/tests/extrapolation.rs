@@ -54,12 +54,12 @@ proptest! {
         for k in 0..(90.0 / step_deg) as usize {
             let theta = (k as f64 * step_deg).to_radians();
             let rotation = DMat3::from_rotation_z(theta) * rest;
-            for mi in 0..moving.components.len() {
+            for mi in 0..moving.components().len() {
                 for (fi, sc) in scene.components.iter().enumerate() {
                     let (got, route) = store
                         .obstacle(&moving, mi, 0, rest, theta, rotation, fi, sc, &cache)
                         .expect("obstacle");
-                    let built = obstacle(&moving.components[mi], rotation, &sc.world).expect("constructed");
+                    let built = obstacle(&moving.components()[mi], rotation, &sc.world).expect("constructed");
                     let difference = relative_difference(&got, &built);
                     prop_assert!(
                         difference.is_some_and(|d| d <= 1e-9),

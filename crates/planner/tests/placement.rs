@@ -27,7 +27,7 @@ fn box_goes_on_top_of_a_box() {
     let best = &res.placements[0];
     assert!((best.cost - 75.0 * 75.0).abs() < 1e-6, "cost {}", best.cost);
     let pose = best.pose();
-    let cg = pose.apply(small.mass.center_of_gravity);
+    let cg = pose.apply(small.mass().center_of_gravity);
     assert!((cg - DVec3::new(50.0, 50.0, 75.0)).length() < 1e-6, "c.g. {cg}");
     assert!(best.contacts.iter().any(|c| matches!(c, Contact::Stack { stack_part: 0, .. })), "{:?}", best.contacts);
     // sorted, and every one valid by the independent all-pairs check

@@ -56,7 +56,8 @@ struct Placed {
 
 fn placed(part: &Part, rotation_rows: &[[f64; 3]; 3], position: DVec3) -> Placed {
     let r = DMat3::from_cols_array_2d(rotation_rows).transpose();
-    let components = part.components.iter().map(|c| c.vertices().iter().map(|v| r * *v + position).collect()).collect();
+    let components =
+        part.components().iter().map(|c| c.vertices().iter().map(|v| r * *v + position).collect()).collect();
     Placed { components }
 }
 
@@ -219,9 +220,9 @@ fn check_plan(part: &Part, plan: &Plan, options: &PlanOptions) {
                 Contact::Stack { our_component, stack_part, stack_component, .. } => {
                     let rotation = |k: usize| DMat3::from_cols_array_2d(&plan.parts[k].rotation).transpose();
                     let d = separation(
-                        (&part.components[our_component], rotation(i), &part_i.components[our_component]),
+                        (&part.components()[our_component], rotation(i), &part_i.components[our_component]),
                         (
-                            &part.components[stack_component],
+                            &part.components()[stack_component],
                             rotation(stack_part),
                             &at_rest[stack_part].components[stack_component],
                         ),

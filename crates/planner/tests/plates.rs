@@ -63,14 +63,14 @@ proptest! {
         // the moving plate turned about z (and possibly upside down: still parallel)
         let rotation = if flip { DMat3::from_rotation_x(std::f64::consts::PI) } else { DMat3::IDENTITY }
             * DMat3::from_rotation_z(turn);
-        let (a, b) = (&moving.plates[0], &fixed.plates[0]);
+        let (a, b) = (&moving.plates()[0], &fixed.plates()[0]);
         prop_assert!(a.pieces.len() >= 2 && b.pieces.len() >= 2, "plates with holes have several pieces");
         prop_assert!(merges_exactly(a, rotation, b, DMat3::IDENTITY, 1e-6));
         let filled = obstacle(&a.filled, rotation, &b.filled).expect("filled obstacle");
         let pairs: Vec<_> = moving
-            .components
+            .components()
             .iter()
-            .flat_map(|m| fixed.components.iter().map(move |f| obstacle(m, rotation, f).expect("pair obstacle")))
+            .flat_map(|m| fixed.components().iter().map(move |f| obstacle(m, rotation, f).expect("pair obstacle")))
             .collect();
         // positions in the filled obstacle's box, in the slab where the plates overlap (|z| < 2)
         let (lo, hi) = filled.polytope().aabb();
@@ -114,11 +114,11 @@ proptest! {
         let b = ConvexPolytope::cuboid(DVec3::ZERO, DVec3::new(size.0, size.1, size.2)).expect("box");
         let turn = DMat3::from_rotation_z(tilt.0) * DMat3::from_rotation_x(tilt.1) * DMat3::from_rotation_z(tilt.2);
         let fixed = b.transformed(turn, DVec3::new(60.0, 40.0, 0.0));
-        let plate = &moving.plates[0];
+        let plate = &moving.plates()[0];
         let clear = stackplan_geom::plate::slices_clear_holes(fixed.vertices(), plate.normal, plate.hole_diameter, 1e-6);
         let filled = obstacle(&plate.filled, DMat3::IDENTITY, &fixed).expect("filled obstacle");
         let pairs: Vec<_> =
-            moving.components.iter().map(|m| obstacle(m, DMat3::IDENTITY, &fixed).expect("pair obstacle")).collect();
+            moving.components().iter().map(|m| obstacle(m, DMat3::IDENTITY, &fixed).expect("pair obstacle")).collect();
         let (lo, hi) = filled.polytope().aabb();
         let mut state = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
         let mut next = || {
@@ -145,13 +145,13 @@ fn a_plate_that_fits_into_a_hole_leaves_a_pocket_and_is_not_merged() {
     // big one's hole, where the filled plates overlap and no pieces do
     let small = plate(40.0, 30.0, &[(15.0, 10.0, 10.0, 10.0)]);
     let big = plate(200.0, 140.0, &[(70.0, 45.0, 60.0, 50.0)]);
-    let (a, b) = (&small.plates[0], &big.plates[0]);
+    let (a, b) = (&small.plates()[0], &big.plates()[0]);
     assert!(!merges_exactly(a, DMat3::IDENTITY, b, DMat3::IDENTITY, 1e-6));
     let filled = obstacle(&a.filled, DMat3::IDENTITY, &b.filled).expect("filled");
     let pocket = DVec3::new(80.0, 55.0, 0.0); // the small plate at (80..120, 55..85), inside the hole (70..130, 45..95)
     assert!(depth(filled.planes(), pocket) > 1.0);
-    for m in &small.components {
-        for f in &big.components {
+    for m in small.components() {
+        for f in big.components() {
             let o = obstacle(m, DMat3::IDENTITY, f).expect("pair");
             assert!(depth(o.planes(), pocket) < 0.0, "the pocket is free of every pair");
         }
@@ -202,10 +202,10 @@ proptest! {
             // every contact names pieces that touch (within the tolerance)
             for c in &q.contacts {
                 if let stackplan_planner::Contact::Stack { our_component, stack_part, stack_component, .. } = c {
-                    let ours: &ConvexPolytope = &part.components[*our_component];
+                    let ours: &ConvexPolytope = &part.components()[*our_component];
                     let placed = stackplan_cspace::PlacedConvex::new(ours, pose.rotation, pose.position);
                     let theirs = stackplan_cspace::PlacedConvex::new(
-                        &part.components[*stack_component],
+                        &part.components()[*stack_component],
                         poses[*stack_part].rotation,
                         poses[*stack_part].position,
                     );

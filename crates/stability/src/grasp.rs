@@ -443,7 +443,7 @@ fn projection_above(component: &WorldComponent, h: f64, tol: f64) -> Vec<DVec2> 
 /// Grasp faces of a posed part (`world = rotation * v + position`), largest inscribed radius first.
 pub fn grasp_faces(part: &Part, rotation: DMat3, position: DVec3, options: &GraspOptions) -> Vec<GraspFace> {
     let components: Vec<WorldComponent> =
-        part.components.iter().map(|c| WorldComponent::new(c.transformed(rotation, position))).collect();
+        part.components().iter().map(|c| WorldComponent::new(c.transformed(rotation, position))).collect();
     grasp_faces_of_components(&components, part.tolerance().linear, options)
 }
 

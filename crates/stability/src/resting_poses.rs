@@ -94,7 +94,7 @@ pub fn resting_poses(part: &Part) -> Result<Vec<RestingPose>, StabilityError> {
     let points: Vec<DVec3> = part.all_vertices().collect();
     let hull = convex_hull_merged(&points).map_err(|e| StabilityError::Hull(e.to_string()))?.polytope;
     let tol = part.tolerance().linear;
-    let cg = part.mass.center_of_gravity;
+    let cg = part.mass().center_of_gravity;
     let mut poses = Vec::new();
     for (f, face) in hull.faces().iter().enumerate() {
         let n = face.plane.normal;

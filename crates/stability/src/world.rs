@@ -84,7 +84,7 @@ fn check_placed(placed: &PlacedPart<'_>, index: usize) -> Result<(), StabilityEr
     if !placed.pose.position.is_finite() {
         return Err(StabilityError::NonFinitePosition { part: index });
     }
-    if placed.part.components.is_empty() {
+    if placed.part.components().is_empty() {
         return Err(StabilityError::EmptyPart { part: index });
     }
     Ok(())
@@ -96,7 +96,7 @@ impl WorldPart {
         check_placed(placed, index)?;
         let components: Vec<WorldComponent> = placed
             .part
-            .components
+            .components()
             .iter()
             .map(|c| WorldComponent::new(c.transformed(placed.pose.rotation, placed.pose.position)))
             .collect();
@@ -107,8 +107,8 @@ impl WorldPart {
         Ok(Self {
             name: placed.part.name.clone(),
             components,
-            center_of_gravity: placed.pose.rotation * placed.part.mass.center_of_gravity + placed.pose.position,
-            mass: placed.part.mass.mass,
+            center_of_gravity: placed.pose.rotation * placed.part.mass().center_of_gravity + placed.pose.position,
+            mass: placed.part.mass().mass,
             aabb,
         })
     }
@@ -117,7 +117,7 @@ impl WorldPart {
     /// and a maximum do not round), without building its components; the same errors. O(vertices).
     pub fn aabb_of(placed: &PlacedPart<'_>, index: usize) -> Result<(DVec3, DVec3), StabilityError> {
         check_placed(placed, index)?;
-        Ok(placed.part.components.iter().flat_map(|c| c.vertices()).fold(
+        Ok(placed.part.components().iter().flat_map(|c| c.vertices()).fold(
             (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
             |(lo, hi), v| {
                 // `ConvexPolytope::transformed`'s arithmetic

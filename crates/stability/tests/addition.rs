@@ -86,7 +86,7 @@ fn added_parts_report_like_the_whole_check_on_fixture_columns() {
     for_each_fixture_column(&[(0.0, 0.0), (7.0, -3.0), (40.0, 0.0)], |label, part, stack| {
         for (mu, directions, clearance) in [(0.4, 8, 0.0), (0.8, 0, 5.0)] {
             let what = format!("{label} mu {mu}");
-            compared += compare_additions(stack, &options(mu, directions, clearance), part.mass.mass, &what);
+            compared += compare_additions(stack, &options(mu, directions, clearance), part.mass().mass, &what);
         }
     });
     assert!(compared >= 100, "only {compared} additions compared");
@@ -96,7 +96,7 @@ fn added_parts_report_like_the_whole_check_on_fixture_columns() {
 fn added_parts_report_like_the_whole_check_on_the_planned_channel_stack() {
     let plan = planned_channels();
     let stack = placements(&plan);
-    let compared = compare_additions(&stack, &options(0.5, 0, 0.0), plan.part.mass.mass, "planned channels");
+    let compared = compare_additions(&stack, &options(0.5, 0, 0.0), plan.part.mass().mass, "planned channels");
     assert_eq!(compared, stack.len());
 }
 
@@ -121,7 +121,7 @@ fn added_parts_report_like_the_whole_check_on_brick_walls() {
         let positions = brick_wall(4, 4, offset, overhang);
         let stack: Vec<PlacedPart<'_>> = positions.iter().map(|&p| at(&brick, p)).collect();
         let what = format!("wall offset {offset} overhang {overhang}");
-        compared += compare_additions(&stack, &options(0.5, 0, 0.0), brick.mass.mass, &what);
+        compared += compare_additions(&stack, &options(0.5, 0, 0.0), brick.mass().mass, &what);
     }
     assert!(compared >= 40, "only {compared} additions compared");
 }
@@ -147,7 +147,7 @@ proptest! {
         let parts: Vec<stackplan_geom::Part> =
             boxes.iter().map(|(_, size)| box_part("box", *size)).collect();
         let stack: Vec<PlacedPart<'_>> = parts.iter().zip(&boxes).map(|(p, (lo, _))| at(p, *lo)).collect();
-        let weight = parts.iter().map(|p| p.mass.mass).fold(0.0, f64::max);
+        let weight = parts.iter().map(|p| p.mass().mass).fold(0.0, f64::max);
         compare_additions(&stack, &options(mu, 4, clearance), weight, "random boxes");
     }
 }

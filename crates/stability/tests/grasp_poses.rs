@@ -189,7 +189,7 @@ proptest! {
         let all: Vec<DVec3> = base.iter().flat_map(|&p| [p, p + DVec3::Z * 3.0]).collect();
         let Ok(hull) = convex_hull(&all) else { return Ok(()) };
         let part = Part::from_components("p", vec![hull.polytope], 1.0, PartOrigin::ConvexPieces).expect("part");
-        prop_assume!(part.mass.volume > 30.0);
+        prop_assume!(part.mass().volume > 30.0);
         let faces = grasp_faces(&part, DMat3::IDENTITY, DVec3::ZERO, &opts(1.0));
         prop_assert_eq!(faces.len(), 1);
         let f = &faces[0];
@@ -207,7 +207,7 @@ proptest! {
         let Ok(hull) = convex_hull(&points) else { return Ok(()) };
         prop_assume!(hull.polytope.volume() > 1.0);
         let part = Part::from_components("cloud", vec![hull.polytope], 1.0, PartOrigin::ConvexPieces).expect("part");
-        let cg = part.mass.center_of_gravity;
+        let cg = part.mass().center_of_gravity;
         let verts: Vec<DVec3> = part.all_vertices().collect();
         let tol = 1e-9 * 40.0;
         let mut expected: Vec<(DVec3, f64)> = Vec::new();

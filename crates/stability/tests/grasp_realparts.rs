@@ -241,7 +241,7 @@ fn check_against_reference(file: &str) -> Vec<PoseGrasp> {
         let label = format!("{file} pose {} (c.g. at {:.1} mm)", pose.hull_face, pose.cg_height);
         let faces = grasp_faces(&part, pose.rotation, pose.position, &options);
         let components: Vec<ConvexPolytope> =
-            part.components.iter().map(|c| c.transformed(pose.rotation, pose.position)).collect();
+            part.components().iter().map(|c| c.transformed(pose.rotation, pose.position)).collect();
         let planes = reference_planes(&components, radius);
         let undecided: Vec<&Plane> = planes.iter().filter(|p| p.verdict == Verdict::Undecided).collect();
         assert!(undecided.is_empty(), "{label}: the reference leaves planes undecided: {undecided:?}");

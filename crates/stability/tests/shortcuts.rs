@@ -93,7 +93,7 @@ fn shortcuts_match_the_plain_socps_on_fixture_columns() {
         options.mu = 0.4;
         let fast = check_stack(stack, &options).expect("check");
         let plain = check_stack_reference(stack, &options).expect("check");
-        assert_checks_equivalent(&fast, &plain, part.mass.mass, label);
+        assert_checks_equivalent(&fast, &plain, part.mass().mass, label);
     });
 }
 
@@ -130,7 +130,7 @@ fn shortcuts_match_the_plain_socps_on_the_planned_channel_stack() {
         let options = CheckOptions { mu, ..options() };
         let fast = check_stack(&stack, &options).expect("check");
         let plain = check_stack_reference(&stack, &options).expect("check");
-        assert_checks_equivalent(&fast, &plain, plan.part.mass.mass, &format!("planned channels, mu {mu}"));
+        assert_checks_equivalent(&fast, &plain, plan.part.mass().mass, &format!("planned channels, mu {mu}"));
     }
 }
 
@@ -199,7 +199,7 @@ proptest! {
         let options = CheckOptions { mu, ..options() };
         let fast = check_stack(&stack, &options).expect("check");
         let plain = check_stack_reference(&stack, &options).expect("check");
-        let weight: f64 = parts.iter().map(|p| p.mass.mass).sum();
+        let weight: f64 = parts.iter().map(|p| p.mass().mass).sum();
         assert_checks_equivalent(&fast, &plain, weight, "random boxes");
     }
 
@@ -222,7 +222,7 @@ proptest! {
         let options = CheckOptions { mu, ..options() };
         let fast = check_stack(&stack, &options).expect("check");
         let plain = check_stack_reference(&stack, &options).expect("check");
-        assert_checks_equivalent(&fast, &plain, brick.mass.mass * stack.len() as f64, "brick wall");
+        assert_checks_equivalent(&fast, &plain, brick.mass().mass * stack.len() as f64, "brick wall");
     }
 
     #[test]

@@ -96,8 +96,8 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         let v = parse_list(o, 3, "--offset")?;
         crate::input::check_lengths("--offset", &v)?;
         let shift = DVec3::new(v[0], v[1], v[2]);
-        let components = fixed.components.iter().map(|c| c.transformed(DMat3::IDENTITY, shift)).collect();
-        fixed = Part::from_components(fixed.name.clone(), components, fixed.density, PartOrigin::ConvexPieces)?;
+        let components = fixed.components().iter().map(|c| c.transformed(DMat3::IDENTITY, shift)).collect();
+        fixed = Part::from_components(fixed.name.clone(), components, fixed.density(), PartOrigin::ConvexPieces)?;
     }
     let moving = ContactPart::from_part(&moving).with_context(|| format!("surface of {}", args.moving))?;
     let fixed = ContactPart::from_part(&fixed).with_context(|| format!("surface of {}", args.fixed))?;

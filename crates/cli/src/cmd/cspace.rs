@@ -205,9 +205,9 @@ pub fn obstacles(args: &Args) -> anyhow::Result<Vec<PairObstacle>> {
     let theta = radians_mod_turn(args.theta_deg);
     let rotation = DMat3::from_rotation_z(theta);
     let placed: Vec<ConvexPolytope> =
-        fixed.components.iter().map(|c| c.transformed(fixed_rotation, fixed_position)).collect();
+        fixed.components().iter().map(|c| c.transformed(fixed_rotation, fixed_position)).collect();
     let mut out = Vec::new();
-    for (i, a) in moving.components.iter().enumerate() {
+    for (i, a) in moving.components().iter().enumerate() {
         for (j, b) in placed.iter().enumerate() {
             if only.is_some_and(|o| o != (i, j)) {
                 continue;

@@ -43,17 +43,17 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         files.push((args.out.join(format!("{name}.glb")), glb_bytes(&[GlbItem::part(&part)])));
         let scene = Scene {
             solids: part
-                .components
+                .components()
                 .iter()
                 .enumerate()
                 .map(|(i, c)| Solid { polytope: c.clone(), color: part_color(i), part: 0 })
                 .collect(),
-            markers: vec![Marker { position: part.mass.center_of_gravity, color: CG_MARK }],
+            markers: vec![Marker { position: part.mass().center_of_gravity, color: CG_MARK }],
             floor: Vec::new(),
             title: format!(
                 "{name}: {} convex pieces, {:.0} mm^3, {:.0} x {:.0} x {:.0} mm",
-                part.components.len(),
-                part.mass.volume,
+                part.components().len(),
+                part.mass().volume,
                 info.bounding_box[1][0] - info.bounding_box[0][0],
                 info.bounding_box[1][1] - info.bounding_box[0][1],
                 info.bounding_box[1][2] - info.bounding_box[0][2]

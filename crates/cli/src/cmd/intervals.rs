@@ -121,8 +121,8 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         load_pair(&args.moving, &args.fixed, args.triangulate, args.fixed_pose.as_deref(), args.pair.as_deref())?;
     let (rotation, translation) = (fixed_pose.rotation, fixed_pose.position);
     let mut pairs = Vec::new();
-    for (i, a) in moving.components.iter().enumerate() {
-        for (j, b) in fixed.components.iter().enumerate() {
+    for (i, a) in moving.components().iter().enumerate() {
+        for (j, b) in fixed.components().iter().enumerate() {
             if only.is_some_and(|p| p != (i, j)) {
                 continue;
             }

@@ -120,24 +120,24 @@ fn arr(v: DVec3) -> [f64; 3] {
 /// The information shown by `part info`.
 pub fn part_info(part: &Part, with_pieces: bool) -> PartInfo {
     let (lo, hi) = part.aabb();
-    let i = part.mass.inertia;
+    let i = part.mass().inertia;
     PartInfo {
         name: part.name.clone(),
         origin: part.origin.clone(),
-        components: part.components.len(),
-        volume: part.mass.volume,
-        mass: part.mass.mass,
-        density: part.density,
-        center_of_gravity: arr(part.mass.center_of_gravity),
+        components: part.components().len(),
+        volume: part.mass().volume,
+        mass: part.mass().mass,
+        density: part.density(),
+        center_of_gravity: arr(part.mass().center_of_gravity),
         inertia: [
             [i.x_axis.x, i.y_axis.x, i.z_axis.x],
             [i.x_axis.y, i.y_axis.y, i.z_axis.y],
             [i.x_axis.z, i.y_axis.z, i.z_axis.z],
         ],
         bounding_box: [arr(lo), arr(hi)],
-        boundary_faces: part.boundary.len(),
+        boundary_faces: part.boundary().len(),
         pieces: with_pieces.then(|| {
-            part.components
+            part.components()
                 .iter()
                 .map(|c| PieceJson {
                     vertices: c.vertices().iter().map(|v| arr(*v)).collect(),

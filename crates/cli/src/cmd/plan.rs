@@ -220,7 +220,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         seconds,
         args.out.display()
     ))?;
-    if let Some(note) = crate::input::origin_note(&part.origin, part.mass.volume) {
+    if let Some(note) = crate::input::origin_note(&part.origin, part.mass().volume) {
         crate::output::print_summary(&format!("part {}: {note}\n", part.name))?;
     }
     if plan.stats.cells_unsolved > 0 {

@@ -98,7 +98,7 @@ pub fn layer_counts(part: &Part, poses: &[Pose]) -> Vec<usize> {
     let mut bottoms: Vec<f64> = poses
         .iter()
         .map(|pose| {
-            part.components
+            part.components()
                 .iter()
                 .flat_map(|c| c.vertices().iter())
                 .map(|v| pose.apply(*v).z)

@@ -110,9 +110,9 @@ pub fn independent_check(
     }
     // no penetration, by the c-space crate's separating-axis classification
     let (rotation, position) = (pose.rotation, pose.translation);
-    for (i, ca) in a_part.components.iter().enumerate() {
+    for (i, ca) in a_part.components().iter().enumerate() {
         let pa = PlacedConvex::new(ca, DMat3::IDENTITY, DVec3::ZERO);
-        for (j, cb) in b_part.components.iter().enumerate() {
+        for (j, cb) in b_part.components().iter().enumerate() {
             let pb = PlacedConvex::new(cb, rotation, position);
             if let PairContact::Penetrating { depth } = classify_pair(&pa, &pb, tol, 0.0) {
                 return Err(format!("pieces {i} and {j} penetrate by {depth:e}"));

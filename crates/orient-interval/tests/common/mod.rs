@@ -88,7 +88,7 @@ pub fn example_components() -> Vec<ConvexPolytope> {
     let mut out = Vec::new();
     for name in examples::NAMES {
         if let Some(p) = examples::part_by_name(name, Decomposition::Triangulation) {
-            out.extend(p.components.into_iter().take(12));
+            out.extend(p.components().iter().take(12).cloned());
         }
     }
     out

@@ -425,7 +425,7 @@ impl Search<'_, '_> {
             raw
         } else {
             self.cache
-                .get_or_build(moving, sc.part, sc.piece, &self.request.part.components[moving], o.rotation, &sc.world)
+                .get_or_build(moving, sc.part, sc.piece, &self.request.part.components()[moving], o.rotation, &sc.world)
                 .map_err(|e| to_error(e.to_string()))?
         };
         let mut built = DerivedObstacle::from_obstacle(

@@ -96,11 +96,11 @@ pub(super) fn prepare<'r, 'a>(
         orientations_requested: request.resting_rotations.len() * n_theta,
         orientations_searched: orientations.len(),
         symmetry_orders,
-        part_components: part.components.len(),
+        part_components: part.components().len(),
         stack_components: scene.components.len(),
-        total_pairs: (part.components.len() * scene.components.len() * request.resting_rotations.len() * n_theta)
+        total_pairs: (part.components().len() * scene.components.len() * request.resting_rotations.len() * n_theta)
             as u64,
-        total_pairs_searched: (part.components.len() * scene.components.len() * orientations.len()) as u64,
+        total_pairs_searched: (part.components().len() * scene.components.len() * orientations.len()) as u64,
         ..Default::default()
     };
     caches.adopt(CacheSignature {

@@ -545,7 +545,7 @@ fn why_not_graspable(
         Some(r) => format!("{head}: the largest cup that fits is {:.1} mm", 2.0 * r),
         None => {
             let up = part
-                .boundary
+                .boundary()
                 .iter()
                 .map(|f| (pose.rotation * f.plane.normal).z)
                 .filter(|z| *z > 0.0)

@@ -123,7 +123,7 @@ impl<'p> Planner<'p> {
             contacts: candidate.contacts.clone(),
             release_drop: best.release_drop,
             rejected_candidates: best.rejected,
-            cg_height: pose.apply(part.mass.center_of_gravity).z,
+            cg_height: pose.apply(part.mass().center_of_gravity).z,
             stability_margin: None,
             grasp_radius: best.grasp_radius,
         });
