@@ -3,7 +3,7 @@
 //! * `part`: a part file (or built-in example) with a decomposition: component count, volume, centre of gravity,
 //!   bounding box, boundary face count.
 //! * `place`: one of the placement scenarios of \[A\] Figs. 15-17 (`"scenario"`: `channel`, `triangle`, `complex`;
-//!   built by `stackplan::planner::regress`): the best placement (theta, cost, position), nesting height, pairs
+//!   built by `stackplan::planner::paper_scenarios`): the best placement (theta, cost, position), nesting height, pairs
 //!   evaluated over the total, obstacles constructed and extrapolated (\[A\] Table I).
 //! * `plan`: a stacking plan (`stackplan::planner::plan_stack`) of `count` parts at weight `w`: parts placed, height,
 //!   footprint, total cost, layers (distinct c.g. heights), the largest release drop (a part released above inclined
@@ -85,7 +85,7 @@ fn part(scenario: &Value, dir: &Path) -> anyhow::Result<Fields> {
 }
 
 fn place(scenario: &Value) -> anyhow::Result<Fields> {
-    use stackplan::planner::regress;
+    use stackplan::planner::paper_scenarios as regress;
     let name = scenario.get("scenario").and_then(Value::as_str).context("place scenario has no \"scenario\"")?;
     let sc = regress::scenario(name)?.with_context(|| format!("unknown placement scenario {name:?}"))?;
     let (_, report) = regress::run(&sc)?;

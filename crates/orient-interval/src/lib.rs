@@ -11,17 +11,17 @@
 //! * [`sweep`](mod@sweep): obstacles over a list of angles, building at interval starts and extrapolating elsewhere,
 //!   with counters (\[A\] Table I);
 //! * [`structure`]: structure comparison (faces by kind and provenance, as sets);
-//! * [`regress`]: the regression summary for `cargo xtask regress`.
+//! * [`pair_summary`]: the regression summary for `cargo xtask regress`.
 
 pub mod critical;
 pub mod extrapolate;
-pub mod regress;
+pub mod pair_summary;
 pub mod structure;
 pub mod sweep;
 pub mod trig;
 
 pub use critical::{Event, EventBand, EventKind, Interval, PairEvents, Pole, TurnInterval, point_face_event};
 pub use extrapolate::{ExtrapolateError, ExtrapolatedGeometry, ObstacleStructure, extrapolate_from, rotation_z};
-pub use regress::regress_summary;
+pub use pair_summary::regress_summary;
 pub use sweep::{PairSweep, SweepStats, degree_steps, sweep, uniform_angles};
 pub use trig::Trig;

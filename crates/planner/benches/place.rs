@@ -8,7 +8,7 @@
 #![allow(clippy::print_stdout)] // a benchmark program reports its on-CPU medians beside criterion's figures
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use stackplan_planner::regress::{SCENARIOS, run, scenario};
+use stackplan_planner::paper_scenarios::{SCENARIOS, run, scenario};
 
 #[path = "common/cpu.rs"]
 mod cpu;

@@ -14,12 +14,12 @@ use cpu::process_cpu_ns;
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let Some(name) = args.first() else {
-        let value = stackplan_planner::regress::regress_place();
+        let value = stackplan_planner::paper_scenarios::regress_place();
         println!("{}", serde_json::to_string_pretty(&value).unwrap_or_default());
         return;
     };
     let repeats: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1).max(1);
-    let sc = match stackplan_planner::regress::scenario(name) {
+    let sc = match stackplan_planner::paper_scenarios::scenario(name) {
         Ok(Some(sc)) => sc,
         other => {
             println!("scenario {name}: {other:?}");
@@ -30,7 +30,7 @@ fn main() {
     let mut last = None;
     for _ in 0..repeats {
         let before = process_cpu_ns();
-        let out = stackplan_planner::regress::run(&sc);
+        let out = stackplan_planner::paper_scenarios::run(&sc);
         if let (Some(b), Some(a)) = (before, process_cpu_ns()) {
             cpu.push((a - b) as f64 / 1e6);
         }

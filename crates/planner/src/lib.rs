@@ -15,10 +15,11 @@
 //! Inside (hidden from the documentation, public only for the tests, benches and `cargo xtask`): `orientation`
 //! (`Omega` and the cost per orientation), `detect` (interference pairs at a configuration), `interval_obstacles`
 //! (obstacles extrapolated within constant-topology intervals, \[A\] IV-B), `reference` (the brute-force reference
-//! the tests compare with) and `regress` (the scenarios of \[A\] Figs. 15-17). Private: `obstacles` (the pair
-//! obstacles cut out), `plates` (one obstacle for two parallel plates where that is exact), `qp` (the QP on a cell),
+//! the tests compare with) and `paper_scenarios` (the scenarios of \[A\] Figs. 15-17). Private: `obstacles` (the pair
+//! obstacles cut out), `plates` (one obstacle for two parallel plates where that is exact), `cell_qp` (the QP on a cell),
 //! `settle` (the vertical drop of a released part) and `symmetry` (rotational symmetry about z).
 
+mod cell_qp;
 #[doc(hidden)]
 pub mod detect;
 #[doc(hidden)]
@@ -26,12 +27,11 @@ pub mod interval_obstacles;
 mod obstacles;
 #[doc(hidden)]
 pub mod orientation;
+#[doc(hidden)]
+pub mod paper_scenarios;
 mod plates;
-mod qp;
 #[doc(hidden)]
 pub mod reference;
-#[doc(hidden)]
-pub mod regress;
 pub mod request;
 pub mod search;
 mod settle;

@@ -9,10 +9,10 @@
 //!   vertical path for insertion), reporting every violated condition.
 
 use crate::PlacedPart;
+use crate::cell_qp::{Quadratic, minimise};
 use crate::detect::StackScene;
 use crate::obstacles::DerivedObstacle;
 use crate::orientation::Orientation;
-use crate::qp::{Quadratic, minimise};
 use crate::request::PlacementRequest;
 use glam::{DMat3, DVec3};
 use stackplan_cspace::ObstacleCache;
@@ -115,7 +115,7 @@ pub fn violations(
     insertion_step: f64,
 ) -> Vec<String> {
     let mut out = Vec::new();
-    let placements: Vec<stackplan_geom::PlacedPart<'_>> = stack.iter().map(|s| *s).collect();
+    let placements: Vec<stackplan_geom::PlacedPart<'_>> = stack.to_vec();
     let scene = PlacedScene::new(&placements);
     for pair in scene.interference_pairs_brute_force(part, rotation, position, request.clearance) {
         let bad = match pair.contact {

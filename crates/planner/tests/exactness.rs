@@ -99,7 +99,7 @@ proptest! {
         }
         // dense sample: no free position of any orientation beats the optimum
         let placements: Vec<stackplan_geom::PlacedPart<'_>> =
-            req.stack.iter().map(|s| *s).collect();
+            req.stack.to_vec();
         let scene = PlacedScene::new(&placements);
         let best = res.placements.first().map(|b| b.cost).unwrap_or(f64::INFINITY);
         for (ti, &theta) in req.thetas.iter().enumerate() {

@@ -88,12 +88,7 @@ proptest! {
             let v = violations(&c.part, pose.rotation, pose.position, &req.stack, &req, 1e-6, 2.0);
             prop_assert!(v.is_empty(), "{:?}", v);
         }
-        let placements: Vec<PlacedPart<'_>> = req
-            .stack
-            .iter()
-            .map(|s| *s)
-            .collect();
-        let scene = PlacedScene::new(&placements);
+        let scene = PlacedScene::new(&req.stack);
         let best = res.placements.first().map_or(f64::INFINITY, |b| b.cost);
         let (x0, y0, x1, y1, h) = FLOOR;
         let mut any_omega = false;

@@ -8,7 +8,7 @@ use glam::DVec3;
 use stackplan_cspace::ObstacleCache;
 use stackplan_geom::examples::part_by_name;
 use stackplan_geom::sheet_metal::Decomposition;
-use stackplan_planner::regress::{SCENARIOS, Scenario, scenario};
+use stackplan_planner::paper_scenarios::{SCENARIOS, Scenario, scenario};
 use stackplan_planner::search::{PlacementSearch, SearchCaches, place_with_caches};
 use stackplan_planner::{
     FloorVolume, NoPlacement, PlacementError, PlacementRequest, PlacementResult, PlanOptions, plan_stack,

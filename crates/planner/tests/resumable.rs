@@ -3,7 +3,7 @@
 //! handed back when it is dropped.
 
 use stackplan_cspace::ObstacleCache;
-use stackplan_planner::regress::{Scenario, scenario};
+use stackplan_planner::paper_scenarios::{Scenario, scenario};
 use stackplan_planner::search::{PlacementSearch, SearchCaches, place_with_caches};
 use stackplan_planner::{NoPlacement, PlacementRequest};
 

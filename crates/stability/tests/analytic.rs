@@ -123,8 +123,7 @@ fn incline_case(beta: f64, mu: f64) -> Verdict {
     let rotation = DMat3::from_rotation_y(beta);
     let up_slope = DVec3::new(-beta.cos(), 0.0, beta.sin());
     let corner = DVec3::new(length, 10.0, 0.0) + up_slope * 60.0;
-    let stack =
-        [at(&wedge, DVec3::ZERO), PlacedPart { part: &cube, pose: Pose { rotation: rotation, position: corner } }];
+    let stack = [at(&wedge, DVec3::ZERO), PlacedPart { part: &cube, pose: Pose { rotation, position: corner } }];
     let report = check_stack(&stack, &options(mu)).expect("check");
     assert_eq!(report.parts[0].stable, Verdict::Stable);
     assert!(report.parts[1].interference == 0.0, "{:?}", report.parts[1]);

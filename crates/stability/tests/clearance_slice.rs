@@ -51,7 +51,7 @@ proptest! {
         let rotation = DMat3::from_rotation_z(turn) * DMat3::from_rotation_x(tilt);
         let stack = [
             PlacedPart { part: &a, pose: Pose { rotation: DMat3::IDENTITY, position: DVec3::ZERO } },
-            PlacedPart { part: &b, pose: Pose { rotation: rotation, position: DVec3::new(shift.0, shift.1, shift.2) } },
+            PlacedPart { part: &b, pose: Pose { rotation, position: DVec3::new(shift.0, shift.1, shift.2) } },
         ];
         let parts = world_stack(&stack).expect("world");
         let (ca, cb) = (&parts[0].components[0], &parts[1].components[0]);

@@ -2,11 +2,11 @@
 //! obstacle, split into lazily solved children, or record a free optimum.
 
 use super::*;
+use crate::cell_qp::{QpOptimum, minimise};
 use crate::detect::{CandidateQueue, DetectCounts, SweepAxes};
 use crate::interval_obstacles::ObstacleRoute;
 use crate::obstacles::DerivedObstacle;
 use crate::orientation::rotated_components;
-use crate::qp::{QpOptimum, minimise};
 use crate::request::PlacementError;
 use glam::DVec3;
 use stackplan_freespace::cell::{Cell, Halfspace, Tag};

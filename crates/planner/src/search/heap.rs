@@ -2,7 +2,7 @@
 //! orientation, id), the search's total order.
 
 use super::dary_heap::DaryHeap;
-use crate::qp::QpOptimum;
+use crate::cell_qp::QpOptimum;
 use stackplan_freespace::cell::Cell;
 use std::sync::Arc;
 

@@ -35,7 +35,7 @@
 //!    emptiness is decided by a
 //!    phase 1 from the parent's optimum (`Cell::is_empty_with`: the optimum violates only
 //!    `n_k . p >= d_k`, so this is usually one LP move); a non-empty child's cell is built from a second phase 1 on
-//!    the exact cell (`Cell::with_halfspaces_from`, no Chebyshev LP) and its QP solved (`qp.rs`), and it is
+//!    the exact cell (`Cell::with_halfspaces_from`, no Chebyshev LP) and its QP solved (`cell_qp.rs`), and it is
 //!    pushed back with its own cost — so children that never become the cheapest are never solved. The keys only decide
 //!    *when* a pending child is solved, never the order of the solved nodes (a total order by (cost, orientation, id)
 //!    that a valid lower bound cannot overtake), so the search pops the same solved nodes in the same order as with the

@@ -1,8 +1,8 @@
 //! A free optimum as a placement: its pose, cost and the contacts read from the active constraints of its cell.
 
 use super::*;
+use crate::cell_qp::QpOptimum;
 use crate::obstacles::PlaneOrigin;
-use crate::qp::QpOptimum;
 use glam::DVec3;
 use stackplan_freespace::cell::{Cell, Tag};
 

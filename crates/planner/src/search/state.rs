@@ -2,11 +2,11 @@
 //! root cells and a carried frontier widened to a larger floor.
 
 use super::*;
+use crate::cell_qp::{QpOptimum, Quadratic, minimise};
 use crate::detect::{DetectScratch, StackScene, SweepAxes};
 use crate::interval_obstacles::IntervalObstacles;
 use crate::obstacles::DerivedObstacle;
 use crate::orientation::{Orientation, SeparableQuadratic};
-use crate::qp::{QpOptimum, Quadratic, minimise};
 use crate::request::{FloorVolume, PlacementError, PlacementRequest};
 use glam::DVec3;
 use rayon::prelude::*;

@@ -54,7 +54,7 @@ pub fn wedge_part(name: &str, length: f64, height: f64, width: f64) -> Part {
 
 /// A placement with identity rotation.
 pub fn at(part: &Part, position: DVec3) -> PlacedPart<'_> {
-    PlacedPart { part, pose: Pose { rotation: DMat3::IDENTITY, position: position } }
+    PlacedPart { part, pose: Pose { rotation: DMat3::IDENTITY, position } }
 }
 
 /// Margins agree within 1e-6 relative (both absent, or both present).

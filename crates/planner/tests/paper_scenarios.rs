@@ -1,10 +1,10 @@
 //! The scenarios of \[A\] Figs. 15-17: the Triangle part nests, every placement is valid, statistics are recorded.
 
+use stackplan_planner::paper_scenarios::{run, scenario};
 use stackplan_planner::reference::violations;
-use stackplan_planner::regress::{run, scenario};
 use stackplan_planner::{PlacedPart, PlacementRequest};
 
-fn check(name: &str) -> stackplan_planner::regress::ScenarioReport {
+fn check(name: &str) -> stackplan_planner::paper_scenarios::ScenarioReport {
     let sc = scenario(name).expect("stack built").expect("known scenario");
     let (result, report) = run(&sc).expect("placement");
     let best = result.placements.first().expect("a placement");
