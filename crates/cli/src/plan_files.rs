@@ -465,7 +465,8 @@ pub fn contacts_text(contacts: Option<&Value>) -> String {
     if named.is_empty() { "-".to_string() } else { named.join(", ") }
 }
 
-/// Why a part is where it is, for people: the stage that placed it, and whether cheaper candidates were rejected.
+/// Why a part is where it is, for people: the stage that placed it, whether cheaper candidates of that stage were
+/// rejected, and by which checks the candidates rejected while it was placed failed (`rejections` in plan.json).
 pub fn placement_reason(p: &Map<String, Value>) -> String {
     let stage = match p.get("stage").and_then(Value::as_u64) {
         Some(1) => "stage 1 (within the stack's footprint)",
@@ -475,13 +476,30 @@ pub fn placement_reason(p: &Map<String, Value>) -> String {
     let rejected = p.get("rejected_candidates").and_then(Value::as_u64).unwrap_or(0);
     let why = match rejected {
         0 => "the cheapest candidate of its stage passed every check".to_string(),
-        1 => "1 cheaper candidate failed a check (stability, grasp, insertion or clearance)".to_string(),
-        k => format!("{k} cheaper candidates failed a check (stability, grasp, insertion or clearance)"),
+        1 => "1 cheaper candidate of its stage failed a check".to_string(),
+        k => format!("{k} cheaper candidates of its stage failed a check"),
     };
+    let reasons = [
+        ("not_stable", "not stable on its supports"),
+        ("stack_not_stable", "the stack would not be stable"),
+        ("not_graspable", "no face for the cup"),
+        ("not_insertable", "not insertable from above"),
+        ("clearance", "too close to a part"),
+    ];
+    let counts = p.get("rejections").and_then(Value::as_object);
+    let failed: Vec<String> = reasons
+        .iter()
+        .filter_map(|(key, text)| {
+            let k = counts?.get(*key).and_then(Value::as_u64).filter(|k| *k > 0)?;
+            Some(format!("{k} {text}"))
+        })
+        .collect();
+    let failed =
+        if failed.is_empty() { String::new() } else { format!(" (rejected while placing it: {})", failed.join(", ")) };
     let drop = p.get("release_drop").and_then(Value::as_f64).unwrap_or(0.0);
     let drop =
         if drop > 0.0 { format!("; released {drop:.1} mm above its rest and drops into place") } else { String::new() };
-    format!("{stage}: {why}{drop}")
+    format!("{stage}: {why}{failed}{drop}")
 }
 
 /// The paragraph that says what the plan was asked, what it found, and why it stopped if it did.
@@ -635,6 +653,28 @@ Plan: <a href="plan.json">plan.json</a> (a stack file: <code>stackplan check pla
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The report's "why here" names the stage, the cheaper candidates of the stage, and each check that rejected
+    /// candidates while the part was placed, with its count; reasons without rejections are left out.
+    #[test]
+    fn why_here_names_the_checks_that_rejected_candidates() {
+        let part = |v: Value| v.as_object().expect("object").clone();
+        let passed = placement_reason(&part(serde_json::json!({"stage": 1, "rejected_candidates": 0})));
+        assert_eq!(
+            passed,
+            "stage 1 (within the stack's footprint): the cheapest candidate of its stage passed every check"
+        );
+        let rejected = placement_reason(&part(serde_json::json!({
+            "stage": 2, "rejected_candidates": 3, "release_drop": 0.31,
+            "rejections": {"not_stable": 2, "stack_not_stable": 0, "not_graspable": 0, "not_insertable": 1, "clearance": 0}
+        })));
+        assert_eq!(
+            rejected,
+            "stage 2 (the whole floor): 3 cheaper candidates of its stage failed a check (rejected while placing it: 2 \
+             not stable on its supports, 1 not insertable from above); released 0.3 mm above its rest and drops into \
+             place"
+        );
+    }
 
     #[test]
     fn build_frames_cover_every_part_and_end_at_n() {

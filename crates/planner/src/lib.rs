@@ -46,6 +46,7 @@ pub use search::{
     place_with_cache, place_with_caches,
 };
 pub use stack_plan::{
-    DEFAULT_MAX_CANDIDATES, Plan, PlanError, PlanOptions, PlanStats, PlannedPart, plan_stack, plan_stack_with_progress,
+    DEFAULT_MAX_CANDIDATES, Plan, PlanError, PlanOptions, PlanStats, PlannedPart, Rejections, plan_stack,
+    plan_stack_with_progress,
 };
 pub use stackplan_stability::world::PlacedPart;

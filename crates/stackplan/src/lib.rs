@@ -33,9 +33,9 @@
 //! // the c-space obstacle of component 0 turned by 30 degrees about z against component 1 (both unplaced):
 //! // translations p with the turned component 0 at p overlapping component 1
 //! let obstacle = stackplan::cspace::minkowski::obstacle(
-//!     &part.components[0],
+//!     &part.components()[0],
 //!     DMat3::from_rotation_z(30f64.to_radians()),
-//!     &part.components[1],
+//!     &part.components()[1],
 //! )?;
 //! assert!(obstacle.polytope().volume() > 0.0);
 //! # Ok::<(), Box<dyn std::error::Error>>(())

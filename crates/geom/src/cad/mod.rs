@@ -224,3 +224,23 @@ pub struct Tessellation {
     /// recognised from the mesh contain the solid to within it.
     pub chord_tolerance: f64,
 }
+
+/// The area enclosed by a closed loop of segments (mm^2), signed positive when it turns counter-clockwise about `normal` (a unit
+/// vector): the polygon of the segments' chords plus, for every arc, the circular segment between chord and arc
+/// (`r^2 (t - sin t) / 2` for a sweep `t`, with the sign of the arc's axis along the normal); a full circle gives
+/// `pi r^2`. O(segments).
+pub fn loop_area(lp: &[Segment], normal: DVec3) -> f64 {
+    let origin = lp.first().map_or(DVec3::ZERO, Segment::start);
+    lp.iter()
+        .map(|s| {
+            let chord = 0.5 * (s.start() - origin).cross(s.end() - origin).dot(normal);
+            match *s {
+                Segment::Line { .. } => chord,
+                Segment::Arc { axis, radius, .. } => {
+                    let t = s.sweep();
+                    chord + axis.dot(normal) * 0.5 * radius * radius * (t - t.sin())
+                }
+            }
+        })
+        .sum()
+}

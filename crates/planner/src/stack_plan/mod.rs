@@ -209,14 +209,60 @@ pub struct PlannedPart {
     /// robot releases it at `position + release_drop z`. 0 for a part that rests where it is released.
     #[serde(default)]
     pub release_drop: f64,
-    /// Interference-free candidates tested before this one passed (0 = the cheapest passed).
+    /// Interference-free candidates tested before this one passed in its stage (0 = the cheapest passed).
     pub rejected_candidates: usize,
+    /// Every candidate rejected while this part was placed (in every stage and the floor search), by reason.
+    #[serde(default)]
+    pub rejections: Rejections,
     /// Height of the c.g. (mm).
     pub cg_height: f64,
     /// Robustness margin of the finished stack for this part (largest horizontal load factor resisted), if computed.
     pub stability_margin: Option<f64>,
     /// Radius of the largest suction disc on its grasp face (mm).
     pub grasp_radius: f64,
+}
+
+/// Candidates rejected while one part was placed, by the check that failed (the per-part share of the
+/// `rejected_*` counters of [`PlanStats`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Rejections {
+    /// Not stable on its supports.
+    pub not_stable: usize,
+    /// The stack with it would not be stable.
+    pub stack_not_stable: usize,
+    /// No face holds the suction cup.
+    pub not_graspable: usize,
+    /// It cannot be lowered straight down into place.
+    pub not_insertable: usize,
+    /// Closer to another part than the clearance at its release position.
+    pub clearance: usize,
+}
+
+impl Rejections {
+    fn of(stats: &PlanStats) -> Self {
+        Self {
+            not_stable: stats.rejected_not_stable,
+            stack_not_stable: stats.rejected_stack_not_stable,
+            not_graspable: stats.rejected_not_graspable,
+            not_insertable: stats.rejected_not_insertable,
+            clearance: stats.rejected_clearance,
+        }
+    }
+
+    fn minus(&self, before: &Self) -> Self {
+        Self {
+            not_stable: self.not_stable - before.not_stable,
+            stack_not_stable: self.stack_not_stable - before.stack_not_stable,
+            not_graspable: self.not_graspable - before.not_graspable,
+            not_insertable: self.not_insertable - before.not_insertable,
+            clearance: self.clearance - before.clearance,
+        }
+    }
+
+    /// The sum over the reasons.
+    pub fn total(&self) -> usize {
+        self.not_stable + self.stack_not_stable + self.not_graspable + self.not_insertable + self.clearance
+    }
 }
 
 impl PlannedPart {
@@ -668,6 +714,17 @@ mod tests {
         // the rejections are proofs of instability, not solver failures
         assert!(repeated.stats.rejected_not_stable + repeated.stats.rejected_stack_not_stable >= 1);
         assert_eq!(repeated.stats.undecided_verdicts, 0);
+        // each part's rejections by reason are its share of the plan's: the fourth part's include the failures
+        // of its stage, and the shares add up to the plan's counters reason by reason
+        let fourth = repeated.parts[3].rejections;
+        assert!(fourth.total() >= repeated.parts[3].rejected_candidates, "{fourth:?}");
+        let sum = |f: fn(&Rejections) -> usize| repeated.parts.iter().map(|p| f(&p.rejections)).sum::<usize>();
+        let st = &repeated.stats;
+        assert_eq!(sum(|r| r.not_stable), st.rejected_not_stable);
+        assert_eq!(sum(|r| r.stack_not_stable), st.rejected_stack_not_stable);
+        assert_eq!(sum(|r| r.not_graspable), st.rejected_not_graspable);
+        assert_eq!(sum(|r| r.not_insertable), st.rejected_not_insertable);
+        assert_eq!(sum(|r| r.clearance), st.rejected_clearance);
     }
 
     /// L-corner at w = 0.9 (columns) with a limit of two candidates: from the fourth part on, the two cheapest

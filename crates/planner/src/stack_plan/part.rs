@@ -7,7 +7,7 @@
 
 use super::candidate::{Candidate, Verdict};
 use super::floor::{clip_to_rectangle, footprint};
-use super::{PlanError, PlanOptions, PlanStats, PlannedPart};
+use super::{PlanError, PlanOptions, PlanStats, PlannedPart, Rejections};
 use crate::orientation::Orientation;
 use crate::request::{Cost, FloorVolume, PlacementError, PlacementRequest};
 use crate::search::{NoPlacement, Placement, PlacementSearch, SearchCaches};
@@ -87,6 +87,7 @@ impl<'p> Planner<'p> {
             )));
         }
         let mut last_reason = String::from("no interference-free position");
+        let before = Rejections::of(&self.stats);
         let mut accepted: Vec<Accepted> = Vec::new();
         let stages = self.stages();
         let last_stage = stages.last().map_or(2, |s| s.0);
@@ -123,6 +124,7 @@ impl<'p> Planner<'p> {
             contacts: candidate.contacts.clone(),
             release_drop: best.release_drop,
             rejected_candidates: best.rejected,
+            rejections: Rejections::of(&self.stats).minus(&before),
             cg_height: pose.apply(part.mass().center_of_gravity).z,
             stability_margin: None,
             grasp_radius: best.grasp_radius,

@@ -4,7 +4,7 @@
 use super::StepOptions;
 use super::p21::{Body, Exchange, Instance, Record, Value};
 use crate::cad::geometry::Frame;
-use crate::cad::{Brep, BrepFace, FaceSource, Segment, Surface};
+use crate::cad::{Brep, BrepFace, FaceSource, Segment, Surface, loop_area};
 use crate::io::{IoError, Place, check_coordinate};
 use glam::DVec3;
 use std::collections::HashSet;
@@ -210,29 +210,9 @@ fn reverse_loop(lp: &mut [Segment]) {
     }
 }
 
-/// The area enclosed by a closed loop, signed positive when it turns counter-clockwise about `normal` (a unit
-/// vector): the polygon of the segments' chords plus, for every arc, the circular segment between chord and arc
-/// (`r^2 (t - sin t) / 2` for a sweep `t`, with the sign of the arc's axis along the normal); a full circle gives
-/// `pi r^2`.
-pub(crate) fn signed_area(lp: &[Segment], normal: DVec3) -> f64 {
-    let origin = lp.first().map_or(DVec3::ZERO, Segment::start);
-    lp.iter()
-        .map(|s| {
-            let chord = 0.5 * (s.start() - origin).cross(s.end() - origin).dot(normal);
-            match *s {
-                Segment::Line { .. } => chord,
-                Segment::Arc { axis, radius, .. } => {
-                    let t = s.sweep();
-                    chord + axis.dot(normal) * 0.5 * radius * radius * (t - t.sin())
-                }
-            }
-        })
-        .sum()
-}
-
 /// Puts the loop of largest absolute area first and counter-clockwise about `normal`, the others clockwise.
 fn orient_planar_loops(loops: &mut Vec<Vec<Segment>>, normal: DVec3) {
-    let areas: Vec<f64> = loops.iter().map(|lp| signed_area(lp, normal)).collect();
+    let areas: Vec<f64> = loops.iter().map(|lp| loop_area(lp, normal)).collect();
     let Some(outer) = (0..areas.len()).max_by(|&a, &b| areas[a].abs().total_cmp(&areas[b].abs())) else { return };
     for (k, lp) in loops.iter_mut().enumerate() {
         if (k == outer) != (areas[k] > 0.0) {
@@ -833,13 +813,13 @@ mod tests {
             l([0.0, 1.0], [0.0, 0.0]),
         ];
         let want = 1.0 - 0.25 + PI * 0.25 / 4.0;
-        assert!((signed_area(&lp, n) - want).abs() < 1e-12);
+        assert!((loop_area(&lp, n) - want).abs() < 1e-12);
         let mut rev = lp.clone();
         reverse_loop(&mut rev);
-        assert!((signed_area(&rev, n) + want).abs() < 1e-12);
+        assert!((loop_area(&rev, n) + want).abs() < 1e-12);
         let p = DVec3::new(3.0, 0.0, 0.0);
         let circle = Segment::Arc { center: DVec3::ZERO, axis: -n, radius: 3.0, start: p, end: p };
-        assert!((signed_area(&[circle], n) + 9.0 * PI).abs() < 1e-12);
+        assert!((loop_area(&[circle], n) + 9.0 * PI).abs() < 1e-12);
     }
 
     #[test]
@@ -860,9 +840,9 @@ mod tests {
         reverse_loop(&mut hole);
         let mut loops = vec![square(1.0), outer, hole];
         orient_planar_loops(&mut loops, n);
-        assert!((signed_area(&loops[0], n) - 25.0).abs() < 1e-12);
-        assert!((signed_area(&loops[1], n) + 1.0).abs() < 1e-12);
-        assert!((signed_area(&loops[2], n) + 1.0).abs() < 1e-12);
+        assert!((loop_area(&loops[0], n) - 25.0).abs() < 1e-12);
+        assert!((loop_area(&loops[1], n) + 1.0).abs() < 1e-12);
+        assert!((loop_area(&loops[2], n) + 1.0).abs() < 1e-12);
     }
 
     #[test]
