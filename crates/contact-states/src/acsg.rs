@@ -61,6 +61,15 @@ pub struct AcsgSettings {
     /// state holding at each is verified there and joins the graph (0 disables them).
     #[serde(default = "default_samples")]
     pub samples: usize,
+    /// Highest level whose hypotheses get a GA search when no neighbour's configuration verifies them; above it a
+    /// hypothesis is checked from its neighbours' and parents' configurations only, and its states come from the
+    /// configurations met ([`crate::discovery`]).
+    #[serde(default = "default_ga_max_level")]
+    pub ga_max_level: usize,
+}
+
+fn default_ga_max_level() -> usize {
+    2
 }
 
 fn default_samples() -> usize {
@@ -83,6 +92,7 @@ impl Default for AcsgSettings {
             max_level: 12,
             analytic_steps: default_analytic_steps(),
             samples: default_samples(),
+            ga_max_level: default_ga_max_level(),
         }
     }
 }
@@ -428,9 +438,10 @@ impl Context<'_> {
         // Proposition 1: hull of the CLCN states' ranges
         let clcn: Vec<&&StateRecord> = feasible_ids.iter().filter(|r| r.state.is_clcn_of(state, sa, sb)).collect();
         let mut search = self.bounds;
+        // a joined hypothesis starts from its parents' witnesses and a few of their extremals
         let mut seeds: Vec<Config> = parents.iter().filter_map(|r| r.witness).collect();
         let mut extremal_seeds: Vec<Config> =
-            parents.iter().flat_map(|r| r.extremals.iter().filter(|e| e.converged).map(|e| e.t)).collect();
+            parents.iter().flat_map(|r| r.extremals.iter().filter(|e| e.converged).take(3).map(|e| e.t)).collect();
         if !clcn.is_empty() {
             let mut hull: Option<ConfigBox> = None;
             for r in &clcn {
@@ -486,8 +497,8 @@ impl Context<'_> {
         // the neighbours' configurations, projected onto this state's manifold, usually verify it without a GA run
         let mut witness = None;
         if !seeds.is_empty() {
-            // the witnesses first, then the extremals; a dozen starts are plenty (two dozen for two parents)
-            seeds.truncate(if joined { 24 } else { 12 });
+            // the witnesses first, then the extremals; a dozen starts are plenty
+            seeds.truncate(if joined { 8 } else { 12 });
             match self.manifolds.interior_witness_with(
                 state,
                 &seeds,
@@ -515,7 +526,7 @@ impl Context<'_> {
                 .find(|t| self.manifolds.verify(state, t, &self.bounds).is_ok());
             record.analytic_witness = witness.is_some();
         }
-        if witness.is_none() && !joined {
+        if witness.is_none() && !joined && state.level() <= self.settings.ga_max_level {
             let f = |t: &Config| objective.value(t);
             let smooth = |t: &Config| objective.smooth_value(t);
             let ga = GaSettings { seed: hypothesis_seed, ..self.settings.ga };
@@ -689,7 +700,11 @@ pub fn generate(
                 break;
             }
             // the level's GA work, every hypothesis counted as a search, within the graph's limit (before any search)
-            let searches = batch.iter().filter(|s| !parents.contains_key(*s)).count();
+            let searches = if level <= settings.ga_max_level {
+                batch.iter().filter(|s| !parents.contains_key(*s)).count()
+            } else {
+                0
+            };
             if stats.evaluations.saturating_add(searches.saturating_mul(per_search)) > MAX_GRAPH_EVALUATIONS {
                 return Err(SettingsError::TotalEffort {
                     level,
@@ -721,7 +736,7 @@ pub fn generate(
                 } else if r.analytic_witness {
                     stats.analytic += 1;
                 } else if !r.searched_by_ga {
-                    stats.from_neighbours += 1;
+                    stats.from_neighbours += usize::from(r.feasible);
                 } else {
                     stats.searched += 1;
                     stats.evaluations += per_search;

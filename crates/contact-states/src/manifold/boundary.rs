@@ -57,17 +57,26 @@ fn is_convex(s: &SurfaceElements, e: Element) -> bool {
 }
 
 /// The lowest element whose closure holds every point of `points` within `tol`, descending from `e` through convex
-/// boundary elements only.
-pub fn locate(s: &SurfaceElements, e: Element, points: &[DVec3], tol: f64) -> Element {
+/// boundary elements only; with the distance of the points from a convex boundary element they are not within `tol`
+/// of but within `band` of (nearly but not clearly on the boundary), if any.
+pub fn locate(s: &SurfaceElements, e: Element, points: &[DVec3], tol: f64, band: f64) -> (Element, Option<f64>) {
     let mut current = e;
     loop {
-        let next = s
-            .immediate_boundary(current)
-            .into_iter()
-            .find(|b| is_convex(s, *b) && points.iter().all(|p| element_point_distance(s, *b, *p) <= tol));
+        let mut next = None;
+        let mut near: Option<f64> = None;
+        for b in s.immediate_boundary(current).into_iter().filter(|b| is_convex(s, *b)) {
+            let d = points.iter().map(|p| element_point_distance(s, b, *p)).fold(0.0, f64::max);
+            if d <= tol {
+                next = Some(b);
+                break;
+            }
+            if d <= band {
+                near = Some(near.map_or(d, |m: f64| m.min(d)));
+            }
+        }
         match next {
             Some(b) => current = b,
-            None => return current,
+            None => return (current, near),
         }
     }
 }
@@ -144,23 +153,46 @@ impl Manifolds<'_> {
         }
     }
 
-    /// The pair of elements where a PC's contact set lies ([`locate`] on each part); the PC's own elements for f-f.
-    pub fn located_pair(&self, pc: &PrincipalContact, pose: &Pose) -> (Element, Element) {
+    /// The pair of elements where a PC's contact set lies ([`locate`] on each part, `hold` with the band `clear`);
+    /// the PC's own elements for f-f. With the distance from a boundary element the contact set is nearly but not
+    /// clearly on, if any.
+    pub fn located_pair(&self, pc: &PrincipalContact, pose: &Pose) -> ((Element, Element), Option<f64>) {
         let Some(points) = self.contact_points(pc, pose) else {
-            return (pc.a, pc.b);
+            return ((pc.a, pc.b), None);
         };
-        let tol = self.hold();
+        let (tol, band) = (self.hold(), self.clear());
         let in_b: Vec<DVec3> = points.iter().map(|p| pose.inverse_apply(*p)).collect();
-        (locate(&self.fixed.surface, pc.a, &points, tol), locate(&self.moving.surface, pc.b, &in_b, tol))
+        let (a, near_a) = locate(&self.fixed.surface, pc.a, &points, tol, band);
+        let (b, near_b) = locate(&self.moving.surface, pc.b, &in_b, tol, band);
+        ((a, b), near_a.into_iter().chain(near_b).reduce(f64::min))
     }
 
-    /// The state without the PCs that only touch along a boundary where another PC holds (the module's rule).
-    pub(super) fn without_boundary_contacts(&self, state: ContactState, pose: &Pose) -> ContactState {
+    /// The state without the PCs that only touch along a boundary where another PC holds (the module's rule), and
+    /// the PC (with its distance) whose contact set is nearly but not clearly on a boundary, if any: the rule's
+    /// verdict there is ambiguous.
+    pub(super) fn without_boundary_contacts(
+        &self,
+        state: ContactState,
+        pose: &Pose,
+    ) -> (ContactState, Option<(PrincipalContact, f64)>) {
         if state.pcs.len() < 2 {
-            return state;
+            return (state, None);
         }
         let (sa, sb) = (&self.fixed.surface, &self.moving.surface);
-        let located: Vec<(Element, Element)> = state.pcs.iter().map(|pc| self.located_pair(pc, pose)).collect();
+        let mut ambiguous: Option<(PrincipalContact, f64)> = None;
+        let located: Vec<(Element, Element)> = state
+            .pcs
+            .iter()
+            .map(|pc| {
+                let (pair, near) = self.located_pair(pc, pose);
+                if let Some(d) = near
+                    && ambiguous.is_none_or(|(_, best)| d < best)
+                {
+                    ambiguous = Some((*pc, d));
+                }
+                pair
+            })
+            .collect();
         let pcs = state
             .pcs
             .iter()
@@ -175,7 +207,7 @@ impl Manifolds<'_> {
             })
             .map(|(_, (pc, _))| *pc)
             .collect();
-        ContactState { pcs }
+        (ContactState { pcs }, ambiguous)
     }
 }
 

@@ -505,10 +505,16 @@ impl<'a> Manifolds<'a> {
     /// PCs that hold at `t` (criterion `<= clear`; [`ContactState::canonical_with`]: at degenerate configurations the
     /// mapping's rules can name a PC that does not hold, such as two coplanar faces with equal normals).
     pub fn state_at(&self, t: &Config) -> ContactState {
-        self.state_of(self.holding(t).0, &Pose::from_config(t))
+        self.state_of(self.holding(t).0, &Pose::from_config(t)).0
     }
 
-    pub(super) fn state_of(&self, holding: Vec<PrincipalContact>, pose: &Pose) -> ContactState {
+    /// The state of the PPCs `holding` at `pose`, with a PC whose contact set is nearly but not clearly on a
+    /// boundary, if any ([`Self::without_boundary_contacts`]).
+    pub(super) fn state_of(
+        &self,
+        holding: Vec<PrincipalContact>,
+        pose: &Pose,
+    ) -> (ContactState, Option<(PrincipalContact, f64)>) {
         let clear = self.clear();
         let merged = ContactState::canonical_with(holding, &self.fixed.surface, &self.moving.surface, |m| {
             pc_criterion(m, self.fixed, self.moving, pose, &self.weights) <= clear
@@ -546,7 +552,10 @@ impl<'a> Manifolds<'a> {
         if let Some((pc, distance)) = ambiguous {
             return Err(Rejection::Ambiguous { pc: pc.label(), distance });
         }
-        let actual = self.state_of(holding, &pose);
+        let (actual, near_boundary) = self.state_of(holding, &pose);
+        if let Some((pc, distance)) = near_boundary {
+            return Err(Rejection::Ambiguous { pc: pc.label(), distance });
+        }
         if &actual != state {
             return Err(Rejection::OtherState { holding: actual.label() });
         }

@@ -21,6 +21,36 @@ pub fn independent_check(
     t: &Config,
     tol: f64,
 ) -> Result<(), String> {
+    let actual = classify(a, a_part, b, b_part, Some(state), t, tol)?;
+    if &actual != state {
+        return Err(format!("in contact: {} instead", actual.label()));
+    }
+    Ok(())
+}
+
+/// The state in contact at `t`, classified independently (see [`independent_check`]); an error when the parts
+/// penetrate.
+pub fn independent_state(
+    a: &ContactPart,
+    a_part: &Part,
+    b: &ContactPart,
+    b_part: &Part,
+    t: &Config,
+    tol: f64,
+) -> Result<ContactState, String> {
+    classify(a, a_part, b, b_part, None, t, tol)
+}
+
+/// With `state`, its PCs are checked to hold first.
+fn classify(
+    a: &ContactPart,
+    a_part: &Part,
+    b: &ContactPart,
+    b_part: &Part,
+    state: Option<&ContactState>,
+    t: &Config,
+    tol: f64,
+) -> Result<ContactState, String> {
     use parry3d_f64::math::Pose as PPose;
     use parry3d_f64::query::{PointQuery, distance};
     use parry3d_f64::shape::{Segment, Triangle};
@@ -70,7 +100,6 @@ pub fn independent_check(
                     t2.iter().map(move |y| distance(&id, x, &id, y).map(|d| d.distance).unwrap_or(f64::INFINITY))
                 })
                 .fold(f64::INFINITY, f64::min),
-            _ => f64::INFINITY,
         }
     };
     let pc_distance = |pc: &PrincipalContact| dist(&geo(a, pc.a, false), &geo(b, pc.b, true));
@@ -100,7 +129,7 @@ pub fn independent_check(
         }
         _ => 0.0,
     };
-    for pc in &state.pcs {
+    for pc in state.iter().flat_map(|s| s.pcs.iter()) {
         let d = pc_distance(pc);
         if d > tol {
             return Err(format!("{} apart by {d:e}", pc.label()));
@@ -216,11 +245,7 @@ pub fn independent_check(
         })
         .map(|(_, pc)| *pc)
         .collect();
-    let actual = ContactState { pcs };
-    if &actual != state {
-        return Err(format!("in contact: {} instead", actual.label()));
-    }
-    Ok(())
+    Ok(ContactState { pcs })
 }
 
 /// Parameters `(s, t)` of the closest points of segments `p0 p1` and `q0 q1`: the stationary point of the squared
