@@ -1,4 +1,4 @@
-//! `stackplan part info PART [--json]` and `stackplan part export PART --glb F | --obj F | --stl F`.
+//! `stackplan part info PART [--json [--features]]` and `stackplan part export PART --glb F | --obj F | --stl F`.
 
 use crate::Outcome;
 use crate::input::{PartArgs, load_part};
