@@ -162,3 +162,62 @@ fn a_part_turned_and_stored_in_single_precision_rests_as_in_double_precision() {
         assert!((d - s).abs() <= 1e-3, "margins {double:?} (f64) vs {single:?} (f32)");
     }
 }
+
+/// `part info --json --features` lists the merged surface's elements that `contacts` names, and `contacts --json`
+/// lists the same for both parts: a channel's faces are named after its plates; a block's faces have no names, its
+/// face centroids are the face centres and its edges' end points lie on both of their faces.
+#[test]
+fn features_name_the_elements_of_contact_states() {
+    let o = run(&["part", "info", "example:channel", "--json", "--features"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("JSON");
+    let faces = v["features"]["faces"].as_array().expect("faces");
+    let names: Vec<&str> = faces.iter().filter_map(|f| f["name"].as_str()).collect();
+    assert_eq!(names.len(), faces.len(), "{names:?}");
+    for name in ["plate1.front", "plate1.back", "plate2.front", "plate3.back"] {
+        assert!(names.contains(&name), "{name} in {names:?}");
+    }
+    // without --json the flag is an error
+    let o = run(&["part", "info", "example:channel", "--features"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+
+    let o = run(&[
+        "contacts",
+        "example:cube",
+        "example:block",
+        "--t-min=-1,-1,100,-1,-1,-1",
+        "--t-max=1,1,100.5,1,1,1",
+        "--population",
+        "8",
+        "--generations",
+        "2",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("JSON");
+    let fixed = &v["fixed_features"];
+    assert_eq!(fixed["faces"].as_array().map(Vec::len), Some(6));
+    assert_eq!(fixed["edges"].as_array().map(Vec::len), Some(12));
+    assert_eq!(fixed["vertices"].as_array().map(Vec::len), Some(8));
+    let point = |p: &serde_json::Value| [0, 1, 2].map(|k| p[k].as_f64().expect("coordinate"));
+    for f in fixed["faces"].as_array().expect("faces") {
+        assert!(f["name"].is_null());
+        let (c, n) = (point(&f["centroid"]), point(&f["normal"]));
+        // the block [0, 80] x [0, 80] x [0, 100]: the face centre is the centre moved by half the size along n
+        let expected = [40.0 + 40.0 * n[0], 40.0 + 40.0 * n[1], 50.0 + 50.0 * n[2]];
+        assert!((0..3).all(|k| (c[k] - expected[k]).abs() < 1e-9), "{f}");
+    }
+    let faces = fixed["faces"].as_array().expect("faces");
+    for e in fixed["edges"].as_array().expect("edges") {
+        for end in e["endpoints"].as_array().expect("endpoints") {
+            let p = point(end);
+            for f in e["faces"].as_array().expect("faces") {
+                let face = &faces[f.as_u64().expect("index") as usize];
+                let (c, n) = (point(&face["centroid"]), point(&face["normal"]));
+                let height: f64 = (0..3).map(|k| (p[k] - c[k]) * n[k]).sum();
+                assert!(height.abs() < 1e-9, "{e}");
+            }
+        }
+    }
+    assert_eq!(v["moving_features"]["faces"].as_array().map(Vec::len), Some(6));
+}

@@ -23,7 +23,9 @@
 
 use crate::analytic_seeds::edge_edge_candidates;
 use crate::criteria::{ContactPart, Objective, Weights, face_point_distance_2d};
+use crate::discovery::{contact_samples, state_with_witness};
 use crate::extremal::{Extremal, extremals, range_of};
+use crate::features::{Features, readable_label};
 use crate::ga::{GaSettings, SettingsError, check_count, minimise_with_polish, mix_seed};
 use crate::manifold::{Manifolds, Rejection, StrictTolerances, segment_segment_distance};
 use crate::pose::{Config, ConfigBox, VARIABLE_NAMES};
@@ -55,6 +57,23 @@ pub struct AcsgSettings {
     /// Grid values per angle of the analytic edge-edge candidates ([`crate::analytic_seeds`]; 0 disables them).
     #[serde(default = "default_analytic_steps")]
     pub analytic_steps: usize,
+    /// Seeded configurations pushed into contact before the search ([`crate::discovery::contact_samples`]); the
+    /// state holding at each is verified there and joins the graph (0 disables them).
+    #[serde(default = "default_samples")]
+    pub samples: usize,
+    /// Highest level whose hypotheses get a GA search when no neighbour's configuration verifies them; above it a
+    /// hypothesis is checked from its neighbours' and parents' configurations only, and its states come from the
+    /// configurations met ([`crate::discovery`]).
+    #[serde(default = "default_ga_max_level")]
+    pub ga_max_level: usize,
+}
+
+fn default_ga_max_level() -> usize {
+    2
+}
+
+fn default_samples() -> usize {
+    2000
 }
 
 fn default_analytic_steps() -> usize {
@@ -72,6 +91,8 @@ impl Default for AcsgSettings {
             widen: 0.05,
             max_level: 12,
             analytic_steps: default_analytic_steps(),
+            samples: default_samples(),
+            ga_max_level: default_ga_max_level(),
         }
     }
 }
@@ -85,8 +106,8 @@ pub const MAX_ANALYTIC_STEPS: usize = 64;
 /// objective, 250 times the default run's 4 million).
 pub const MAX_GRAPH_EVALUATIONS: usize = 1_000_000_000;
 
-/// The most witness attempts per start ([`AcsgSettings::witness_attempts`]) and projections per extremal search
-/// ([`AcsgSettings::extremal_budget`]).
+/// The most witness attempts per start ([`AcsgSettings::witness_attempts`]), projections per extremal search
+/// ([`AcsgSettings::extremal_budget`]) and contact samples ([`AcsgSettings::samples`]).
 pub const MAX_ATTEMPTS: usize = 1_000_000;
 
 impl AcsgSettings {
@@ -98,6 +119,7 @@ impl AcsgSettings {
         check_count("witness_attempts", self.witness_attempts, 0, MAX_ATTEMPTS)?;
         check_count("extremal_budget", self.extremal_budget, 0, MAX_ATTEMPTS)?;
         check_count("analytic_steps", self.analytic_steps, 0, MAX_ANALYTIC_STEPS)?;
+        check_count("samples", self.samples, 0, MAX_ATTEMPTS)?;
         for (name, value) in [
             ("threshold_relative", self.threshold_relative),
             ("widen", self.widen),
@@ -121,6 +143,10 @@ pub struct StateRecord {
     pub state: ContactState,
     /// Label such as `{f2-v3}` (A's element first).
     pub label: String,
+    /// The label with the elements' names where the parts' faces have names ([`crate::features::readable_label`];
+    /// the label otherwise).
+    #[serde(default)]
+    pub name: String,
     /// Level (number of point contacts).
     pub level: usize,
     /// Whether a configuration in the box verifies the state strictly (its PCs and no others in contact, no
@@ -137,6 +163,10 @@ pub struct StateRecord {
     /// Whether the witness is an analytic edge-edge crossing ([`crate::analytic_seeds`]), checked before any GA run.
     #[serde(default)]
     pub analytic_witness: bool,
+    /// Whether the state was found at a configuration (a contact sample, or a configuration met while searching
+    /// another state) rather than as a hypothesis; the witness is that configuration or its projection.
+    #[serde(default)]
+    pub discovered: bool,
     /// Why the hypothesis was rejected without a search, if it was.
     pub pruned: Option<String>,
     /// The configuration attaining `objective`.
@@ -172,6 +202,14 @@ pub struct AcsgStats {
     /// Single e-e hypotheses verified at an analytic crossing without a GA run.
     #[serde(default)]
     pub analytic: usize,
+    /// States found at configurations (contact samples, GA minima, extremals, rejected candidates) and verified there
+    /// ([`crate::discovery`]).
+    #[serde(default)]
+    pub discovered: usize,
+    /// Hypotheses made by joining two feasible states (one of them a single PC), checked by projecting their
+    /// configurations onto the joint manifold without a GA run.
+    #[serde(default)]
+    pub joined: usize,
     /// Hypotheses with a candidate configuration (a projected neighbour's configuration or a GA minimum below the
     /// threshold) that failed the strict check and were not verified otherwise.
     pub rejected_candidates: usize,
@@ -198,6 +236,12 @@ pub struct Acsg {
     pub threshold: f64,
     /// Strict contact tolerance `hold * L` (mm).
     pub hold: f64,
+    /// Every face, edge and vertex of the fixed part A that a PC can name.
+    #[serde(default)]
+    pub fixed_features: Features,
+    /// Every face, edge and vertex of the moving part B that a PC can name.
+    #[serde(default)]
+    pub moving_features: Features,
     /// Evaluated hypotheses (feasible and infeasible), in evaluation order.
     pub states: Vec<StateRecord>,
     /// CLCN/CMCN relations between feasible states.
@@ -339,23 +383,43 @@ struct Context<'a> {
 }
 
 impl Context<'_> {
+    /// Evaluates a hypothesis; also returns the configurations met on the way that may lie in other states (the GA
+    /// minimum, candidates rejected as another state, the extremals), for [`crate::discovery`].
     fn evaluate(
         &self,
         state: &ContactState,
         known: &HashMap<ContactState, StateRecord>,
         feasible_ids: &[&StateRecord],
+        parents: &[&StateRecord],
+    ) -> (StateRecord, Vec<Config>) {
+        let mut found = Vec::new();
+        let record = self.evaluate_into(state, known, feasible_ids, parents, &mut found);
+        (record, found)
+    }
+
+    fn evaluate_into(
+        &self,
+        state: &ContactState,
+        known: &HashMap<ContactState, StateRecord>,
+        feasible_ids: &[&StateRecord],
+        parents: &[&StateRecord],
+        found: &mut Vec<Config>,
     ) -> StateRecord {
+        // a joined hypothesis (two feasible states' contacts together) is checked from their configurations only
+        let joined = !parents.is_empty();
         let (sa, sb) = (&self.fixed.surface, &self.moving.surface);
         let mut record = StateRecord {
             id: 0,
             state: state.clone(),
             label: state.label(),
+            name: String::new(),
             level: state.level(),
             feasible: false,
             objective: None,
             rejection: None,
             searched_by_ga: false,
             analytic_witness: false,
+            discovered: false,
             pruned: None,
             witness: None,
             search_box: None,
@@ -374,8 +438,10 @@ impl Context<'_> {
         // Proposition 1: hull of the CLCN states' ranges
         let clcn: Vec<&&StateRecord> = feasible_ids.iter().filter(|r| r.state.is_clcn_of(state, sa, sb)).collect();
         let mut search = self.bounds;
-        let mut seeds: Vec<Config> = Vec::new();
-        let mut extremal_seeds: Vec<Config> = Vec::new();
+        // a joined hypothesis starts from its parents' witnesses and a few of their extremals
+        let mut seeds: Vec<Config> = parents.iter().filter_map(|r| r.witness).collect();
+        let mut extremal_seeds: Vec<Config> =
+            parents.iter().flat_map(|r| r.extremals.iter().filter(|e| e.converged).take(3).map(|e| e.t)).collect();
         if !clcn.is_empty() {
             let mut hull: Option<ConfigBox> = None;
             for r in &clcn {
@@ -402,7 +468,13 @@ impl Context<'_> {
         if state.pcs.len() > 1 {
             for pc in &state.pcs {
                 if let Some(single) = known.get(&ContactState::single(*pc)) {
-                    if !single.feasible {
+                    // a PC that holds nowhere in the box (no candidate, or candidates apart) cannot hold in the
+                    // state; one that holds only together with other contacts (rejected as another state) can
+                    let holds_elsewhere = matches!(
+                        single.rejection,
+                        Some(Rejection::OtherState { .. } | Rejection::Ambiguous { .. } | Rejection::NotExact { .. })
+                    );
+                    if !single.feasible && !holds_elsewhere {
                         record.pruned = Some(format!("{} alone is infeasible (Proposition 2)", pc.label()));
                         return record;
                     }
@@ -426,14 +498,15 @@ impl Context<'_> {
         let mut witness = None;
         if !seeds.is_empty() {
             // the witnesses first, then the extremals; a dozen starts are plenty
-            seeds.truncate(12);
+            seeds.truncate(if joined { 8 } else { 12 });
             match self.manifolds.interior_witness_with(
                 state,
                 &seeds,
                 &self.bounds,
                 hypothesis_seed,
-                self.settings.witness_attempts,
+                if joined { 2 } else { self.settings.witness_attempts },
                 false,
+                found,
             ) {
                 Ok(w) => witness = Some(w),
                 Err(e) => record.rejection = Some(e),
@@ -442,6 +515,7 @@ impl Context<'_> {
         // a single e-e contact: crossings built analytically, checked in a fixed order (deterministic; the GA minimum
         // of such a thin state usually lies in a neighbouring f-e / e-f / f-f state)
         if witness.is_none()
+            && !joined
             && self.settings.analytic_steps > 0
             && let [pc] = state.pcs.as_slice()
             && pc.kind() == PcType::EdgeEdge
@@ -452,7 +526,7 @@ impl Context<'_> {
                 .find(|t| self.manifolds.verify(state, t, &self.bounds).is_ok());
             record.analytic_witness = witness.is_some();
         }
-        if witness.is_none() {
+        if witness.is_none() && !joined && state.level() <= self.settings.ga_max_level {
             let f = |t: &Config| objective.value(t);
             let smooth = |t: &Config| objective.smooth_value(t);
             let ga = GaSettings { seed: hypothesis_seed, ..self.settings.ga };
@@ -461,14 +535,17 @@ impl Context<'_> {
             record.searched_by_ga = true;
             record.objective = Some(m.value);
             record.witness = Some(m.t);
+            found.push(m.t);
             if m.value <= self.threshold {
-                match self.manifolds.interior_witness(
+                match self.manifolds.interior_witness_with(
                     state,
                     &[m.t],
                     &self.bounds,
                     mix_seed(hypothesis_seed, 1),
                     // single PPCs have no neighbours to start from, and every state above grows from them
                     self.settings.witness_attempts * if state.pcs.len() == 1 && state.level() == 1 { 6 } else { 2 },
+                    true,
+                    found,
                 ) {
                     Ok(w) => witness = Some(w),
                     Err(e) => record.rejection = Some(e),
@@ -482,9 +559,82 @@ impl Context<'_> {
             record.objective = Some(objective.value(&w));
             record.extremals = extremals(&self.manifolds, state, &self.bounds, w, self.settings.extremal_budget);
             record.range = Some(range_of(&record.extremals, &self.bounds));
+            found.extend(record.extremals.iter().map(|e| e.t));
         }
         tracing::debug!(state = %record.label, value = ?record.objective, feasible = record.feasible, "hypothesis evaluated");
         record
+    }
+}
+
+impl Context<'_> {
+    /// The states holding at `configs` (drained) that are not yet feasible, verified there
+    /// ([`state_with_witness`]), with their extremals, recorded as feasible and `discovered`; the configurations met
+    /// by their extremal searches are classified in turn. Returns the new feasible states.
+    fn discover(
+        &self,
+        configs: &mut Vec<Config>,
+        known: &mut HashMap<ContactState, StateRecord>,
+        order: &mut Vec<ContactState>,
+        stats: &mut AcsgStats,
+    ) -> Vec<ContactState> {
+        let mut out = Vec::new();
+        while !configs.is_empty() {
+            let classified: Vec<Option<(ContactState, Config)>> = configs
+                .par_iter()
+                .map(|t| {
+                    let s = self.manifolds.state_at(t);
+                    if s.pcs.is_empty() || known.get(&s).is_some_and(|r| r.feasible) {
+                        return None;
+                    }
+                    state_with_witness(&self.manifolds, t, &self.bounds)
+                })
+                .collect();
+            configs.clear();
+            // the first configuration of each new state, in the order met
+            let mut fresh: Vec<(ContactState, Config)> = Vec::new();
+            for (s, w) in classified.into_iter().flatten() {
+                if !known.get(&s).is_some_and(|r| r.feasible) && !fresh.iter().any(|(f, _)| f == &s) {
+                    fresh.push((s, w));
+                }
+            }
+            let records: Vec<StateRecord> = fresh
+                .par_iter()
+                .map(|(s, w)| {
+                    let objective =
+                        Objective { fixed: self.fixed, moving: self.moving, state: s, weights: self.weights };
+                    let extremals = extremals(&self.manifolds, s, &self.bounds, *w, self.settings.extremal_budget);
+                    StateRecord {
+                        id: 0,
+                        state: s.clone(),
+                        label: s.label(),
+                        name: String::new(),
+                        level: s.level(),
+                        feasible: true,
+                        objective: Some(objective.value(w)),
+                        rejection: None,
+                        searched_by_ga: false,
+                        analytic_witness: false,
+                        discovered: true,
+                        pruned: None,
+                        witness: Some(*w),
+                        search_box: None,
+                        range: Some(range_of(&extremals, &self.bounds)),
+                        extremals,
+                    }
+                })
+                .collect();
+            for r in records {
+                tracing::debug!(state = %r.label, "state found at a configuration");
+                configs.extend(r.extremals.iter().map(|e| e.t));
+                stats.discovered += 1;
+                out.push(r.state.clone());
+                if !known.contains_key(&r.state) {
+                    order.push(r.state.clone());
+                }
+                known.insert(r.state.clone(), r);
+            }
+        }
+        out
     }
 }
 
@@ -518,81 +668,159 @@ pub fn generate(
     let mut order: Vec<ContactState> = Vec::new();
     let mut queue: BTreeMap<usize, Vec<ContactState>> = BTreeMap::new();
     let mut seen: HashSet<ContactState> = HashSet::new();
+    // joined hypotheses (checked from their parents' configurations only) and their two parents
+    let mut parents: HashMap<ContactState, [ContactState; 2]> = HashMap::new();
     for pc in &ppcs {
         let s = ContactState::single(*pc);
         if seen.insert(s.clone()) {
             queue.entry(1).or_default().push(s);
         }
     }
-    let mut feasible_ppcs: Vec<PrincipalContact> = Vec::new();
     let faces_can_face = can_face(sa, sb, &bounds);
-    while let Some((level, batch)) = queue.pop_first() {
-        if level > settings.max_level {
+    // level 1's GA work within the graph's limit, before any search (the samples' states have extremal searches)
+    let per_search = settings.ga.evaluations_per_search();
+    let level_one = queue.get(&1).map_or(0, Vec::len);
+    if level_one.saturating_mul(per_search) > MAX_GRAPH_EVALUATIONS {
+        return Err(SettingsError::TotalEffort {
+            level: 1,
+            hypotheses: level_one,
+            per_search,
+            spent: 0,
+            max: MAX_GRAPH_EVALUATIONS,
+        });
+    }
+    // states found at configurations: first the contact samples
+    let mut configs = contact_samples(&ctx.manifolds, &bounds, settings.samples, mix_seed(settings.ga.seed, 0x5a));
+    // feasible states not yet combined with the others (combinations start once every PPC is evaluated)
+    let mut uncombined: Vec<ContactState> = ctx.discover(&mut configs, &mut known, &mut order, &mut stats);
+    let mut level_one_done = false;
+    loop {
+        if let Some((level, batch)) = queue.pop_first() {
+            if level > settings.max_level {
+                break;
+            }
+            // the level's GA work, every hypothesis counted as a search, within the graph's limit (before any search)
+            let searches = if level <= settings.ga_max_level {
+                batch.iter().filter(|s| !parents.contains_key(*s)).count()
+            } else {
+                0
+            };
+            if stats.evaluations.saturating_add(searches.saturating_mul(per_search)) > MAX_GRAPH_EVALUATIONS {
+                return Err(SettingsError::TotalEffort {
+                    level,
+                    hypotheses: searches,
+                    per_search,
+                    spent: stats.evaluations,
+                    max: MAX_GRAPH_EVALUATIONS,
+                });
+            }
+            // a state discovered meanwhile is not evaluated again
+            let batch: Vec<ContactState> =
+                batch.into_iter().filter(|s| known.get(s).is_none_or(|r| !r.feasible)).collect();
+            let feasible_so_far: Vec<&StateRecord> =
+                order.iter().filter_map(|s| known.get(s)).filter(|r| r.feasible).collect();
+            let results: Vec<(StateRecord, Vec<Config>)> = batch
+                .par_iter()
+                .map(|s| {
+                    let from: Vec<&StateRecord> =
+                        parents.get(s).map(|p| p.iter().filter_map(|q| known.get(q)).collect()).unwrap_or_default();
+                    ctx.evaluate(s, &known, &feasible_so_far, &from)
+                })
+                .collect();
+            let mut new_feasible = 0;
+            for (r, mut found) in results {
+                if r.pruned.is_some() {
+                    stats.pruned += 1;
+                } else if parents.contains_key(&r.state) {
+                    stats.joined += 1;
+                } else if r.analytic_witness {
+                    stats.analytic += 1;
+                } else if !r.searched_by_ga {
+                    stats.from_neighbours += usize::from(r.feasible);
+                } else {
+                    stats.searched += 1;
+                    stats.evaluations += per_search;
+                }
+                if !r.feasible && r.rejection.is_some() {
+                    stats.rejected_candidates += 1;
+                }
+                configs.append(&mut found);
+                if known.get(&r.state).is_some_and(|k| k.feasible) {
+                    continue;
+                }
+                if r.feasible {
+                    new_feasible += 1;
+                    uncombined.push(r.state.clone());
+                }
+                if !known.contains_key(&r.state) {
+                    order.push(r.state.clone());
+                }
+                known.insert(r.state.clone(), r);
+            }
+            tracing::info!(level, hypotheses = batch.len(), feasible = new_feasible, "level evaluated");
+            if level == 1 {
+                level_one_done = true;
+            }
+        } else if configs.is_empty() && (uncombined.is_empty() || !level_one_done) {
             break;
         }
-        // the level's GA work, every hypothesis counted as a search, within the graph's limit (before any search)
-        let per_search = settings.ga.evaluations_per_search();
-        if stats.evaluations.saturating_add(batch.len().saturating_mul(per_search)) > MAX_GRAPH_EVALUATIONS {
-            return Err(SettingsError::TotalEffort {
-                level,
-                hypotheses: batch.len(),
-                per_search,
-                spent: stats.evaluations,
-                max: MAX_GRAPH_EVALUATIONS,
-            });
+        // the configurations met while searching: their states, and the configurations met while those are searched
+        uncombined.extend(ctx.discover(&mut configs, &mut known, &mut order, &mut stats));
+        if !level_one_done {
+            continue;
         }
-        let feasible_so_far: Vec<&StateRecord> =
-            order.iter().filter_map(|s| known.get(s)).filter(|r| r.feasible).collect();
-        let records: Vec<StateRecord> = batch.par_iter().map(|s| ctx.evaluate(s, &known, &feasible_so_far)).collect();
-        let mut new_feasible: Vec<ContactState> = Vec::new();
-        for r in records {
-            if r.pruned.is_some() {
-                stats.pruned += 1;
-            } else if r.analytic_witness {
-                stats.analytic += 1;
-            } else if !r.searched_by_ga {
-                stats.from_neighbours += 1;
-            } else {
-                stats.searched += 1;
-                stats.evaluations += per_search;
-            }
-            if !r.feasible && r.rejection.is_some() {
-                stats.rejected_candidates += 1;
-            }
-            if r.feasible {
-                new_feasible.push(r.state.clone());
-                if level == 1 {
-                    feasible_ppcs.push(r.state.pcs[0]);
-                }
-            }
-            order.push(r.state.clone());
-            known.insert(r.state.clone(), r);
-        }
-        tracing::info!(level, hypotheses = batch.len(), feasible = new_feasible.len(), "level evaluated");
-        // level 1 completes before any combination, so every feasible PPC is known here
-        for s in &new_feasible {
-            for p in &feasible_ppcs {
-                if s.pcs.contains(p) {
+        // combinations (step 2): each new feasible state with every feasible PPC (the GA route of [P]), and with
+        // every feasible single-PC state (joined: contacts that the bounds force together, such as two faces flat)
+        let feasible: Vec<&StateRecord> = order.iter().filter_map(|s| known.get(s)).filter(|r| r.feasible).collect();
+        let singles: Vec<&StateRecord> = feasible.iter().copied().filter(|r| r.state.pcs.len() == 1).collect();
+        let combine = |pcs: Vec<PrincipalContact>| {
+            ContactState::canonical_with(pcs, sa, sb, |m| {
+                m.kind() != PcType::FaceFace || faces_can_face(m.a.index, m.b.index)
+            })
+        };
+        for s in std::mem::take(&mut uncombined) {
+            let Some(rs) = known.get(&s) else { continue };
+            for t in &singles {
+                let p = t.state.pcs[0];
+                if s.pcs.contains(&p) {
                     continue;
                 }
                 let mut pcs = s.pcs.clone();
-                pcs.push(*p);
-                let c = ContactState::canonical_with(pcs, sa, sb, |m| {
-                    m.kind() != PcType::FaceFace || faces_can_face(m.a.index, m.b.index)
-                });
-                if c.level() > s.level() && seen.insert(c.clone()) {
+                pcs.push(p);
+                let c = combine(pcs);
+                if c.level() <= s.level().max(t.level) || known.get(&c).is_some_and(|r| r.feasible) {
+                    continue;
+                }
+                if p.is_ppc() {
+                    // the GA route; a queued joined hypothesis gets the GA as well
+                    if seen.insert(c.clone()) {
+                        queue.entry(c.level()).or_default().push(c);
+                    } else if !known.contains_key(&c) {
+                        parents.remove(&c);
+                    }
+                    continue;
+                }
+                // joined: only where the two states' ranges meet (the joint state lies in both closures)
+                let meet = match (rs.range, t.range) {
+                    (Some(a), Some(b)) => a
+                        .widened_within(&bounds, settings.widen)
+                        .intersect(&b.widened_within(&bounds, settings.widen))
+                        .is_some(),
+                    _ => false,
+                };
+                if meet && seen.insert(c.clone()) {
+                    parents.insert(c.clone(), [s.clone(), t.state.clone()]);
                     queue.entry(c.level()).or_default().push(c);
                 }
             }
         }
-        if level == 1 {
-            // feasible single states at level 1 were all pushed above only after every PPC was evaluated
-            continue;
-        }
     }
     let mut states: Vec<StateRecord> = order.iter().filter_map(|s| known.remove(s)).collect();
+    let fixed_features = Features::new(sa, &fixed.face_names);
+    let moving_features = Features::new(sb, &moving.face_names);
     for (i, r) in states.iter_mut().enumerate() {
         r.id = i;
+        r.name = readable_label(&r.state, &fixed_features, &moving_features);
     }
     let feasible: Vec<&StateRecord> = states.iter().filter(|r| r.feasible).collect();
     let mut relations = Vec::new();
@@ -611,6 +839,8 @@ pub fn generate(
         length: weights.length,
         threshold,
         hold,
+        fixed_features,
+        moving_features,
         states,
         relations,
         stats,
@@ -639,7 +869,8 @@ impl Acsg {
         let mut levels: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
         for r in self.feasible() {
             levels.entry(r.level).or_default().push(r.id);
-            s.push_str(&format!("  s{} [label=\"{}\\nlevel {}\"];\n", r.id, r.label.replace('"', "'"), r.level));
+            let name = if r.name.is_empty() { &r.label } else { &r.name };
+            s.push_str(&format!("  s{} [label=\"{}\\nlevel {}\"];\n", r.id, name.replace('"', "'"), r.level));
         }
         for ids in levels.values() {
             let names: Vec<String> = ids.iter().map(|i| format!("s{i}")).collect();

@@ -49,6 +49,8 @@ pub struct ContactPart {
     pub face_polygons: Vec<Vec<Vec<DVec3>>>,
     /// Per face, the mean of its polygon vertices.
     pub face_centres: Vec<DVec3>,
+    /// Per face, its name where the part's faces have names ([`crate::features::face_names`]).
+    pub face_names: Vec<Option<String>>,
 }
 
 impl ContactPart {
@@ -56,7 +58,8 @@ impl ContactPart {
     pub fn from_part(part: &Part) -> Result<Self, SurfaceError> {
         let surface = SurfaceElements::from_part(part)?;
         let pieces = part.components().iter().map(ConvexPiece::from_polytope).collect();
-        Ok(Self::new(part.name.clone(), surface, pieces))
+        let names = crate::features::face_names(part, &surface);
+        Ok(Self { face_names: names, ..Self::new(part.name.clone(), surface, pieces) })
     }
 
     /// From a surface and its convex pieces.
@@ -69,7 +72,8 @@ impl ContactPart {
                 ps.iter().flatten().copied().sum::<DVec3>() / n as f64
             })
             .collect();
-        Self { name, surface, pieces, face_polygons, face_centres }
+        let face_names = vec![None; surface.faces.len()];
+        Self { name, surface, pieces, face_polygons, face_centres, face_names }
     }
 
     /// Bounding box of the pieces.

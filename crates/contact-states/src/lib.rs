@@ -21,8 +21,10 @@
 pub mod acsg;
 pub mod analytic_seeds;
 pub mod criteria;
+pub mod discovery;
 pub mod dxf_input;
 pub mod extremal;
+pub mod features;
 pub mod ga;
 pub mod growth_distance;
 pub mod manifold;

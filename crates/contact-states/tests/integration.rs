@@ -5,4 +5,5 @@
 mod acsg_counts;
 mod block_l_corner;
 mod common;
+mod forced_contacts;
 mod growth_distance_props;

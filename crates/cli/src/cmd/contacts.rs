@@ -155,7 +155,8 @@ pub fn contacts_text(graph: &stackplan::contact_states::acsg::Acsg) -> String {
         };
         let objective = r.objective.map_or("-".to_string(), |o| format!("{o:.3e}"));
         let feasibility = if r.feasible { "feasible" } else { "infeasible" };
-        let _ = writeln!(text, "{:<32} {objective:>11} {feasibility:<11} {lo:<62} {hi:<62}", r.label);
+        let name = if r.name.is_empty() { &r.label } else { &r.name };
+        let _ = writeln!(text, "{name:<32} {objective:>11} {feasibility:<11} {lo:<62} {hi:<62}");
     }
     text
 }

@@ -1,4 +1,4 @@
-//! `stackplan part info PART [--json]` and `stackplan part export PART --glb F | --obj F | --stl F`.
+//! `stackplan part info PART [--json [--features]]` and `stackplan part export PART --glb F | --obj F | --stl F`.
 
 use crate::Outcome;
 use crate::input::{PartArgs, load_part};
@@ -30,6 +30,10 @@ pub struct InfoArgs {
     /// JSON output, including every convex component's vertices and faces.
     #[arg(long)]
     pub json: bool,
+    /// With `--json`: also `features`, every face, edge and vertex of the merged surface that `contacts` names
+    /// (`f3`, `e7`, `v2`).
+    #[arg(long, requires = "json")]
+    pub features: bool,
 }
 
 /// Arguments of `part export`.
@@ -167,6 +171,12 @@ fn info(args: &InfoArgs) -> anyhow::Result<Outcome> {
     }
     if args.json {
         let mut json = serde_json::to_value(&info)?;
+        if args.features {
+            let surface = stackplan::contact_states::ContactPart::from_part(&part)
+                .map_err(|e| anyhow::anyhow!("surface of {}: {e}", args.part.part))?;
+            let features = stackplan::contact_states::features::Features::new(&surface.surface, &surface.face_names);
+            json["features"] = serde_json::to_value(features)?;
+        }
         for key in ["start", "angle"] {
             output::rename_key(&mut json, &["recognition", "bends", "*", "bend", key], &format!("{key}_rad"));
         }
