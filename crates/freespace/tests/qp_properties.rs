@@ -4,11 +4,9 @@ use crate::common;
 
 use common::{Rng, Shape, bbox, random_cell};
 use proptest::prelude::*;
-use stackplan_freespace::{
-    Cell, Halfspace, SeparableCost, SeparableQuadratic, desired_position_cost, minimize, minimize_clarabel, omega,
-    stacking_cost, verify_kkt,
-};
-use stackplan_geom::{Containment, DVec2, DVec3};
+use common::{desired_position_cost, stacking_cost};
+use stackplan_freespace::{Cell, Halfspace, SeparableCost, minimize, minimize_clarabel, verify_kkt};
+use stackplan_geom::{Containment, DVec3, Tolerance};
 
 #[derive(Debug, Clone, Copy)]
 enum CostKind {
@@ -146,15 +144,17 @@ proptest! {
         check_case(seed, shape_of(shape), if w1 { CostKind::W1 } else { CostKind::W0 }, extra)?;
     }
 
-    /// Omega cut by random planes: unbounded directions of the cuts are closed by Omega.
+    /// A box (the permissible set of a part over a rectangular floor, \[A\] eq. 3) cut by random planes: unbounded
+    /// directions of the cuts are closed by the box.
     #[test]
-    fn qp_over_omega_cut_by_half_spaces(seed in any::<u64>(), kind in 0u8..5, cuts in 0usize..6) {
+    fn qp_over_a_box_cut_by_half_spaces(seed in any::<u64>(), kind in 0u8..5, cuts in 0usize..6) {
         let mut rng = Rng(seed);
-        let floor = stackplan_freespace::FloorVolume::rectangle(
-            DVec2::new(-10.0, -8.0), DVec2::new(rng.range(2.0, 12.0), rng.range(2.0, 10.0)), rng.range(3.0, 10.0),
-        ).expect("floor");
+        let (x1, y1, height) = (rng.range(2.0, 12.0), rng.range(2.0, 10.0), rng.range(3.0, 10.0));
         let part = common::random_points(&mut rng, DVec3::ZERO, 1.5, 10);
-        let om = omega(&floor, &part).expect("omega");
+        let (lo, hi) = part.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
+        // the part's vertices inside [-10, x1] x [-8, y1] x [0, height]
+        let boxed = common::boxed([-10.0 - lo.x, -8.0 - lo.y, -lo.z], [x1 - hi.x, y1 - hi.y, height - hi.z]);
+        let om = Cell::new(boxed, Tolerance::for_scale(30.0)).expect("box");
         prop_assume!(!om.is_empty());
         let c = om.interior_point().expect("point");
         let cuts: Vec<Halfspace<3>> = (0..cuts).map(|i| {
