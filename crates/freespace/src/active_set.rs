@@ -530,7 +530,6 @@ impl Problem<'_> {
         Err(ActiveSetError::IterationLimit { limit })
     }
 
-
     /// Runs the active-set method from `start` (feasible, or infeasible only by rounding).
     pub(crate) fn solve(&self, start: V4) -> Result<Outcome, ActiveSetError> {
         let m = self.rows.len();

@@ -25,7 +25,6 @@
 //!
 //! Redundancy removal costs one LP per inequality (O(m) iterations of O(m) each); membership is O(m).
 
-
 use crate::active_set::{ActiveSetError, Outcome, Problem, default_tie};
 use crate::clarabel::clarabel_qp;
 use crate::halfspace::{Halfspace, Tag};
@@ -162,7 +161,6 @@ fn push_normalised<const D: usize>(
     }
     Ok(trivially_empty)
 }
-
 
 /// Result of a linear programme over a cell.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -667,7 +665,6 @@ impl<const D: usize> Cell<D> {
     }
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -799,7 +796,11 @@ mod tests {
                 let n = [lcg(&mut state), lcg(&mut state), lcg(&mut state)];
                 let s = 10f64.powf(2.0 * lcg(&mut state));
                 let q = [lcg(&mut state), lcg(&mut state), lcg(&mut state)];
-                extra.push(Halfspace::new(n.map(|c| s * c), s * (n[0] * q[0] + n[1] * q[1] + n[2] * q[2]), Tag::User(50 + k as u64)));
+                extra.push(Halfspace::new(
+                    n.map(|c| s * c),
+                    s * (n[0] * q[0] + n[1] * q[1] + n[2] * q[2]),
+                    Tag::User(50 + k as u64),
+                ));
             }
             match case % 5 {
                 2 => extra.push(Halfspace::new([0.0; 3], 1.0, Tag::User(70))),

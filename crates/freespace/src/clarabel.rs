@@ -55,8 +55,7 @@ pub(crate) fn clarabel_qp<const D: usize>(
             .equilibrate_enable(equilibrate)
             .build()
             .map_err(|e| format!("settings: {e}"))?;
-        let mut solver =
-            DefaultSolver::new(&p, g, &a, b, &cones, settings).map_err(|e| format!("setup: {e}"))?;
+        let mut solver = DefaultSolver::new(&p, g, &a, b, &cones, settings).map_err(|e| format!("setup: {e}"))?;
         solver.solve();
         status = solver.solution.status;
         if status == SolverStatus::Solved {

@@ -69,4 +69,3 @@ impl<const D: usize> Halfspace<D> {
         Self { normal: self.normal.map(|c| -c), offset: -self.offset, tag }
     }
 }
-

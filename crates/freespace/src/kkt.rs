@@ -20,11 +20,7 @@ use crate::solution::{QpError, QpSolution};
 /// parallel) they are about `|grad f| / sin(angle)`, and the rounding of the 2 x 2 system that gives them leaves a
 /// residual near 1e-10 `T`, far above `1e-8 G` (the test `the_apex_of_a_thin_wedge_passes_the_kkt_check`). A wrong
 /// working set leaves a residual of the order of `G`, which ordinary multipliers (`T` about `G`) still reject.
-pub fn verify_kkt<const D: usize>(
-    cell: &Cell<D>,
-    cost: &SeparableCost<D>,
-    sol: &QpSolution<D>,
-) -> Result<(), QpError> {
+pub fn verify_kkt<const D: usize>(cell: &Cell<D>, cost: &SeparableCost<D>, sol: &QpSolution<D>) -> Result<(), QpError> {
     let tol = cell.tolerance().linear;
     let hs = cell.halfspaces();
     let mut worst = f64::NEG_INFINITY;

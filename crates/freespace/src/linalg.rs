@@ -9,7 +9,6 @@ pub(crate) const MAX_N: usize = 4;
 /// A vector in up to four variables; unused components are zero.
 pub(crate) type V4 = [f64; MAX_N];
 
-
 #[inline]
 pub(crate) fn dot4(a: &V4, b: &V4) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]

@@ -101,4 +101,3 @@ impl Scratch {
         SCRATCH.with(|s| s.set(self));
     }
 }
-

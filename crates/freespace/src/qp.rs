@@ -36,10 +36,7 @@ use crate::solution::{QpError, QpSolution, ShortList, tight_set, tight_set_withi
 type Prepared<'c, const D: usize> = (Problem<'c>, [f64; MAX_N], [f64; D], [f64; D]);
 
 /// The active-set problem of `cost` over `cell` and its start (the cell's interior point), with the checked cost.
-fn problem<'c, const D: usize>(
-    cell: &'c Cell<D>,
-    cost: &SeparableCost<D>,
-) -> Result<Prepared<'c, D>, QpError> {
+fn problem<'c, const D: usize>(cell: &'c Cell<D>, cost: &SeparableCost<D>) -> Result<Prepared<'c, D>, QpError> {
     let (h, g) = (cost.hessian_diagonal(), cost.linear());
     let start = cell.interior_point().ok_or(QpError::EmptyCell)?;
     let prob = Problem {
@@ -89,7 +86,6 @@ pub fn minimize<const D: usize>(cell: &Cell<D>, cost: &SeparableCost<D>) -> Resu
     }
 }
 
-
 /// [`minimize`] without the retry on degenerate cells.
 fn minimize_exact<const D: usize>(cell: &Cell<D>, cost: &SeparableCost<D>) -> Result<QpSolution<D>, QpError> {
     let (prob, start, h, g) = problem(cell, cost)?;
@@ -107,10 +103,7 @@ fn minimize_exact<const D: usize>(cell: &Cell<D>, cost: &SeparableCost<D>) -> Re
 /// [`minimize`] by the general active-set method only (Gram-Schmidt null-space split, lexicographic multipliers),
 /// without the closed-form path for strictly convex costs. Same answer as [`minimize`] up to rounding in the last
 /// bits (the minimiser is unique when the fast path applies); the tests' reference for the fast path.
-pub fn minimize_general<const D: usize>(
-    cell: &Cell<D>,
-    cost: &SeparableCost<D>,
-) -> Result<QpSolution<D>, QpError> {
+pub fn minimize_general<const D: usize>(cell: &Cell<D>, cost: &SeparableCost<D>) -> Result<QpSolution<D>, QpError> {
     let (prob, start, h, g) = problem(cell, cost)?;
     solution(cell, cost, &h, &g, prob.solve(start)?)
 }
@@ -171,12 +164,8 @@ fn solution<const D: usize>(
     }
 }
 
-
 /// Minimum of `cost` over `cell` by clarabel (interior point). The general path and the tests' cross-check.
-pub fn minimize_clarabel<const D: usize>(
-    cell: &Cell<D>,
-    cost: &SeparableCost<D>,
-) -> Result<QpSolution<D>, QpError> {
+pub fn minimize_clarabel<const D: usize>(cell: &Cell<D>, cost: &SeparableCost<D>) -> Result<QpSolution<D>, QpError> {
     let (h, g) = (cost.hessian_diagonal(), cost.linear());
     if cell.is_empty() {
         return Err(QpError::EmptyCell);
@@ -199,9 +188,9 @@ pub fn minimize_clarabel<const D: usize>(
 mod tests {
     use super::*;
     use crate::cell::CellShape;
+    use crate::cost::SeparableCost;
     use crate::halfspace::{Halfspace, Tag};
     use crate::kkt::verify_kkt;
-    use crate::cost::SeparableCost;
     use stackplan_geom::Tolerance;
 
     fn unit_cube() -> Cell<3> {

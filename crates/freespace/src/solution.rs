@@ -138,4 +138,3 @@ pub(crate) fn tight_set<const D: usize>(cell: &Cell<D>, p: &[f64; D]) -> Vec<usi
 pub(crate) fn tight_set_within<const D: usize>(cell: &Cell<D>, p: &[f64; D], tol: f64) -> Vec<usize> {
     (0..cell.len()).filter(|&j| cell.halfspaces()[j].excess(p).abs() <= tol).collect()
 }
-

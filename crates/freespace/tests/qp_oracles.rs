@@ -21,9 +21,7 @@ use crate::common;
 use common::Rng;
 use proptest::prelude::*;
 use stackplan_freespace::qp::minimize_general;
-use stackplan_freespace::{
-    Cell, Halfspace, QpError, QpSolution, SeparableCost, Tag, minimize, minimize_clarabel,
-};
+use stackplan_freespace::{Cell, Halfspace, QpError, QpSolution, SeparableCost, Tag, minimize, minimize_clarabel};
 use stackplan_geom::{DVec3, Tolerance};
 
 fn dot<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {

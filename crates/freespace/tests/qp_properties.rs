@@ -3,8 +3,8 @@
 use crate::common;
 
 use common::{Rng, Shape, bbox, random_cell};
-use proptest::prelude::*;
 use common::{desired_position_cost, stacking_cost};
+use proptest::prelude::*;
 use stackplan_freespace::{Cell, Halfspace, SeparableCost, minimize, minimize_clarabel, verify_kkt};
 use stackplan_geom::{Containment, DVec3, Tolerance};
 

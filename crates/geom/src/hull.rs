@@ -124,7 +124,6 @@ fn snap_tiny(points: &[DVec3]) -> std::borrow::Cow<'_, [DVec3]> {
     std::borrow::Cow::Owned(points.iter().map(|p| DVec3::new(snap(p.x), snap(p.y), snap(p.z))).collect())
 }
 
-
 /// Convex hull of `points`. See the module documentation.
 pub fn convex_hull(points: &[DVec3]) -> Result<ConvexHull, HullError> {
     hull_with(points, None)

@@ -319,4 +319,3 @@ pub(crate) fn merge(
     let polytope = ConvexPolytope::from_faces_with_area(vertices, faces)?;
     Ok((polytope, source))
 }
-

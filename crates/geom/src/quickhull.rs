@@ -315,4 +315,3 @@ fn expand(p: &[DVec3], tris: &mut Vec<Tri>, outside: &mut Outside, diameter: f64
         }
     }
 }
-
