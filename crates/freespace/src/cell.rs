@@ -12,7 +12,7 @@
 //!
 //! (ties broken by the lowest centre z, then y, then x, so the centre is deterministic). `r* < -tol`: empty;
 //! `|r*| <= tol`: flat (a face, an edge or a point, within the tolerance); `r* > tol`: solid with centre `c*` and
-//! inradius `r*`. The LP is solved by the exact active-set method of [`crate::active_set`] (one extra variable):
+//! inradius `r*`. The LP is solved by the exact active-set method of `active_set.rs` (one extra variable):
 //! O(m) per iteration, a handful of iterations.
 //!
 //! **Boundedness.** Every non-empty cell is bounded: [`Cell::new`] checks it (2D LPs `max +-p_i`) and returns
@@ -298,7 +298,7 @@ impl<const D: usize> Cell<D> {
     /// `b_j + tol`; it is non-empty iff the Chebyshev radius is at least `-tol`, so the answer is the one of
     /// `self.with_halfspaces(extra)?.is_empty()`, up to rounding at that boundary). The inequalities violated at the
     /// current point by more than the tolerance are taken in order; for each, the LP `min a_j . p` over the
-    /// inequalities satisfied so far runs from the current point (the active-set solver of [`crate::active_set`])
+    /// inequalities satisfied so far runs from the current point (the active-set solver of `active_set.rs`)
     /// and stops on reaching `a_j . p = b_j + tol`. If its minimum stays above that, the satisfied inequalities
     /// already exclude `j`: empty. Otherwise the point moves there and `j` joins the satisfied set. Each LP starts
     /// feasible; about one LP per violated inequality, usually a single move (a child cell of the planner's search

@@ -5,22 +5,22 @@
 //! floor volume.
 //!
 //! Two solvers:
-//! * [`minimize`]: the exact primal active-set method of [`crate::active_set`] started at the cell's interior point
+//! * [`minimize`]: the exact primal active-set method of `active_set.rs` started at the cell's interior point
 //!   (O(m) per iteration, a handful of iterations in 2-3 variables). When the Hessian is singular (`w = 1` leaves z
 //!   free, `w = 0` leaves x and y free) the minimiser set is not a point; the solver returns its lexicographic
 //!   minimum: lowest z, then lowest y, then lowest x (lowest y then x in 2-D). Before returning, the KKT conditions
-//!   are verified from scratch (see [`crate::kkt::verify_kkt`]); a failed check is an error, never a silent wrong answer.
+//!   are verified from scratch (see [`crate::verify_kkt`]); a failed check is an error, never a silent wrong answer.
 //!   Strictly convex costs (every `h_i > 0` within a factor 1000 of each other: cost (1) with
 //!   `0.002 <= w <= 0.9995`, the desired-position cost) run the same
-//!   iteration with closed-form linear algebra ([`crate::active_set`], "strictly convex fast path"); if that path
+//!   iteration with closed-form linear algebra (`closed_form.rs`, "strictly convex fast path"); if that path
 //!   breaks down or its answer fails the KKT check, the general method solves the problem again. The minimiser is
 //!   unique there, so both give the same point up to rounding in the last bits; [`minimize_general`] runs the
 //!   general method alone (the reference of the tests and benchmarks).
 //! * [`minimize_clarabel`]: clarabel's interior-point QP (general path and cross-check; statuses other than
 //!   `Solved` are errors). Its point is some minimiser (no tie-break); its `active` list is the tight inequalities.
 //!
-//! The answer and its errors are in [`crate::solution`], the KKT check in [`crate::kkt`], the enumeration that
-//! solves degenerate cells in [`crate::enumerate`], clarabel's call in [`crate::clarabel`].
+//! The answer and its errors are in [`crate::solution`], the KKT check in `kkt.rs`, the enumeration that
+//! solves degenerate cells in `enumerate.rs`, clarabel's call in `clarabel.rs`.
 
 use crate::active_set::{Outcome, Problem, default_tie};
 use crate::cell::Cell;
