@@ -5,7 +5,7 @@ use crate::common;
 use common::{Rng, Shape, bbox, random_cell};
 use common::{desired_position_cost, stacking_cost};
 use proptest::prelude::*;
-use stackplan_freespace::{Cell, Halfspace, SeparableCost, minimize, minimize_clarabel, verify_kkt};
+use stackplan_freespace::{Cell, Halfspace, SeparableCost, Tag, minimize, minimize_clarabel, verify_kkt};
 use stackplan_geom::{Containment, DVec3, Tolerance};
 
 #[derive(Debug, Clone, Copy)]
@@ -152,9 +152,13 @@ proptest! {
         let (x1, y1, height) = (rng.range(2.0, 12.0), rng.range(2.0, 10.0), rng.range(3.0, 10.0));
         let part = common::random_points(&mut rng, DVec3::ZERO, 1.5, 10);
         let (lo, hi) = part.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
-        // the part's vertices inside [-10, x1] x [-8, y1] x [0, height]
-        let boxed = common::boxed([-10.0 - lo.x, -8.0 - lo.y, -lo.z], [x1 - hi.x, y1 - hi.y, height - hi.z]);
-        let om = Cell::new(boxed, Tolerance::for_scale(30.0)).expect("box");
+        // the part's vertices inside [-10, x1] x [-8, y1] x [0, height]: the floor's sides counter-clockwise from
+        // (-10, -8), then the floor and the ceiling, as the planner orders them
+        let sides = [([0.0, -1.0, 0.0], 8.0 + lo.y), ([1.0, 0.0, 0.0], x1 - hi.x), ([0.0, 1.0, 0.0], y1 - hi.y),
+            ([-1.0, 0.0, 0.0], 10.0 + lo.x), ([0.0, 0.0, -1.0], lo.z), ([0.0, 0.0, 1.0], height - hi.z)];
+        let walls = sides.iter().enumerate().map(|(k, &(n, d))| Halfspace::new(n, d, Tag::User(k as u64))).collect();
+        let scale = (x1 + 10.0).hypot(y1 + 8.0).max(height).max((hi - lo).length());
+        let om = Cell::new(walls, Tolerance::for_scale(scale)).expect("box");
         prop_assume!(!om.is_empty());
         let c = om.interior_point().expect("point");
         let cuts: Vec<Halfspace<3>> = (0..cuts).map(|i| {
