@@ -174,6 +174,8 @@ fn hull_with(points: &[DVec3], merge_tolerance: Option<f64>) -> Result<ConvexHul
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::predicates::side;
+    use std::cmp::Ordering;
 
     /// A box turned by a general rotation: its faces are planar only to rounding. The exact hull splits some of them
     /// into facets; the merged hull has the box's 6 faces and 8 vertices, planes supporting every point.
