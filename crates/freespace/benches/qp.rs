@@ -1,5 +1,5 @@
 //! Benchmarks: time per placement QP (exact active-set vs clarabel, same cells and costs, same run) for cells of
-//! 6, 16, 32 and 64 inequalities, and time per obstacle subtraction.
+//! 6, 16, 32 and 64 inequalities, and time per emptiness test of a child cell.
 //!
 //! `exact` is `minimize` (strictly convex costs take the closed-form path of `active_set`), `general` is
 //! `qp::minimize_general` (the general active-set method alone, what the closed-form path saves measured in the same
@@ -15,11 +15,8 @@
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use stackplan_freespace::qp::minimize_general;
-use stackplan_freespace::{
-    Cell, Halfspace, Obstacle, RotatedExtents, SeparableCost, SubtractOptions, Tag, minimize, minimize_clarabel,
-    stacking_cost, subtract,
-};
-use stackplan_geom::{DVec3, Tolerance, convex_hull};
+use stackplan_freespace::{Cell, Halfspace, SeparableCost, Tag, minimize, minimize_clarabel};
+use stackplan_geom::{DVec3, Tolerance};
 use std::hint::black_box;
 
 struct Rng(u64);
@@ -68,18 +65,19 @@ fn cost(rng: &mut Rng) -> SeparableCost<3> {
     cost_with_weight(rng, 0.7)
 }
 
-/// Cost (1) with weight `w` and the reference outside the cell.
+/// Cost (1) with weight `w` and the reference outside the cell, for a part with the extents x in [-10, 10], y in
+/// [-5, 5] and its c.g. 3 above the position: `w [(p_x + 10 - x0)^2 + (p_x - 10 - x0)^2 + (p_y + 5 - y0)^2 +
+/// (p_y - 5 - y0)^2] + 4 (1 - w) (p_z + 3 - z0)^2` expanded into `1/2 h p^2 + g p + c`.
 fn cost_with_weight(rng: &mut Rng, w: f64) -> SeparableCost<3> {
-    let ext = RotatedExtents {
-        x_max: 10.0,
-        x_min: -10.0,
-        y_max: 5.0,
-        y_min: -5.0,
-        center_of_gravity: DVec3::new(0.0, 0.0, 3.0),
-    };
     let t = rng.range(0.0, std::f64::consts::TAU);
     let reference = DVec3::new(120.0 * t.cos(), 120.0 * t.sin(), rng.range(-80.0, 0.0));
-    stacking_cost(w, &ext, reference).expect("cost")
+    let (ax, bx) = (10.0 - reference.x, -10.0 - reference.x);
+    let (ay, by) = (5.0 - reference.y, -5.0 - reference.y);
+    let e = 3.0 - reference.z;
+    let h = [4.0 * w, 4.0 * w, 8.0 * (1.0 - w)];
+    let g = [2.0 * w * (ax + bx), 2.0 * w * (ay + by), 8.0 * (1.0 - w) * e];
+    let c = w * (ax * ax + bx * bx + ay * ay + by * by) + 4.0 * (1.0 - w) * e * e;
+    SeparableCost::new(h, g, c).expect("cost")
 }
 
 /// On-CPU time of the current thread in nanoseconds (first field of `/proc/thread-self/schedstat`).
@@ -148,37 +146,6 @@ fn qp(c: &mut Criterion, name: &str) {
     group.finish();
 }
 
-fn subtraction(c: &mut Criterion, name: &str) {
-    let mut group = c.benchmark_group(format!("subtract_{name}"));
-    let mut rng = Rng(99);
-    let cases: Vec<(Cell<3>, Obstacle<3>)> = (0..16)
-        .map(|k| {
-            let cell = cell(&mut rng, 10);
-            let centre = DVec3::new(rng.range(-30.0, 30.0), rng.range(-30.0, 30.0), rng.range(-30.0, 30.0));
-            let pts: Vec<DVec3> = (0..12)
-                .map(|_| {
-                    let u = rng.unit();
-                    centre + DVec3::from_array(u) * rng.range(10.0, 25.0)
-                })
-                .collect();
-            let hull = convex_hull(&pts).expect("hull");
-            (cell, Obstacle::from_polytope(k, &hull.polytope).expect("obstacle"))
-        })
-        .collect();
-    for (name, remove_redundant) in [("with_redundancy_removal", true), ("plain", false)] {
-        let opts = SubtractOptions { clearance: 0.5, remove_redundant };
-        let mut i = 0;
-        group.bench_function(name, |b| {
-            b.iter(|| {
-                i = (i + 1) % cases.len();
-                let (cell, obstacle) = &cases[i];
-                black_box(subtract(black_box(cell), black_box(obstacle), opts).expect("subtract"))
-            })
-        });
-    }
-    group.finish();
-}
-
 /// Emptiness of a child cell as the planner's search builds it: a cell of 32 inequalities, its QP optimum as the
 /// known point, and an obstacle-like split (the outside of one random plane through the optimum's neighbourhood plus
 /// the inside of three others): `Cell::is_empty_with` (phase 1 from the optimum) against `with_halfspaces` (the
@@ -231,7 +198,6 @@ fn emptiness(c: &mut Criterion, name: &str) {
 
 fn wall(c: &mut Criterion) {
     qp(c, "wall");
-    subtraction(c, "wall");
     emptiness(c, "wall");
 }
 

@@ -37,24 +37,10 @@
 //! limit returns an error instead of looping. Cost per iteration O(m) (the ratio test) plus O(1) linear algebra on
 //! at most 4x4 matrices; in three variables the number of iterations is usually at most 4-8.
 //!
-//! **Strictly convex fast path** (`Problem::solve_strictly_convex`, the placement QP of cost (1) with
-//! `0.002 <= w <= 0.9995` and the desired-position cost): when every `h_i > 0` in 2 or 3 variables (and
-//! `min h / max h >= 1e-3`, so that no direction is nearly flat), `F` is empty, the
-//! minimiser is unique and the tie-break stages are moot, so the same iteration (same start, same working-set
-//! rules, ratio test, multiplier test and anti-cycling) runs with its linear algebra in closed form: the Newton step
-//! in the null space of `A_W` is `-H^-1 grad` (no working row), `-(z . grad) / (z^T H z) z` for a one-dimensional
-//! null space `z = a_1 x a_2` (2 rows in 3-D; `a_1` turned by 90 degrees in 2-D), a 2x2 reduced system on an
-//! orthonormal basis `a x e / |.|`, `a x z_1 / |.|` of the plane (1 row in 3-D), and zero at a vertex; the
-//! multipliers `A_W^T lambda = -grad` come from the Gram system of order <= 2 or Cramer's rule with cross products.
-//! About 0.1 µs of linear algebra per iteration instead of about 0.3-0.5 µs for the Gram-Schmidt split with Cholesky
-//! factors and lexicographic stages. A numerically singular system or the iteration limit hands the problem to the
-//! general method (and [`crate::qp::minimize`] falls back to it too when the KKT check rejects the result).
+//! The closed-form variants for 2-3 variables (the phase 1 of a cell and the strictly convex QP) are in
+//! [`crate::closed_form`].
 
-/// Largest number of variables.
-pub(crate) const MAX_N: usize = 4;
-
-/// A vector in up to four variables; unused components are zero.
-pub(crate) type V4 = [f64; MAX_N];
+use crate::linalg::{Basis, MAX_N, V4, axpy, cholesky, cholesky_solve, dot_first, dot4, norm4, unit};
 
 /// Relative size below which a vector is linearly dependent on a working set (Gram-Schmidt residual).
 const RANK_TOL: f64 = 1e-12;
@@ -66,52 +52,18 @@ const FLAT_TOL: f64 = 1e-8;
 /// A tie-break direction is followed only if its projection on the flat subspace exceeds this.
 const TIE_TOL: f64 = 1e-9;
 /// Relative tolerance of multipliers.
-const MULT_TOL: f64 = 1e-10;
+pub(crate) const MULT_TOL: f64 = 1e-10;
 /// The strictly convex fast path runs only when `min h / max h` is at least this (cost (1): `0.002 < w < 0.9995`).
 /// A nearly flat direction makes the minimiser ill-determined within the multiplier tolerance (with
 /// `min h / max h = 1e-9` the two methods' points differ by millimetres, both KKT points within tolerance); those
 /// problems keep the general method's answer.
 pub(crate) const FAST_PATH_MIN_CURVATURE_RATIO: f64 = 1e-3;
 
-#[inline]
-pub(crate) fn dot4(a: &V4, b: &V4) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]
-}
-
-/// `a . b` over the first `K` lanes, summed in the order of [`dot4`] (which is `dot_first::<4>`).
-#[inline]
-pub(crate) fn dot_first<const K: usize>(a: &V4, b: &V4) -> f64 {
-    let mut s = a[0] * b[0];
-    for i in 1..K {
-        s += a[i] * b[i];
-    }
-    s
-}
-
-#[inline]
-fn norm4(a: &V4) -> f64 {
-    dot4(a, a).sqrt()
-}
-
-#[inline]
-fn unit(i: usize) -> V4 {
-    let mut e = [0.0; MAX_N];
-    e[i] = 1.0;
-    e
-}
-
-#[inline]
-fn axpy(y: &mut V4, alpha: f64, x: &V4) {
-    for i in 0..MAX_N {
-        y[i] += alpha * x[i];
-    }
-}
-
 /// Anti-cycling bookkeeping after a move of length `moved` blocked by `blocking`: a real move (longer than 1e-13 of
 /// the length scale) clears the banned constraints; a null move blocked by the constraint just dropped bans that
 /// constraint (dropping and re-adding it would cycle). The last drop is forgotten either way.
 #[inline]
-fn record_move(
+pub(crate) fn record_move(
     moved: f64,
     length_scale: f64,
     blocking: Option<usize>,
@@ -126,143 +78,37 @@ fn record_move(
     *last_dropped = None;
 }
 
-/// An orthonormal set of at most four vectors.
-#[derive(Debug, Clone, Copy)]
-struct Basis {
-    v: [V4; MAX_N],
-    len: usize,
-}
-
-impl Basis {
-    fn new() -> Self {
-        Self { v: [[0.0; MAX_N]; MAX_N], len: 0 }
-    }
-
-    fn vectors(&self) -> &[V4] {
-        &self.v[..self.len]
-    }
-
-    /// The part of `x` orthogonal to the basis (two Gram-Schmidt passes).
-    fn residual(&self, x: &V4) -> V4 {
-        let mut w = *x;
-        for _ in 0..2 {
-            for q in self.vectors() {
-                let c = dot4(&w, q);
-                axpy(&mut w, -c, q);
-            }
-        }
-        w
-    }
-
-    /// Adds the normalised residual of `x` if it is at least `rel_tol |x|`; returns whether it was added.
-    fn try_add(&mut self, x: &V4, rel_tol: f64) -> bool {
-        let n0 = norm4(x);
-        if n0.is_nan() || n0 <= 0.0 || self.len == MAX_N {
-            return false;
-        }
-        let w = self.residual(x);
-        let nw = norm4(&w);
-        if nw > rel_tol * n0 {
-            self.v[self.len] = w.map(|c| c / nw);
-            self.len += 1;
-            true
-        } else {
-            false
-        }
-    }
-
-    /// An orthonormal basis of the orthogonal complement of `self` in `R^n` (greedy: most independent unit vector).
-    fn complement(&self, n: usize) -> Basis {
-        let mut all = *self;
-        let mut out = Basis::new();
-        while all.len < n {
-            let mut best = (-1.0, [0.0; MAX_N]);
-            for i in 0..n {
-                let w = all.residual(&unit(i));
-                let r = norm4(&w);
-                if r > best.0 {
-                    best = (r, w);
-                }
-            }
-            // the residual of the best unit vector is at least sqrt((n - len) / n) > 0.5
-            let w = best.1.map(|c| c / best.0);
-            all.v[all.len] = w;
-            all.len += 1;
-            out.v[out.len] = w;
-            out.len += 1;
-        }
-        out
-    }
-}
-
-/// Cholesky factorisation of a symmetric positive (semi)definite matrix of order `k <= 4`, in place (lower).
-/// Pivots that rounding made non-positive are floored at a tiny positive value (the step then becomes long and the
-/// ratio test cuts it).
-pub(crate) fn cholesky(a: &mut [[f64; MAX_N]; MAX_N], k: usize) {
-    for j in 0..k {
-        let mut d = a[j][j];
-        for l in 0..j {
-            d -= a[j][l] * a[j][l];
-        }
-        let d = if d > 1e-280 { d.sqrt() } else { 1e-140 };
-        a[j][j] = d;
-        for i in j + 1..k {
-            let mut s = a[i][j];
-            for l in 0..j {
-                s -= a[i][l] * a[j][l];
-            }
-            a[i][j] = s / d;
-        }
-    }
-}
-
-/// Solves `L L^T x = b` for the factor of [`cholesky`].
-pub(crate) fn cholesky_solve(l: &[[f64; MAX_N]; MAX_N], k: usize, b: &V4) -> V4 {
-    let mut y = [0.0; MAX_N];
-    for i in 0..k {
-        let mut s = b[i];
-        for j in 0..i {
-            s -= l[i][j] * y[j];
-        }
-        y[i] = s / l[i][i];
-    }
-    let mut x = [0.0; MAX_N];
-    for i in (0..k).rev() {
-        let mut s = y[i];
-        for j in i + 1..k {
-            s -= l[j][i] * x[j];
-        }
-        x[i] = s / l[i][i];
-    }
-    x
-}
-
 /// The working set: indices of constraints, in the order they joined.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct WorkSet {
-    idx: [usize; MAX_N],
-    len: usize,
+    pub(crate) idx: [usize; MAX_N],
+    pub(crate) len: usize,
 }
 
 impl WorkSet {
     pub(crate) fn as_slice(&self) -> &[usize] {
         &self.idx[..self.len]
     }
-    fn contains(&self, j: usize) -> bool {
+    pub(crate) fn contains(&self, j: usize) -> bool {
         self.as_slice().contains(&j)
     }
-    fn push(&mut self, j: usize) {
+    pub(crate) fn push(&mut self, j: usize) {
         if self.len < MAX_N {
             self.idx[self.len] = j;
             self.len += 1;
         }
     }
-    fn remove_at(&mut self, k: usize) {
+    pub(crate) fn remove_at(&mut self, k: usize) {
         for i in k..self.len - 1 {
             self.idx[i] = self.idx[i + 1];
         }
         self.len -= 1;
     }
+}
+
+/// The default tie-break order: lowest z, then y, then x (D = 3); lowest y then x (D = 2).
+pub(crate) fn default_tie(d: usize) -> [usize; MAX_N] {
+    if d == 3 { [2, 1, 0, 3] } else { [1, 0, 2, 3] }
 }
 
 /// A problem instance. Rows are constraint normals in the first `n` components (the rest zero).
@@ -455,11 +301,11 @@ enum Step {
 
 impl Problem<'_> {
     #[inline]
-    fn enabled(&self, j: usize) -> bool {
+    pub(crate) fn enabled(&self, j: usize) -> bool {
         self.mask.is_none_or(|m| m[j])
     }
 
-    fn gradient(&self, p: &V4) -> V4 {
+    pub(crate) fn gradient(&self, p: &V4) -> V4 {
         let mut gr = [0.0; MAX_N];
         for i in 0..self.n {
             gr[i] = self.h[i] * p[i] + self.g[i];
@@ -468,7 +314,7 @@ impl Problem<'_> {
     }
 
     /// Typical size of the gradient over the problem's region (for relative thresholds).
-    fn gradient_scale(&self) -> f64 {
+    pub(crate) fn gradient_scale(&self) -> f64 {
         let mut s: f64 = 0.0;
         for i in 0..self.n {
             s = s.max(self.h[i] * self.length_scale + self.g[i].abs());
@@ -581,7 +427,7 @@ impl Problem<'_> {
     /// them, so the remaining terms are zeros, which change a non-zero sum not at all, and a zero sum never passes
     /// the test (`BLOCK_TOL * len >= 0`); the outcome is the one of the full [`dot4`], bit for bit.
     #[inline]
-    fn ratio_test(&self, w: &WorkSet, p: &V4, dir: &V4, len: f64, alpha0: f64) -> (f64, Option<usize>) {
+    pub(crate) fn ratio_test(&self, w: &WorkSet, p: &V4, dir: &V4, len: f64, alpha0: f64) -> (f64, Option<usize>) {
         match self.n {
             2 => self.ratio_test_in::<2>(w, p, dir, len, alpha0),
             3 => self.ratio_test_in::<3>(w, p, dir, len, alpha0),
@@ -684,115 +530,6 @@ impl Problem<'_> {
         Err(ActiveSetError::IterationLimit { limit })
     }
 
-    /// [`Problem::seek`] for a linear objective in 2 or 3 variables with the linear algebra in closed form: the
-    /// same iteration (same start, working-set rules, ratio test, level test, multiplier test and anti-cycling) but
-    /// the move is minus the projection of `g` on the null space of the working rows, `-g` (no row),
-    /// `-(g - (g . a) a / |a|^2)` (one row in 3-D), `-(g . z) z / |z|^2` on a line `z = a_1 x a_2` (two rows in 3-D;
-    /// `a_1` turned by 90 degrees in 2-D), none at a vertex; the multipliers come from
-    /// [`Problem::multipliers`] (a Gram system of order <= 2 or Cramer's rule). No Gram-Schmidt split, no Cholesky
-    /// factors: O(m) per iteration (the ratio test) plus O(1).
-    ///
-    /// Rounding differs from [`Problem::seek`] in the last bits, so the point returned may too; its *decision*
-    /// (level reached or not) is the same except when the minimum is within rounding of the target. `None` (the
-    /// caller then runs [`Problem::seek`]) when the path does not apply (`h != 0`, `n` not 2 or 3), a system is
-    /// numerically singular, or the iteration limit is reached.
-    pub(crate) fn seek_small(&self, start: V4, target: f64) -> Option<Seek> {
-        let n = self.n;
-        if !(2..=3).contains(&n) || self.h.iter().any(|&x| x != 0.0) {
-            return None;
-        }
-        let m = self.rows.len();
-        let bland_after = 4 * m + 20;
-        let limit = 40 * (m + 5);
-        let gradient_scale = self.gradient_scale();
-        let flat_tol = 1e-10 * gradient_scale;
-        let mult_tol = MULT_TOL * gradient_scale;
-        let g = self.g;
-        let mut p = start;
-        let mut w = WorkSet::default();
-        let mut banned: Vec<usize> = Vec::new();
-        let mut last_dropped: Option<usize> = None;
-        for iter in 0..limit {
-            let level = dot4(&g, &p);
-            if level <= target {
-                return Some(Seek::Reached(p));
-            }
-            let dir = self.lp_projected_descent(&w)?;
-            let len = norm4(&dir);
-            if !len.is_finite() {
-                return None;
-            }
-            if len <= flat_tol {
-                // stationary: drop the most negative multiplier (Bland's rule late), or stop at the minimum
-                let lambda = self.multipliers(&w, &g)?;
-                let choice = most_negative_multiplier(&lambda, &w, &banned, iter >= bland_after, mult_tol);
-                match choice {
-                    Some(a) => {
-                        last_dropped = Some(w.idx[a]);
-                        w.remove_at(a);
-                        continue;
-                    }
-                    None => return Some(Seek::Minimum { point: p, value: level }),
-                }
-            }
-            let (alpha, blocking) = self.ratio_test(&w, &p, &dir, len, f64::INFINITY);
-            let descent = dot4(&g, &dir);
-            if descent < 0.0 {
-                let to_level = (target - level) / descent;
-                if to_level <= alpha {
-                    axpy(&mut p, to_level, &dir);
-                    return Some(Seek::Reached(p));
-                }
-            }
-            let j = blocking?;
-            axpy(&mut p, alpha, &dir);
-            record_move(alpha * len, self.length_scale, blocking, &mut last_dropped, &mut banned);
-            if w.len >= n {
-                return None;
-            }
-            w.push(j);
-        }
-        None
-    }
-
-    /// `-P g`: minus the projection of the (linear) objective `g` on the null space of the working rows, in closed
-    /// form for `n` = 2 or 3 (see [`Problem::seek_small`]). `None` when the rows are numerically dependent.
-    fn lp_projected_descent(&self, w: &WorkSet) -> Option<V4> {
-        let n = self.n;
-        let g = &self.g;
-        let row = |a: usize| &self.rows[w.idx[a]];
-        let along = |z: &V4| {
-            let zz = dot4(z, z);
-            if !(zz > 0.0 && zz.is_finite()) {
-                return None;
-            }
-            let t = -dot4(z, g) / zz;
-            Some(z.map(|c| c * t))
-        };
-        match (n, w.len) {
-            (_, 0) => Some(g.map(|c| -c)),
-            (2, 1) => {
-                let a = row(0);
-                along(&[-a[1], a[0], 0.0, 0.0])
-            }
-            (3, 1) => {
-                let a = row(0);
-                let aa = dot4(a, a);
-                if !(aa > 0.0 && aa.is_finite()) {
-                    return None;
-                }
-                let t = dot4(a, g) / aa;
-                let mut d = [0.0; MAX_N];
-                for i in 0..3 {
-                    d[i] = -(g[i] - t * a[i]);
-                }
-                Some(d)
-            }
-            (3, 2) => along(&cross3(row(0), row(1))),
-            _ => Some([0.0; MAX_N]),
-        }
-    }
-
     /// Runs the active-set method from `start` (feasible, or infeasible only by rounding).
     pub(crate) fn solve(&self, start: V4) -> Result<Outcome, ActiveSetError> {
         let m = self.rows.len();
@@ -853,248 +590,8 @@ impl Problem<'_> {
     }
 }
 
-impl Problem<'_> {
-    /// Whether the closed-form path applies: `n` is 2 or 3, every `h_i > 0` (finite) and
-    /// `min h / max h >= FAST_PATH_MIN_CURVATURE_RATIO`.
-    fn strictly_convex(&self) -> bool {
-        let h = &self.h[..self.n];
-        let hi = h.iter().fold(0.0_f64, |a, &x| a.max(x));
-        (2..=3).contains(&self.n)
-            && h.iter().all(|&x| x > 0.0 && x.is_finite())
-            && h.iter().all(|&x| x >= FAST_PATH_MIN_CURVATURE_RATIO * hi)
-    }
-
-    /// The Newton step `d` of `f` at `p` within the null space of the working rows, `min f(p + d)` subject to
-    /// `a_w . d = 0`, in closed form (positive diagonal Hessian, `n` = 2 or 3):
-    ///
-    /// * no working row: `d = -H^-1 grad`;
-    /// * a null space of dimension 1 spanned by `z` (`a_1 x a_2` in 3-D, `a_1` turned by 90 degrees in 2-D):
-    ///   `d = -(z . grad) / (z^T H z) z`;
-    /// * one row in 3-D: an orthonormal basis `z_1 = a x e / |.|` (`e` the coordinate axis least aligned with `a`),
-    ///   `z_2 = a x z_1 / |.|` of the plane and the 2x2 system `(Z^T H Z) t = -Z^T grad`, `d = Z t`;
-    /// * `n` rows: `d = 0`.
-    ///
-    /// The step lies in the null space up to the rounding of a few products, as the general method's does, so the
-    /// iterate stays on its working planes. `None` when a reduced Hessian is not positive (underflow).
-    fn null_space_step(&self, w: &WorkSet, grad: &V4) -> Option<V4> {
-        let n = self.n;
-        let k = w.len;
-        let row = |a: usize| &self.rows[w.idx[a]];
-        let mut d = [0.0; MAX_N];
-        if k == 0 {
-            for i in 0..n {
-                d[i] = -grad[i] / self.h[i];
-            }
-            return Some(d);
-        }
-        if k >= n {
-            return Some(d);
-        }
-        let along = |z: &V4| {
-            let mut zhz = 0.0;
-            for i in 0..n {
-                zhz += self.h[i] * z[i] * z[i];
-            }
-            if !(zhz > 0.0 && zhz.is_finite()) {
-                return None;
-            }
-            let t = -dot4(z, grad) / zhz;
-            Some(z.map(|c| c * t))
-        };
-        if n == 2 {
-            let a = row(0);
-            return along(&[-a[1], a[0], 0.0, 0.0]);
-        }
-        if k == 2 {
-            return along(&cross3(row(0), row(1)));
-        }
-        // n = 3, one working row
-        let a = row(0);
-        let axis = if a[0].abs() <= a[1].abs() && a[0].abs() <= a[2].abs() {
-            0
-        } else if a[1].abs() <= a[2].abs() {
-            1
-        } else {
-            2
-        };
-        let z1 = normalized(&cross3(a, &unit(axis)))?;
-        let z2 = normalized(&cross3(a, &z1))?;
-        let (mut m11, mut m12, mut m22) = (0.0, 0.0, 0.0);
-        for i in 0..3 {
-            m11 += self.h[i] * z1[i] * z1[i];
-            m12 += self.h[i] * z1[i] * z2[i];
-            m22 += self.h[i] * z2[i] * z2[i];
-        }
-        let det = m11 * m22 - m12 * m12;
-        if !(det > 0.0 && det.is_finite()) {
-            return None;
-        }
-        let (r1, r2) = (-dot4(&z1, grad), -dot4(&z2, grad));
-        let t1 = (r1 * m22 - r2 * m12) / det;
-        let t2 = (r2 * m11 - r1 * m12) / det;
-        for i in 0..3 {
-            d[i] = t1 * z1[i] + t2 * z2[i];
-        }
-        Some(d)
-    }
-
-    /// Multipliers of the working rows at a stationary point: the least-squares solution of `A_W^T lambda = -r`
-    /// (`r` the gradient at the stationary point), by the Gram system of order `k <= 2` or, for `n` rows, Cramer's
-    /// rule (cross products in 3-D). `None` when the rows are numerically dependent.
-    fn multipliers(&self, w: &WorkSet, r: &V4) -> Option<V4> {
-        let n = self.n;
-        let k = w.len;
-        let row = |a: usize| &self.rows[w.idx[a]];
-        let mut lambda = [0.0; MAX_N];
-        let ok = |x: f64| x.abs() > 0.0 && x.is_finite();
-        match k {
-            0 => {}
-            1 => {
-                let a = row(0);
-                let aa = dot4(a, a);
-                if !ok(aa) {
-                    return None;
-                }
-                lambda[0] = -dot4(a, r) / aa;
-            }
-            2 if n == 2 => {
-                let (a1, a2) = (row(0), row(1));
-                let det = a1[0] * a2[1] - a1[1] * a2[0];
-                if !ok(det) {
-                    return None;
-                }
-                lambda[0] = -(r[0] * a2[1] - r[1] * a2[0]) / det;
-                lambda[1] = -(a1[0] * r[1] - a1[1] * r[0]) / det;
-            }
-            2 => {
-                let (a1, a2) = (row(0), row(1));
-                let (g11, g12, g22) = (dot4(a1, a1), dot4(a1, a2), dot4(a2, a2));
-                let det = g11 * g22 - g12 * g12;
-                if !(det > 0.0 && det.is_finite()) {
-                    return None;
-                }
-                let (r1, r2) = (-dot4(a1, r), -dot4(a2, r));
-                lambda[0] = (r1 * g22 - r2 * g12) / det;
-                lambda[1] = (r2 * g11 - r1 * g12) / det;
-            }
-            _ => {
-                // n = 3 rows in 3-D: the inverse of A_W^T has the rows (a_2 x a_3, a_3 x a_1, a_1 x a_2) / det
-                let (a1, a2, a3) = (row(0), row(1), row(2));
-                let c23 = cross3(a2, a3);
-                let det = dot4(a1, &c23);
-                if !ok(det) {
-                    return None;
-                }
-                lambda[0] = -dot4(r, &c23) / det;
-                lambda[1] = -dot4(r, &cross3(a3, a1)) / det;
-                lambda[2] = -dot4(r, &cross3(a1, a2)) / det;
-            }
-        }
-        Some(lambda)
-    }
-
-    /// The fast path of [`Problem::solve`] for a strictly convex objective (every `h_i > 0`, `n` = 2 or 3,
-    /// `min h / max h >= FAST_PATH_MIN_CURVATURE_RATIO`): the same
-    /// primal active-set iteration from `start` (working-set rules, ratio test, multiplier test, anti-cycling), with
-    /// the null-space Newton step and the multipliers in closed form ([`Problem::null_space_step`],
-    /// [`Problem::multipliers`]) instead of a Gram-Schmidt split with Cholesky factors and lexicographic stages. The
-    /// tie-break is moot (the minimiser is unique), so only the objective's multipliers are tested. O(m) per
-    /// iteration (the ratio test) plus O(1).
-    ///
-    /// Returns `None` (the caller then runs the general [`Problem::solve`]) when the path does not apply, a system
-    /// becomes numerically singular, or the iteration limit is reached; it never reports unboundedness (a strictly
-    /// convex quadratic is bounded below).
-    pub(crate) fn solve_strictly_convex(&self, start: V4) -> Option<Outcome> {
-        if !self.strictly_convex() {
-            return None;
-        }
-        let n = self.n;
-        let m = self.rows.len();
-        let bland_after = 4 * m + 20;
-        let limit = 40 * (m + 5);
-        let stationary = 1e-12 * self.length_scale;
-        let mult_tol = MULT_TOL * self.gradient_scale();
-        let mut p = start;
-        let mut w = WorkSet::default();
-        let mut banned: Vec<usize> = Vec::new();
-        let mut last_dropped: Option<usize> = None;
-        for iter in 0..limit {
-            let grad = self.gradient(&p);
-            let dir = self.null_space_step(&w, &grad)?;
-            let len = norm4(&dir);
-            if !len.is_finite() {
-                return None;
-            }
-            if len <= stationary {
-                // the multiplier test at the gradient of the subspace minimiser p + dir
-                let mut r = grad;
-                for i in 0..n {
-                    r[i] += self.h[i] * dir[i];
-                }
-                let lambda = self.multipliers(&w, &r)?;
-                let choice = most_negative_multiplier(&lambda, &w, &banned, iter >= bland_after, mult_tol);
-                match choice {
-                    Some(a) => {
-                        last_dropped = Some(w.idx[a]);
-                        w.remove_at(a);
-                    }
-                    None => {
-                        return Some(Outcome::Optimal {
-                            point: p,
-                            working: w,
-                            multipliers: lambda,
-                            iterations: iter + 1,
-                        });
-                    }
-                }
-                continue;
-            }
-            let (alpha, blocking) = self.ratio_test(&w, &p, &dir, len, 1.0);
-            axpy(&mut p, alpha, &dir);
-            record_move(alpha * len, self.length_scale, blocking, &mut last_dropped, &mut banned);
-            if let Some(j) = blocking {
-                if w.len >= n {
-                    return None;
-                }
-                w.push(j);
-            }
-        }
-        None
-    }
-}
-
-#[inline]
-/// The working-set slot whose constraint to drop in the closed-form paths ([`Problem::seek_small`],
-/// [`Problem::solve_strictly_convex`]): the most negative multiplier below `-mult_tol` (or, under Bland's rule, the
-/// lowest constraint index among them), skipping `banned` constraints; `None` at a minimum. O(|W| |banned|).
-fn most_negative_multiplier(lambda: &V4, w: &WorkSet, banned: &[usize], bland: bool, mult_tol: f64) -> Option<usize> {
-    let mut choice: Option<usize> = None;
-    for a in 0..w.len {
-        if lambda[a] < -mult_tol && !banned.contains(&w.idx[a]) {
-            choice = match choice {
-                None => Some(a),
-                Some(c) => {
-                    let better = if bland { w.idx[a] < w.idx[c] } else { lambda[a] < lambda[c] };
-                    Some(if better { a } else { c })
-                }
-            };
-        }
-    }
-    choice
-}
-
-fn normalized(x: &V4) -> Option<V4> {
-    let l = norm4(x);
-    if l > 0.0 && l.is_finite() { Some(x.map(|c| c / l)) } else { None }
-}
-
-#[inline]
-fn cross3(a: &V4, b: &V4) -> V4 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0], 0.0]
-}
-
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     fn rows3(v: &[[f64; 3]]) -> Vec<V4> {
@@ -1244,7 +741,7 @@ mod tests {
         assert!(blocked > 600, "{blocked}");
     }
 
-    fn random_problem(seed: u64, n: usize, kind: u8, cuts: usize) -> (Vec<V4>, Vec<f64>, V4, V4, V4) {
+    pub(crate) fn random_problem(seed: u64, n: usize, kind: u8, cuts: usize) -> (Vec<V4>, Vec<f64>, V4, V4, V4) {
         let mut state = seed;
         let mut next = move || {
             state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
@@ -1354,91 +851,6 @@ mod tests {
             proptest::prop_assert_eq!(bits(&fast.curved), bits(&general.curved));
             let chol_bits = |s: &Subspace| s.chol.map(|r| r.map(f64::to_bits));
             proptest::prop_assert_eq!(chol_bits(&fast), chol_bits(&general));
-        }
-
-        /// The closed-form phase 1 (`seek_small`) against the general `seek` (the oracle): the same decision (level
-        /// reached or the minimum above it) unless the minimum is within 1e-9 of the target, the same minimum value,
-        /// and a returned point that satisfies every enabled row and reaches the level. Random cells with duplicate
-        /// rows, flat pairs and apexes of 4-5 planes; random masks; targets below, near and above the minimum.
-        #[test]
-        fn closed_form_phase_one_agrees_with_the_general_one(
-            seed in proptest::prelude::any::<u64>(), n in 2usize..4, kind in 0u8..4, cuts in 0usize..10,
-            masked in proptest::prelude::any::<u32>(), frac in -0.5f64..1.5,
-        ) {
-            let (rows, b, _, g, c) = random_problem(seed, n, kind, cuts);
-            // disabled rows: only cuts (the box stays, so the LP stays bounded)
-            let mask: Vec<bool> = (0..rows.len()).map(|j| j < 2 * n || (masked >> (j % 32)) & 1 == 0).collect();
-            let prob = Problem {
-                n, rows: &rows, offsets: &b, mask: Some(&mask), h: [0.0; MAX_N], g, tie: [2, 1, 0, 3], length_scale: 10.0,
-            };
-            let Ok(Seek::Minimum { value: min, .. }) = prob.seek(c, f64::NEG_INFINITY) else {
-                return Err(proptest::test_runner::TestCaseError::fail("general seek to -inf must end at the minimum"));
-            };
-            let fast_min = prob.seek_small(c, f64::NEG_INFINITY);
-            let Some(Seek::Minimum { value: fmin, point: fp }) = fast_min else {
-                return Err(proptest::test_runner::TestCaseError::fail(format!("fast seek to -inf: {fast_min:?}")));
-            };
-            let scale = 1e-9 * (1.0 + min.abs());
-            proptest::prop_assert!((fmin - min).abs() <= scale, "minimum {fmin} vs {min}");
-            proptest::prop_assert!((dot4(&g, &fp) - fmin).abs() <= scale);
-            let start_level = dot4(&g, &c);
-            let target = min + frac * (start_level - min);
-            let general = prob.seek(c, target).expect("general");
-            let fast = prob.seek_small(c, target).expect("closed form");
-            let point = match (fast, general) {
-                (Seek::Reached(p), Seek::Reached(_)) => p,
-                (Seek::Minimum { point, value }, Seek::Minimum { value: v, .. }) => {
-                    proptest::prop_assert!((value - v).abs() <= scale);
-                    point
-                }
-                (f, _) => {
-                    proptest::prop_assert!((target - min).abs() <= scale, "decisions differ away from the minimum: {f:?}");
-                    return Ok(());
-                }
-            };
-            for (j, a) in rows.iter().enumerate() {
-                if mask[j] {
-                    proptest::prop_assert!(dot4(a, &point) - b[j] <= 1e-9, "row {j} violated");
-                }
-            }
-            if let Seek::Reached(_) = fast {
-                proptest::prop_assert!(dot4(&g, &point) <= target + scale);
-            }
-        }
-
-        /// The closed-form path on its own (no fallback): it must finish, and agree with the general method.
-        #[test]
-        fn strictly_convex_path_agrees_with_the_general_method(
-            seed in proptest::prelude::any::<u64>(), n in 2usize..4, kind in 0u8..4, cuts in 0usize..10,
-        ) {
-            let (rows, b, h, g, c) = random_problem(seed, n, kind, cuts);
-            let prob = Problem { n, rows: &rows, offsets: &b, mask: None, h, g, tie: [2, 1, 0, 3], length_scale: 10.0 };
-            let fast = prob.solve_strictly_convex(c);
-            let (lo, hi) = (0..n).fold((f64::INFINITY, 0.0_f64), |(lo, hi), i| (lo.min(h[i]), hi.max(h[i])));
-            if lo < FAST_PATH_MIN_CURVATURE_RATIO * hi {
-                proptest::prop_assert!(fast.is_none(), "ill-conditioned Hessians take the general method");
-                return Ok(());
-            }
-            let general = prob.solve(c).expect("general");
-            let (Some(Outcome::Optimal { point: pf, working: wf, multipliers: lf, .. }), Outcome::Optimal { point: pg, .. }) =
-                (fast, general)
-            else {
-                return Err(proptest::test_runner::TestCaseError::fail(format!("fast {fast:?} general {general:?}")));
-            };
-            for i in 0..n {
-                proptest::prop_assert!((pf[i] - pg[i]).abs() <= 1e-9, "{pf:?} vs {pg:?}");
-            }
-            // KKT of the fast path's own answer: feasible, working rows tight, multipliers >= 0, stationary
-            for (j, a) in rows.iter().enumerate() {
-                proptest::prop_assert!(dot4(a, &pf) - b[j] <= 1e-9);
-            }
-            let mut r = prob.gradient(&pf);
-            for (k, &j) in wf.as_slice().iter().enumerate() {
-                proptest::prop_assert!((dot4(&rows[j], &pf) - b[j]).abs() <= 1e-9);
-                proptest::prop_assert!(lf[k] >= -1e-9 * prob.gradient_scale());
-                axpy(&mut r, lf[k], &rows[j]);
-            }
-            proptest::prop_assert!(norm4(&r) <= 1e-9 * prob.gradient_scale(), "residual {r:?}");
         }
     }
 }

@@ -12,7 +12,7 @@
 //!
 //! (ties broken by the lowest centre z, then y, then x, so the centre is deterministic). `r* < -tol`: empty;
 //! `|r*| <= tol`: flat (a face, an edge or a point, within the tolerance); `r* > tol`: solid with centre `c*` and
-//! inradius `r*`. The LP is solved by the exact active-set method of [`crate::active_set`] (one extra variable):
+//! inradius `r*`. The LP is solved by the exact active-set method of `active_set.rs` (one extra variable):
 //! O(m) per iteration, a handful of iterations.
 //!
 //! **Boundedness.** Every non-empty cell is bounded: [`Cell::new`] checks it (2D LPs `max +-p_i`) and returns
@@ -25,76 +25,13 @@
 //!
 //! Redundancy removal costs one LP per inequality (O(m) iterations of O(m) each); membership is O(m).
 
-use crate::active_set::{ActiveSetError, MAX_N, Outcome, Problem, Seek, V4, dot_first, dot4};
+use crate::active_set::{ActiveSetError, Outcome, Problem, default_tie};
+use crate::clarabel::clarabel_qp;
+use crate::halfspace::{Halfspace, Tag};
+use crate::linalg::{MAX_N, V4, from_v4, to_v4};
+use crate::phase_one::{Scratch, phase_one_rows};
 use geom::{Containment, Tolerance};
-use serde::{Deserialize, Serialize};
 use stackplan_geom as geom;
-
-/// Where an inequality of a cell comes from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-pub enum Tag {
-    /// Side `side` (from vertex `side` to `side + 1`) of the floor polygon: the part touches that wall.
-    FloorSide {
-        /// Index of the polygon edge.
-        side: u32,
-    },
-    /// The floor `z >= 0`: the part rests on the floor.
-    Floor,
-    /// The maximum stack height `z <= H`.
-    Ceiling,
-    /// The position is outside a c-space obstacle across its face `face` (`n . p >= d`): when active, the part
-    /// touches the obstacle with the contact that face describes.
-    ObstacleFace {
-        /// Caller's identifier of the obstacle.
-        obstacle: u64,
-        /// Face index within the obstacle.
-        face: u32,
-    },
-    /// A cut made by the decomposition of a subtraction (`n . p <= d` of an obstacle face, extended): not a
-    /// contact by itself.
-    ObstacleCut {
-        /// Caller's identifier of the obstacle.
-        obstacle: u64,
-        /// Face index within the obstacle.
-        face: u32,
-    },
-    /// Anything else, labelled by the caller.
-    User(u64),
-}
-
-/// One inequality `normal . p <= offset`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Halfspace<const D: usize> {
-    /// Outward normal (unit length once inside a cell).
-    pub normal: [f64; D],
-    /// Offset.
-    pub offset: f64,
-    /// Provenance.
-    pub tag: Tag,
-}
-
-impl<const D: usize> Halfspace<D> {
-    /// A half-space `normal . p <= offset`.
-    pub fn new(normal: [f64; D], offset: f64, tag: Tag) -> Self {
-        Self { normal, offset, tag }
-    }
-
-    /// Signed distance-like slack `normal . p - offset` (a distance when the normal is unit).
-    #[inline]
-    pub fn excess(&self, p: &[f64; D]) -> f64 {
-        let mut s = -self.offset;
-        for i in 0..D {
-            s += self.normal[i] * p[i];
-        }
-        s
-    }
-
-    /// The complementary closed half-space `normal . p >= offset`, i.e. `-normal . p <= -offset`.
-    pub fn flipped(&self, tag: Tag) -> Self {
-        Self { normal: self.normal.map(|c| -c), offset: -self.offset, tag }
-    }
-}
 
 /// The shape of a cell, from its Chebyshev LP.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -223,11 +160,6 @@ fn push_normalised<const D: usize>(
         }
     }
     Ok(trivially_empty)
-}
-
-/// The default tie-break order: lowest z, then y, then x (D = 3); lowest y then x (D = 2).
-pub(crate) fn default_tie(d: usize) -> [usize; MAX_N] {
-    if d == 3 { [2, 1, 0, 3] } else { [1, 0, 2, 3] }
 }
 
 /// Result of a linear programme over a cell.
@@ -366,7 +298,7 @@ impl<const D: usize> Cell<D> {
     /// `b_j + tol`; it is non-empty iff the Chebyshev radius is at least `-tol`, so the answer is the one of
     /// `self.with_halfspaces(extra)?.is_empty()`, up to rounding at that boundary). The inequalities violated at the
     /// current point by more than the tolerance are taken in order; for each, the LP `min a_j . p` over the
-    /// inequalities satisfied so far runs from the current point (the active-set solver of [`crate::active_set`])
+    /// inequalities satisfied so far runs from the current point (the active-set solver of `active_set.rs`)
     /// and stops on reaching `a_j . p = b_j + tol`. If its minimum stays above that, the satisfied inequalities
     /// already exclude `j`: empty. Otherwise the point moves there and `j` joins the satisfied set. Each LP starts
     /// feasible; about one LP per violated inequality, usually a single move (a child cell of the planner's search
@@ -422,6 +354,7 @@ impl<const D: usize> Cell<D> {
             Ok(cell) if cell.shape != CellShape::Empty => {
                 let mask = &mut scratch.mask;
                 phase_one_rows(cell.rows(), cell.offsets(), start, mask, self.length_scale())
+                    .map_err(|source| CellError::Solver { purpose: "phase 1", source })
             }
             Ok(_) => Ok(None),
             Err(e) => Err(e.clone()),
@@ -521,49 +454,17 @@ impl<const D: usize> Cell<D> {
             }
         }
         phase_one_rows(rows, grown, start, mask, self.length_scale())
+            .map_err(|source| CellError::Solver { purpose: "phase 1", source })
     }
 
     /// This cell with every offset grown by its tolerance: the cell on which emptiness is decided
     /// ([`Cell::is_empty_with`]; a cell that is non-empty within the tolerance has an exact common point here), for
     /// solvers that fail on a cell thinner than the tolerance (the planner's clarabel fallback;
-    /// [`crate::qp::minimize`] retries on [`Cell::grown_without_near_duplicates`]).
+    /// [`crate::qp::minimize`] retries on [`crate::outer_box::grown_without_near_duplicates`]).
     pub fn grown_by_tolerance(&self) -> Result<Self, CellError> {
         let tol = self.tolerance.linear;
         let grown = self.halfspaces.iter().map(|h| Halfspace { offset: h.offset + tol, ..*h }).collect();
         Self::new(grown, self.tolerance)
-    }
-
-    /// [`Cell::grown_by_tolerance`] without the near-duplicates: inequality `j` is left out when an earlier kept
-    /// inequality `k` implies it within the tolerance over the box around the cell ([`crate::outer_box::outer_box`]
-    /// grown by the tolerance): `max over the box of (a_j - a_k) . p <= b_j - b_k + tol`, so every point of the
-    /// reduced grown cell satisfies `j` within twice the tolerance. The c-space obstacles of parts whose faces are a
-    /// sliver out of line put a dozen planes through one vertex with normals 1e-16 to 1e-9 apart, a degenerate
-    /// problem on which both QP solvers can fail. Returns the cell and the index in this cell of each of its
-    /// inequalities. `Err` when the box is not finite.
-    pub fn grown_without_near_duplicates(&self) -> Result<(Self, Vec<usize>), CellError> {
-        let tol = self.tolerance.linear;
-        let (lo, hi) = crate::outer_box::outer_box(&self.halfspaces, tol);
-        if lo.iter().chain(&hi).any(|v| !v.is_finite()) {
-            return Err(CellError::Unbounded);
-        }
-        let mut kept: Vec<Halfspace<D>> = Vec::with_capacity(self.halfspaces.len());
-        let mut index = Vec::with_capacity(self.halfspaces.len());
-        for (j, h) in self.halfspaces.iter().enumerate() {
-            let implied = kept.iter().any(|k| {
-                let reach: f64 = (0..D)
-                    .map(|i| {
-                        let d = h.normal[i] - k.normal[i];
-                        if d > 0.0 { d * hi[i] } else { d * lo[i] }
-                    })
-                    .sum();
-                reach <= h.offset - (k.offset - tol) + tol
-            });
-            if !implied {
-                kept.push(Halfspace { offset: h.offset + tol, ..*h });
-                index.push(j);
-            }
-        }
-        Ok((Self::new(kept, self.tolerance)?, index))
     }
 
     /// The intersection of two cells (inequalities of `self`, then of `other`); tolerance of `self`.
@@ -664,7 +565,7 @@ impl<const D: usize> Cell<D> {
                 let keep = |j: &usize| mask.is_none_or(|m| m[*j]);
                 let rows: Vec<V4> = (0..self.len()).filter(keep).map(|j| self.rows()[j]).collect();
                 let offsets: Vec<f64> = (0..self.len()).filter(keep).map(|j| self.offsets()[j]).collect();
-                let x = crate::qp::clarabel_qp::<D>(&[0.0; D], objective, &rows, &offsets)
+                let x = clarabel_qp::<D>(&[0.0; D], objective, &rows, &offsets)
                     .map_err(|_| CellError::Solver { purpose, source })?;
                 let mut point = [0.0; MAX_N];
                 point[..D].copy_from_slice(&x[..D]);
@@ -728,8 +629,8 @@ impl<const D: usize> Cell<D> {
             Err(source) => {
                 tracing::debug!(error = %source, rows = rows.len(), "Chebyshev LP: active set failed; clarabel");
                 let solved = match D {
-                    2 => crate::qp::clarabel_qp::<3>(&[0.0; 3], &[0.0, 0.0, -1.0], rows, offsets),
-                    3 => crate::qp::clarabel_qp::<4>(&[0.0; 4], &[0.0, 0.0, 0.0, -1.0], rows, offsets),
+                    2 => clarabel_qp::<3>(&[0.0; 3], &[0.0, 0.0, -1.0], rows, offsets),
+                    3 => clarabel_qp::<4>(&[0.0; 4], &[0.0, 0.0, 0.0, -1.0], rows, offsets),
                     _ => return Err(CellError::Solver { purpose: "Chebyshev centre", source }),
                 };
                 let x = solved.map_err(|_| CellError::Solver { purpose: "Chebyshev centre", source })?;
@@ -762,114 +663,6 @@ impl<const D: usize> Cell<D> {
         }
         Ok(())
     }
-}
-
-/// The sequential phase 1 on the inequalities `rows . p <= offsets` from `start` ([`Cell::is_empty_with`]): the
-/// point reached (`None`: empty). `mask` (empty on entry) holds the satisfied set.
-fn phase_one_rows<const D: usize>(
-    rows: &[V4],
-    offsets: &[f64],
-    start: &[f64; D],
-    mask: &mut Vec<bool>,
-    length_scale: f64,
-) -> Result<Option<V4>, CellError> {
-    let mut point = to_v4(start);
-    // the level over the D used lanes (the others are zeros: only the sign of a zero level can differ from the full
-    // `dot4`, and `<=` does not see it)
-    let satisfied_at = |j: usize, p: &V4| dot_first::<D>(&rows[j], p) <= offsets[j];
-    // (a copy of the start point and zipped slices: no bounds checks, and the point stays in registers although
-    // the mask's byte stores could alias it)
-    let p0 = point;
-    mask.extend(rows.iter().zip(offsets).map(|(row, &b)| dot_first::<D>(row, &p0) <= b));
-    for j in 0..rows.len() {
-        if mask[j] {
-            continue;
-        }
-        if satisfied_at(j, &point) {
-            mask[j] = true;
-            continue;
-        }
-        let prob = Problem {
-            n: D,
-            rows,
-            offsets,
-            mask: Some(&mask[..]),
-            h: [0.0; MAX_N],
-            g: rows[j],
-            tie: default_tie(D),
-            length_scale,
-        };
-        // the closed-form iteration in 2-3 variables, the general one if it breaks down
-        let seek = match prob.seek_small(point, offsets[j]) {
-            Some(s) => s,
-            None => prob.seek(point, offsets[j]).map_err(|source| CellError::Solver { purpose: "phase 1", source })?,
-        };
-        match seek {
-            Seek::Reached(p) => point = p,
-            Seek::Minimum { point: p, value } => {
-                if value > offsets[j] {
-                    return Ok(None);
-                }
-                point = p;
-            }
-        }
-        mask[j] = true;
-    }
-    Ok(Some(point))
-}
-
-/// Per-thread lists for the LPs of a cell (rows, offsets, mask), reused between calls so that the hot paths
-/// ([`Cell::is_empty_with`], the Chebyshev LP of every new cell) allocate nothing once warm. Taken out of the
-/// thread-local slot for the duration of a call and put back cleared, so a nested call simply finds an empty one.
-#[derive(Default)]
-struct Scratch {
-    rows: Vec<V4>,
-    offsets: Vec<f64>,
-    mask: Vec<bool>,
-    /// Offset and tag of each normalised extra inequality ([`Cell::phase_one_in`]).
-    extra: Vec<(f64, Tag)>,
-}
-
-thread_local! {
-    static SCRATCH: std::cell::Cell<Scratch> = std::cell::Cell::new(Scratch::default());
-}
-
-impl Scratch {
-    fn take() -> Self {
-        SCRATCH.with(std::cell::Cell::take)
-    }
-
-    fn clear(&mut self) {
-        self.rows.clear();
-        self.offsets.clear();
-        self.mask.clear();
-        self.extra.clear();
-    }
-
-    fn put_back(mut self) {
-        self.clear();
-        SCRATCH.with(|s| s.set(self));
-    }
-}
-
-#[inline]
-pub(crate) fn to_v4<const D: usize>(x: &[f64; D]) -> V4 {
-    let mut v = [0.0; MAX_N];
-    v[..D].copy_from_slice(x);
-    v
-}
-
-#[inline]
-pub(crate) fn from_v4<const D: usize>(x: &V4) -> [f64; D] {
-    let mut v = [0.0; D];
-    v.copy_from_slice(&x[..D]);
-    v
-}
-
-/// `a . b` of two D-vectors through the 4-vector kernel.
-#[inline]
-pub(crate) fn dot<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
-    dot4(&to_v4(a), &to_v4(b))
 }
 
 #[cfg(test)]
@@ -1003,7 +796,11 @@ mod tests {
                 let n = [lcg(&mut state), lcg(&mut state), lcg(&mut state)];
                 let s = 10f64.powf(2.0 * lcg(&mut state));
                 let q = [lcg(&mut state), lcg(&mut state), lcg(&mut state)];
-                extra.push(Halfspace::new(n.map(|c| s * c), s * dot(&n, &q), Tag::User(50 + k as u64)));
+                extra.push(Halfspace::new(
+                    n.map(|c| s * c),
+                    s * (n[0] * q[0] + n[1] * q[1] + n[2] * q[2]),
+                    Tag::User(50 + k as u64),
+                ));
             }
             match case % 5 {
                 2 => extra.push(Halfspace::new([0.0; 3], 1.0, Tag::User(70))),

@@ -14,13 +14,14 @@
 //! **Rounding.** Each bound is a sum of `D` products, so its rounding error is a few units in the last place of the
 //! coordinates' magnitude; the test keeps a margin of the cell tolerance (`1e-9` of the problem's scale) above it.
 //!
-//! **Redundancy** ([`Cell::grown_outer_box_pruned`]): an inequality over whose box the cell's points keep a margin
+//! **Redundancy** ([`grown_outer_box_pruned`]): an inequality over whose box the cell's points keep a margin
 //! from it is dropped, after a second propagation without the dropped ones confirms the box (the first used them).
 //!
 //! Cost: O(passes x m x D^2) for `m` inequalities, no allocation; the test O(D); the pruning two propagations and
 //! one allocation.
 
-use crate::cell::{Cell, Halfspace};
+use crate::cell::{Cell, CellError};
+use crate::halfspace::Halfspace;
 
 /// Passes of the propagation. A second pass tightens what the first could not derive from bounds found later in the
 /// list; for the planner's cells (the permissible set's axis-aligned bounds come first) it filters a few more
@@ -80,51 +81,80 @@ pub fn box_is_empty<const D: usize>((lo, hi): &([f64; D], [f64; D]), slack: f64)
     (0..D).any(|i| lo[i] > hi[i] + 2.0 * slack)
 }
 
-impl<const D: usize> Cell<D> {
-    /// [`outer_box`] of this cell grown by its tolerance: a box that holds every point of the cell with each
-    /// offset grown by the tolerance (the cell on which [`Cell::is_empty_with`] decides).
-    pub fn grown_outer_box(&self) -> ([f64; D], [f64; D]) {
-        outer_box(self.halfspaces(), self.tolerance().linear)
-    }
+/// [`outer_box`] of `cell` grown by its tolerance: a box that holds every point of the cell with each offset grown by
+/// the tolerance (the cell on which [`Cell::is_empty_with`] decides).
+pub fn grown_outer_box<const D: usize>(cell: &Cell<D>) -> ([f64; D], [f64; D]) {
+    outer_box(cell.halfspaces(), cell.tolerance().linear)
 }
 
-impl<const D: usize> Cell<D> {
-    /// [`Cell::grown_outer_box`], and the cell without the inequalities that box proves redundant when there are
-    /// any (`None` otherwise).
-    ///
-    /// **Redundancy.** Inequality `a . p <= b` is dropped when the box proves `a . p < b - 2 tol` over the whole
-    /// tolerance-grown cell (the test and margin of [`box_misses_halfspace`], which decide empty children; the
-    /// cell's normals are unit). The first box was derived with the dropped inequalities themselves, so the drops
-    /// are checked again against the box of the kept inequalities alone: when every dropped one still holds over
-    /// it, the kept inequalities define the same cell, exactly and grown by the tolerance (the kept cell lies in
-    /// that box, which lies strictly inside every dropped half-space); otherwise nothing is dropped. No LP: two
-    /// propagations, O(m D^2).
-    ///
-    /// The planner's search cuts a cell by one obstacle after another and each child inherits its parent's
-    /// inequalities, so most of a deep cell's list no longer touches it (in the 15-part Complex plan about 14 of
-    /// 20 inequalities per split cell); its children are built from the pruned cell.
-    pub fn grown_outer_box_pruned(&self) -> (([f64; D], [f64; D]), Option<Self>) {
-        let tol = self.tolerance().linear;
-        let outer = outer_box(self.halfspaces(), tol);
-        if self.is_empty() {
-            return (outer, None);
-        }
-        let holds = |(lo, hi): &([f64; D], [f64; D]), h: &Halfspace<D>| unit_box_inside(lo, hi, h, tol);
-        let Some(first) = self.halfspaces().iter().position(|h| holds(&outer, h)) else {
-            return (outer, None);
-        };
-        let mut kept = Vec::with_capacity(self.len());
-        kept.extend_from_slice(&self.halfspaces()[..first]);
-        kept.extend(self.halfspaces()[first + 1..].iter().filter(|h| !holds(&outer, h)).copied());
-        let check = outer_box(&kept, tol);
-        // (the dropped ones are found again by the same O(D) test rather than kept in a second list: in the 15-part
-        // Complex plan that list's allocation cost 3 % more instructions than the second test)
-        let dropped = self.halfspaces()[first..].iter().filter(|h| holds(&outer, h));
-        if !dropped.clone().all(|h| holds(&check, h)) {
-            return (outer, None);
-        }
-        (outer, Some(self.with_only(kept)))
+/// [`grown_outer_box`], and `cell` without the inequalities that box proves redundant when there are any (`None`
+/// otherwise).
+///
+/// **Redundancy.** Inequality `a . p <= b` is dropped when the box proves `a . p < b - 2 tol` over the whole
+/// tolerance-grown cell (the test and margin of [`box_misses_halfspace`], which decide empty children; the
+/// cell's normals are unit). The first box was derived with the dropped inequalities themselves, so the drops
+/// are checked again against the box of the kept inequalities alone: when every dropped one still holds over
+/// it, the kept inequalities define the same cell, exactly and grown by the tolerance (the kept cell lies in
+/// that box, which lies strictly inside every dropped half-space); otherwise nothing is dropped. No LP: two
+/// propagations, O(m D^2).
+///
+/// The planner's search cuts a cell by one obstacle after another and each child inherits its parent's
+/// inequalities, so most of a deep cell's list no longer touches it (in the 15-part Complex plan about 14 of
+/// 20 inequalities per split cell); its children are built from the pruned cell.
+pub fn grown_outer_box_pruned<const D: usize>(cell: &Cell<D>) -> (([f64; D], [f64; D]), Option<Cell<D>>) {
+    let tol = cell.tolerance().linear;
+    let outer = outer_box(cell.halfspaces(), tol);
+    if cell.is_empty() {
+        return (outer, None);
     }
+    let holds = |(lo, hi): &([f64; D], [f64; D]), h: &Halfspace<D>| unit_box_inside(lo, hi, h, tol);
+    let Some(first) = cell.halfspaces().iter().position(|h| holds(&outer, h)) else {
+        return (outer, None);
+    };
+    let mut kept = Vec::with_capacity(cell.len());
+    kept.extend_from_slice(&cell.halfspaces()[..first]);
+    kept.extend(cell.halfspaces()[first + 1..].iter().filter(|h| !holds(&outer, h)).copied());
+    let check = outer_box(&kept, tol);
+    // (the dropped ones are found again by the same O(D) test rather than kept in a second list: in the 15-part
+    // Complex plan that list's allocation cost 3 % more instructions than the second test)
+    let dropped = cell.halfspaces()[first..].iter().filter(|h| holds(&outer, h));
+    if !dropped.clone().all(|h| holds(&check, h)) {
+        return (outer, None);
+    }
+    (outer, Some(cell.with_only(kept)))
+}
+
+/// `cell` grown by its tolerance ([`Cell::grown_by_tolerance`]) without the near-duplicates: inequality `j` is left out when an earlier kept
+/// inequality `k` implies it within the tolerance over the box around the cell ([`outer_box`] grown by the
+/// tolerance): `max over the box of (a_j - a_k) . p <= b_j - b_k + tol`, so every point of the
+/// reduced grown cell satisfies `j` within twice the tolerance. The c-space obstacles of parts whose faces are a
+/// sliver out of line put a dozen planes through one vertex with normals 1e-16 to 1e-9 apart, a degenerate
+/// problem on which both QP solvers can fail. Returns the cell and the index in this cell of each of its
+/// inequalities. `Err` when the box is not finite.
+pub fn grown_without_near_duplicates<const D: usize>(cell: &Cell<D>) -> Result<(Cell<D>, Vec<usize>), CellError> {
+    let tol = cell.tolerance().linear;
+    let (lo, hi) = outer_box(cell.halfspaces(), tol);
+    if lo.iter().chain(&hi).any(|v| !v.is_finite()) {
+        return Err(CellError::Unbounded);
+    }
+    let mut kept: Vec<Halfspace<D>> = Vec::with_capacity(cell.len());
+    let mut index = Vec::with_capacity(cell.len());
+    for (j, h) in cell.halfspaces().iter().enumerate() {
+        let implied = kept.iter().any(|k| {
+            let reach: f64 = (0..D)
+                .map(|i| {
+                    let d = h.normal[i] - k.normal[i];
+                    if d > 0.0 { d * hi[i] } else { d * lo[i] }
+                })
+                .sum();
+            reach <= h.offset - (k.offset - tol) + tol
+        });
+        if !implied {
+            kept.push(Halfspace { offset: h.offset + tol, ..*h });
+            index.push(j);
+        }
+    }
+    Ok((Cell::new(kept, cell.tolerance())?, index))
 }
 
 /// Whether every point of the box `[lo, hi]` satisfies `h` (unit normal) with a margin: `max over the box of
@@ -148,7 +178,7 @@ fn unit_box_inside<const D: usize>(lo: &[f64; D], hi: &[f64; D], h: &Halfspace<D
 /// and `d = offset / |normal|`. `false` ("cannot tell") for a zero or non-finite normal or offset and for a box
 /// unbounded in a direction the normal reaches.
 ///
-/// With the box of [`Cell::grown_outer_box`] and `slack` the cell's tolerance, `true` means that the cell with
+/// With the box of [`grown_outer_box`] and `slack` the cell's tolerance, `true` means that the cell with
 /// `-normal . p <= -offset` added (and any further inequalities) is empty even with every offset grown by the
 /// tolerance, so [`Cell::is_empty_with`] and [`Cell::with_halfspaces_from`] find it empty (the margin covers their
 /// rounding and the box's).
@@ -176,7 +206,7 @@ pub fn box_misses_halfspace<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cell::Tag;
+    use crate::halfspace::Tag;
     use proptest::prelude::*;
     use stackplan_geom::Tolerance;
 
@@ -274,14 +304,14 @@ mod tests {
         list.push(hs([0.0, 0.0, 1.0], 3.0));
         list.push(hs([1.0, 1.0, 1.0], 4.0));
         let cell = Cell::new(list, tol).expect("bounded");
-        let (outer, pruned) = cell.grown_outer_box_pruned();
-        assert_eq!(outer, cell.grown_outer_box());
+        let (outer, pruned) = grown_outer_box_pruned(&cell);
+        assert_eq!(outer, grown_outer_box(&cell));
         let pruned = pruned.expect("the far cut is dropped");
         assert_eq!(pruned.len(), cell.len() - 1);
         assert!(pruned.halfspaces().iter().all(|h| h.offset != 10.0 / 2f64.sqrt()));
         assert_eq!(pruned.shape(), cell.shape());
         // nothing left to drop
-        assert!(pruned.grown_outer_box_pruned().1.is_none());
+        assert!(grown_outer_box_pruned(&pruned).1.is_none());
     }
 
     proptest! {
@@ -296,7 +326,7 @@ mod tests {
             let tol = Tolerance::for_scale(10.0);
             let cell = box_with_cuts(&cuts, tol);
             prop_assume!(!cell.is_empty());
-            let b = cell.grown_outer_box();
+            let b = grown_outer_box(&cell);
             for i in 0..3 {
                 for sign in [1.0, -1.0] {
                     let mut e = [0.0; 3];
@@ -330,7 +360,7 @@ mod tests {
             let tol = Tolerance::for_scale(10.0);
             let cell = box_with_cuts(&cuts, tol);
             prop_assume!(!cell.is_empty());
-            let mut b = cell.grown_outer_box();
+            let mut b = grown_outer_box(&cell);
             let extra: Vec<Halfspace<3>> = extra.iter().map(|&(x, y, z, d)| hs([x, y, z], d)).collect();
             for h in &extra {
                 tighten_box(&mut b, &h.normal, h.offset + tol.linear);
@@ -364,7 +394,7 @@ mod tests {
             let tol = Tolerance::for_scale(10.0);
             let cell = box_with_cuts(&cuts, tol);
             prop_assume!(!cell.is_empty());
-            let (_, pruned) = cell.grown_outer_box_pruned();
+            let (_, pruned) = grown_outer_box_pruned(&cell);
             let Some(pruned) = pruned else { return Ok(()) };
             prop_assert!(pruned.len() < cell.len());
             prop_assert!(pruned.halfspaces().iter().all(|h| cell.halfspaces().contains(h)));

@@ -5,184 +5,39 @@
 //! floor volume.
 //!
 //! Two solvers:
-//! * [`minimize`]: the exact primal active-set method of [`crate::active_set`] started at the cell's interior point
+//! * [`minimize`]: the exact primal active-set method of `active_set.rs` started at the cell's interior point
 //!   (O(m) per iteration, a handful of iterations in 2-3 variables). When the Hessian is singular (`w = 1` leaves z
 //!   free, `w = 0` leaves x and y free) the minimiser set is not a point; the solver returns its lexicographic
 //!   minimum: lowest z, then lowest y, then lowest x (lowest y then x in 2-D). Before returning, the KKT conditions
-//!   are verified from scratch (see [`verify_kkt`]); a failed check is an error, never a silent wrong answer.
+//!   are verified from scratch (see [`crate::verify_kkt`]); a failed check is an error, never a silent wrong answer.
 //!   Strictly convex costs (every `h_i > 0` within a factor 1000 of each other: cost (1) with
 //!   `0.002 <= w <= 0.9995`, the desired-position cost) run the same
-//!   iteration with closed-form linear algebra ([`crate::active_set`], "strictly convex fast path"); if that path
+//!   iteration with closed-form linear algebra (`closed_form.rs`, "strictly convex fast path"); if that path
 //!   breaks down or its answer fails the KKT check, the general method solves the problem again. The minimiser is
 //!   unique there, so both give the same point up to rounding in the last bits; [`minimize_general`] runs the
 //!   general method alone (the reference of the tests and benchmarks).
 //! * [`minimize_clarabel`]: clarabel's interior-point QP (general path and cross-check; statuses other than
 //!   `Solved` are errors). Its point is some minimiser (no tie-break); its `active` list is the tight inequalities.
+//!
+//! The answer and its errors are in [`crate::solution`], the KKT check in `kkt.rs`, the enumeration that
+//! solves degenerate cells in `enumerate.rs`, clarabel's call in `clarabel.rs`.
 
-use crate::active_set::{ActiveSetError, MAX_N, Outcome, Problem, cholesky, cholesky_solve};
-use crate::cell::{Cell, default_tie, from_v4, to_v4};
-use crate::cost::SeparableQuadratic;
-use clarabel::algebra::CscMatrix;
-use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT, SolverStatus};
-
-/// A short list read as a slice: up to [`ShortList::INLINE`] entries inline (the working set of the exact solver has
-/// at most `D <= 3`), longer ones on the heap (clarabel's tight set), so that an exact QP solution allocates nothing
-/// for its working set and multipliers. Compares equal to a `Vec`, an array or a slice with the same entries.
-#[derive(Clone)]
-pub struct ShortList<T> {
-    inline: [T; ShortList::<()>::INLINE],
-    len: usize,
-    spill: Vec<T>,
-}
-
-impl ShortList<()> {
-    /// The most entries kept inline.
-    pub const INLINE: usize = MAX_N;
-}
-
-impl<T: Copy + Default> ShortList<T> {
-    /// The list of `items` (inline when there are at most [`ShortList::INLINE`]).
-    pub fn from_slice(items: &[T]) -> Self {
-        let mut inline = [T::default(); ShortList::<()>::INLINE];
-        if items.len() <= inline.len() {
-            inline[..items.len()].copy_from_slice(items);
-            Self { inline, len: items.len(), spill: Vec::new() }
-        } else {
-            Self { inline, len: items.len(), spill: items.to_vec() }
-        }
-    }
-}
-
-impl<T: Copy + Default> Default for ShortList<T> {
-    fn default() -> Self {
-        Self::from_slice(&[])
-    }
-}
-
-impl<T> std::ops::Deref for ShortList<T> {
-    type Target = [T];
-    fn deref(&self) -> &[T] {
-        if self.len <= self.inline.len() { &self.inline[..self.len] } else { &self.spill }
-    }
-}
-
-impl<'a, T> IntoIterator for &'a ShortList<T> {
-    type Item = &'a T;
-    type IntoIter = std::slice::Iter<'a, T>;
-    fn into_iter(self) -> Self::IntoIter {
-        self.iter()
-    }
-}
-
-impl<T: std::fmt::Debug> std::fmt::Debug for ShortList<T> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_list().entries(self.iter()).finish()
-    }
-}
-
-impl<T: PartialEq> PartialEq for ShortList<T> {
-    fn eq(&self, other: &Self) -> bool {
-        **self == **other
-    }
-}
-
-impl<T: PartialEq> PartialEq<Vec<T>> for ShortList<T> {
-    fn eq(&self, other: &Vec<T>) -> bool {
-        **self == **other
-    }
-}
-
-impl<T: PartialEq> PartialEq<[T]> for ShortList<T> {
-    fn eq(&self, other: &[T]) -> bool {
-        **self == *other
-    }
-}
-
-impl<T: PartialEq, const N: usize> PartialEq<[T; N]> for ShortList<T> {
-    fn eq(&self, other: &[T; N]) -> bool {
-        **self == other[..]
-    }
-}
-
-/// An optimum over a cell.
-#[derive(Debug, Clone, PartialEq)]
-pub struct QpSolution<const D: usize> {
-    /// The minimiser (the lexicographic one for the exact solver).
-    pub point: [f64; D],
-    /// The cost there.
-    pub cost: f64,
-    /// Indices (into [`Cell::halfspaces`]) of the working set at the optimum: linearly independent active
-    /// inequalities (at most D), sorted. For the clarabel path: the tight inequalities.
-    pub active: ShortList<usize>,
-    /// Lagrange multipliers of `active` (same order; >= 0). Empty for the clarabel path.
-    pub multipliers: ShortList<f64>,
-    /// All inequalities within the cell's tolerance of equality at `point`, sorted.
-    pub tight: Vec<usize>,
-    /// Active-set iterations (0 for the clarabel path).
-    pub iterations: usize,
-}
-
-/// Why a QP has no answer.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum QpError {
-    /// The cell is empty.
-    #[error("the cell is empty")]
-    EmptyCell,
-    /// The cost has invalid coefficients (negative Hessian entry or non-finite values).
-    #[error("cost coefficient {index} is invalid")]
-    BadCost {
-        /// Variable index.
-        index: usize,
-    },
-    /// The cost decreases without bound over the cell (impossible for bounded cells).
-    #[error("the cost is unbounded below over the cell")]
-    Unbounded,
-    /// The active-set solver gave up.
-    #[error(transparent)]
-    Solver(#[from] ActiveSetError),
-    /// The KKT check after the solve failed.
-    #[error("KKT check failed: {what} (value {value:e}, allowed {allowed:e})")]
-    Kkt {
-        /// Which condition.
-        what: &'static str,
-        /// The offending value.
-        value: f64,
-        /// The allowed bound.
-        allowed: f64,
-    },
-    /// clarabel did not report `Solved`.
-    #[error("clarabel status {0}")]
-    Clarabel(String),
-}
-
-fn check_cost<const D: usize>(cost: &impl SeparableQuadratic<D>) -> Result<([f64; D], [f64; D]), QpError> {
-    let h = cost.hessian_diagonal();
-    let g = cost.linear();
-    for i in 0..D {
-        if !(h[i] >= 0.0 && h[i].is_finite() && g[i].is_finite()) {
-            return Err(QpError::BadCost { index: i });
-        }
-    }
-    Ok((h, g))
-}
-
-fn tight_set<const D: usize>(cell: &Cell<D>, p: &[f64; D]) -> Vec<usize> {
-    tight_set_within(cell, p, cell.tolerance().linear)
-}
-
-fn tight_set_within<const D: usize>(cell: &Cell<D>, p: &[f64; D], tol: f64) -> Vec<usize> {
-    (0..cell.len()).filter(|&j| cell.halfspaces()[j].excess(p).abs() <= tol).collect()
-}
+use crate::active_set::{Outcome, Problem, default_tie};
+use crate::cell::Cell;
+use crate::clarabel::clarabel_qp;
+use crate::cost::SeparableCost;
+use crate::enumerate::minimize_enumerated;
+use crate::kkt::verify_kkt_dual;
+use crate::linalg::{MAX_N, from_v4, to_v4};
+use crate::outer_box::grown_without_near_duplicates;
+use crate::solution::{QpError, QpSolution, ShortList, tight_set, tight_set_within};
 
 /// An active-set problem, its start point and the cost's `h` and `g`.
 type Prepared<'c, const D: usize> = (Problem<'c>, [f64; MAX_N], [f64; D], [f64; D]);
 
 /// The active-set problem of `cost` over `cell` and its start (the cell's interior point), with the checked cost.
-fn problem<'c, const D: usize>(
-    cell: &'c Cell<D>,
-    cost: &impl SeparableQuadratic<D>,
-) -> Result<Prepared<'c, D>, QpError> {
-    let (h, g) = check_cost(cost)?;
+fn problem<'c, const D: usize>(cell: &'c Cell<D>, cost: &SeparableCost<D>) -> Result<Prepared<'c, D>, QpError> {
+    let (h, g) = (cost.hessian_diagonal(), cost.linear());
     let start = cell.interior_point().ok_or(QpError::EmptyCell)?;
     let prob = Problem {
         n: D,
@@ -206,7 +61,7 @@ fn problem<'c, const D: usize>(
 /// multipliers near 1e265 that fail the KKT check. When both paths fail, the problem is solved once more on the cell
 /// with every offset grown by the tolerance (the cell on which emptiness is decided, [`Cell::is_empty_with`], where
 /// the inequalities have a common point) and without its near-duplicate inequalities
-/// ([`Cell::grown_without_near_duplicates`]; indices mapped back to this cell's), by the same method and, if that
+/// ([`grown_without_near_duplicates`]; indices mapped back to this cell's), by the same method and, if that
 /// fails too, by enumeration of its faces (at most 16 inequalities; the same lexicographic tie-break when the
 /// Hessian is singular). The answer, KKT-verified on that cell,
 /// lies within three times the tolerance of every original inequality (the search treats points within the tolerance
@@ -214,10 +69,10 @@ fn problem<'c, const D: usize>(
 ///
 /// [`CellShape::Flat`]: crate::cell::CellShape::Flat
 /// [`CellShape::Known`]: crate::cell::CellShape::Known
-pub fn minimize<const D: usize>(cell: &Cell<D>, cost: &impl SeparableQuadratic<D>) -> Result<QpSolution<D>, QpError> {
+pub fn minimize<const D: usize>(cell: &Cell<D>, cost: &SeparableCost<D>) -> Result<QpSolution<D>, QpError> {
     match minimize_exact(cell, cost) {
         Err(e @ (QpError::Kkt { .. } | QpError::Solver(_))) => {
-            let (reduced, index) = cell.grown_without_near_duplicates().map_err(|_| e.clone())?;
+            let (reduced, index) = grown_without_near_duplicates(cell).map_err(|_| e.clone())?;
             tracing::debug!(error = %e, kept = reduced.len(), of = cell.len(), "QP failed on a cell; grown and reduced");
             let sol = match minimize_exact(&reduced, cost) {
                 Ok(sol) => sol,
@@ -231,224 +86,8 @@ pub fn minimize<const D: usize>(cell: &Cell<D>, cost: &impl SeparableQuadratic<D
     }
 }
 
-/// A candidate of [`minimize_enumerated`]: cost, point, subset and multipliers.
-type Candidate<const D: usize> = (f64, [f64; D], Vec<usize>, Vec<f64>);
-
-/// The most inequalities [`minimize_enumerated`] takes (C(16, <= 3) = 697 systems).
-const ENUMERATE_MAX: usize = 16;
-
-/// The minimum of a convex separable `cost` over a small `cell` by enumeration, the last resort of [`minimize`] on
-/// degenerate cells: for every set `S` of at most `D` inequalities, the minimiser of the cost on
-/// `a_j . p = b_j (j in S)` by the null-space method ([`equality_qp`]); the cheapest
-/// that satisfies every inequality within the tolerance is the optimum (a convex QP's minimiser is the minimiser on
-/// the affine hull of the face it lies in, and that face is cut out by at most `D` of its tight inequalities). Its
-/// multipliers are those of its system when they pass the KKT check, else none (the caller's certificate is then
-/// the gradient alone). Unlike the active-set iteration this never divides by the sine of the angle between two
-/// nearly opposite planes to choose a step: an ill-conditioned system costs accuracy in its own multipliers only.
-///
-/// **Singular Hessians** (`w = 0` or `w = 1` in cost (1), some `h_i = 0`): the minimisers form a face, and the
-/// answer is its lexicographic minimum, lowest `p_{D-1}` first (z, then y, then x), as [`minimize`]'s. That point is
-/// among the candidates: take for `S` a basis of the inequalities tight there; a direction of `S`'s affine hull along
-/// which the cost were flat would lead, both ways, to other minimisers (the inequalities not in `S` are slack or
-/// constant on the hull), one of them lexicographically lower. So the cost is strictly convex on that hull and its
-/// minimiser there is the point. Two candidates are ties when their curved coordinates (`h_i > 0`; every minimiser
-/// has the same) agree within `1e-9` of the cell's length scale and their costs differ by no more than moving that
-/// far changes them; the lexicographically lowest of the ties is taken. Otherwise the cheaper wins, by the cost
-/// difference computed from the two points (near an interior minimum the difference is second order in their
-/// distance, and the values' constant terms would round it away).
-///
-/// `None`: more than [`ENUMERATE_MAX`] inequalities, or no feasible candidate. O(C(m, <= D) D^3).
-fn minimize_enumerated<const D: usize>(cell: &Cell<D>, cost: &impl SeparableQuadratic<D>) -> Option<QpSolution<D>> {
-    let (h, g) = check_cost(cost).ok()?;
-    let m = cell.len();
-    if m > ENUMERATE_MAX {
-        return None;
-    }
-    let hs = cell.halfspaces();
-    let tol = cell.tolerance().linear;
-    let scale = cell.length_scale();
-    // coordinates within `same` compare equal; two candidates whose curved coordinates (h_i > 0) are equal so and
-    // whose costs differ by at most what moving by `same` changes are ties (minimisers of a flat cost); the cost
-    // difference is computed from the two points, f(p) - f(q) = sum (p_i - q_i) (h_i (p_i + q_i) / 2 + g_i), not from
-    // the two values, whose constant terms would round it away near the minimum (where it is second order in the
-    // distance)
-    let same = 1e-9 * scale;
-    let tie = same * (0..D).map(|i| h[i] * scale + g[i].abs()).sum::<f64>();
-    let difference =
-        |p: &[f64; D], q: &[f64; D]| (0..D).map(|i| (p[i] - q[i]) * (0.5 * h[i] * (p[i] + q[i]) + g[i])).sum::<f64>();
-    // lexicographically lower: the last coordinate first (z, then y, then x)
-    let lower = |a: &[f64; D], b: &[f64; D]| {
-        for i in (0..D).rev() {
-            if a[i] < b[i] - same {
-                return true;
-            }
-            if a[i] > b[i] + same {
-                return false;
-            }
-        }
-        false
-    };
-    // (cost, point, subset, multipliers)
-    let mut best: Option<Candidate<D>> = None;
-    let mut subset: Vec<usize> = Vec::with_capacity(D);
-    // every subset of at most D inequalities, in lexicographic order (an odometer over sorted index lists)
-    loop {
-        if let Some((p, lambda)) = equality_qp(hs, &h, &g, &subset) {
-            let feasible = hs.iter().all(|x| x.excess(&p) <= tol);
-            let value = cost.evaluate(&p);
-            let better = |b: &Candidate<D>| {
-                let d = difference(&p, &b.1);
-                let close = (0..D).all(|i| h[i] == 0.0 || (p[i] - b.1[i]).abs() <= same);
-                if close && d.abs() <= tie { lower(&p, &b.1) } else { d < 0.0 }
-            };
-            if feasible && value.is_finite() && best.as_ref().is_none_or(better) {
-                best = Some((value, p, subset.clone(), lambda));
-            }
-        }
-        // next subset: extend, else advance the last index, else drop it and advance the one before
-        if subset.len() < D && subset.last().map_or(0, |&j| j + 1) < m {
-            subset.push(subset.last().map_or(0, |&j| j + 1));
-            continue;
-        }
-        loop {
-            match subset.pop() {
-                None => break,
-                Some(j) if j + 1 < m => {
-                    subset.push(j + 1);
-                    break;
-                }
-                Some(_) => {}
-            }
-        }
-        if subset.is_empty() {
-            break;
-        }
-    }
-    let (value, point, active, lambda) = best?;
-    let mut order: Vec<usize> = (0..active.len()).collect();
-    order.sort_by_key(|&k| active[k]);
-    let active: Vec<usize> = order.iter().map(|&k| active[k]).collect();
-    let lambda: Vec<f64> = order.iter().map(|&k| lambda[k]).collect();
-    let mut sol = QpSolution {
-        point,
-        cost: value,
-        active: ShortList::from_slice(&active),
-        multipliers: ShortList::from_slice(&lambda),
-        tight: tight_set(cell, &point),
-        iterations: 0,
-    };
-    if verify_kkt_dual(cell, &h, &g, &sol).is_err() {
-        sol.multipliers = ShortList::default();
-        sol.active = ShortList::default();
-    }
-    Some(sol)
-}
-
-/// The minimiser of `1/2 sum h_i p_i^2 + g . p` on `a_j . p = b_j (j in subset)` and its multipliers, by the
-/// null-space method: the subset's normals orthonormalised by modified Gram-Schmidt (`a_j = sum_{i <= j} r_ji q_i`;
-/// a normal whose residual is below 1e-12 of its length is dependent: `None`, the face is another subset's), the
-/// point `Q^T c` with `R c = b` on the constraints, the basis `Z` of their orthogonal complement completed from the
-/// axes, and the reduced system `Z^T H Z y = -Z^T (H p0 + g)` (the active set's Cholesky factor); the multipliers
-/// from `R^T lambda = -Q (H p + g)`.
-/// Nearly opposite normals (1e-9 rad) are independent here and give an accurate point: only the multipliers, which
-/// divide by the small residual, lose accuracy. `None` also when a result is not finite.
-fn equality_qp<const D: usize>(
-    hs: &[crate::cell::Halfspace<D>],
-    h: &[f64; D],
-    g: &[f64; D],
-    subset: &[usize],
-) -> Option<([f64; D], Vec<f64>)> {
-    let k = subset.len();
-    let dot = |a: &[f64; D], b: &[f64; D]| (0..D).map(|i| a[i] * b[i]).sum::<f64>();
-    // orthonormal rows q and the lower-triangular r with a_j = sum_i r[j][i] q_i
-    let mut q = [[0.0f64; D]; D];
-    let mut r = [[0.0f64; D]; D];
-    for (j, &row) in subset.iter().enumerate() {
-        let mut v = hs[row].normal;
-        let length = dot(&v, &v).sqrt();
-        for i in 0..j {
-            let c = dot(&v, &q[i]);
-            r[j][i] = c;
-            for t in 0..D {
-                v[t] -= c * q[i][t];
-            }
-        }
-        let rest = dot(&v, &v).sqrt();
-        if rest.is_nan() || rest <= 1e-12 * length {
-            return None;
-        }
-        r[j][j] = rest;
-        q[j] = v.map(|x| x / rest);
-    }
-    // c from R c = b (forward substitution), p0 = Q^T c
-    let mut c = [0.0f64; D];
-    for j in 0..k {
-        let tail: f64 = (0..j).map(|i| r[j][i] * c[i]).sum();
-        c[j] = (hs[subset[j]].offset - tail) / r[j][j];
-    }
-    let mut p = [0.0f64; D];
-    for j in 0..k {
-        for t in 0..D {
-            p[t] += c[j] * q[j][t];
-        }
-    }
-    // Z: the axes orthogonalised against Q (and each other), the D - k longest residuals
-    let mut basis: Vec<[f64; D]> = q[..k].to_vec();
-    let mut z: Vec<[f64; D]> = Vec::new();
-    for axis in 0..D {
-        if basis.len() == D {
-            break;
-        }
-        let mut v = [0.0f64; D];
-        v[axis] = 1.0;
-        for b in &basis {
-            let c = dot(&v, b);
-            for t in 0..D {
-                v[t] -= c * b[t];
-            }
-        }
-        let n = dot(&v, &v).sqrt();
-        if n > 1e-6 {
-            let v = v.map(|x| x / n);
-            basis.push(v);
-            z.push(v);
-        }
-    }
-    if k + z.len() != D {
-        return None;
-    }
-    // the reduced system over y: (Z^T H Z) y = -Z^T (H p0 + g), positive definite for a strictly convex cost; where
-    // the cost is flat along a direction of the hull, `cholesky` clamps the pivot, and the point is some point of the
-    // hull (the gradient has no component along a direction flat as in cost (1)) or one far outside the cell or not
-    // finite (a linear cost): the caller keeps only feasible candidates and compares their costs
-    let nz = z.len();
-    let mut m = [[0.0f64; MAX_N]; MAX_N];
-    let mut rhs = [0.0f64; MAX_N];
-    for a in 0..nz {
-        for b in 0..nz {
-            m[a][b] = (0..D).map(|t| z[a][t] * h[t] * z[b][t]).sum();
-        }
-        rhs[a] = -(0..D).map(|t| z[a][t] * (h[t] * p[t] + g[t])).sum::<f64>();
-    }
-    cholesky(&mut m, nz);
-    let y = cholesky_solve(&m, nz, &rhs);
-    for a in 0..nz {
-        for t in 0..D {
-            p[t] += y[a] * z[a][t];
-        }
-    }
-    // multipliers: R^T lambda = -Q grad (back substitution, R^T upper-triangular)
-    let grad: [f64; D] = std::array::from_fn(|t| h[t] * p[t] + g[t]);
-    let mut lambda = vec![0.0f64; k];
-    for j in (0..k).rev() {
-        let tail: f64 = (j + 1..k).map(|i| r[i][j] * lambda[i]).sum();
-        lambda[j] = (-dot(&q[j], &grad) - tail) / r[j][j];
-    }
-    (p.iter().all(|v| v.is_finite()) && lambda.iter().all(|v| v.is_finite())).then_some((p, lambda))
-}
-
 /// [`minimize`] without the retry on degenerate cells.
-fn minimize_exact<const D: usize>(cell: &Cell<D>, cost: &impl SeparableQuadratic<D>) -> Result<QpSolution<D>, QpError> {
+fn minimize_exact<const D: usize>(cell: &Cell<D>, cost: &SeparableCost<D>) -> Result<QpSolution<D>, QpError> {
     let (prob, start, h, g) = problem(cell, cost)?;
     // strictly convex costs: the closed-form range-space iteration; a result that fails the KKT check (or a
     // breakdown of that path) falls back to the general method, whose answer is the definition
@@ -464,10 +103,7 @@ fn minimize_exact<const D: usize>(cell: &Cell<D>, cost: &impl SeparableQuadratic
 /// [`minimize`] by the general active-set method only (Gram-Schmidt null-space split, lexicographic multipliers),
 /// without the closed-form path for strictly convex costs. Same answer as [`minimize`] up to rounding in the last
 /// bits (the minimiser is unique when the fast path applies); the tests' reference for the fast path.
-pub fn minimize_general<const D: usize>(
-    cell: &Cell<D>,
-    cost: &impl SeparableQuadratic<D>,
-) -> Result<QpSolution<D>, QpError> {
+pub fn minimize_general<const D: usize>(cell: &Cell<D>, cost: &SeparableCost<D>) -> Result<QpSolution<D>, QpError> {
     let (prob, start, h, g) = problem(cell, cost)?;
     solution(cell, cost, &h, &g, prob.solve(start)?)
 }
@@ -475,7 +111,7 @@ pub fn minimize_general<const D: usize>(
 /// The solution of an outcome of the active-set solver, KKT-verified.
 fn solution<const D: usize>(
     cell: &Cell<D>,
-    cost: &impl SeparableQuadratic<D>,
+    cost: &SeparableCost<D>,
     h: &[f64; D],
     g: &[f64; D],
     outcome: Outcome,
@@ -528,89 +164,13 @@ fn solution<const D: usize>(
     }
 }
 
-/// Verifies the first-order (KKT) conditions of a solution of [`minimize`], which for a convex problem prove global
-/// optimality:
-///
-/// * primal feasibility: `a_j . p - b_j <= tol` for every `j` (the cell's tolerance);
-/// * complementarity: every `j` in `active` is tight, `|a_j . p - b_j| <= tol`;
-/// * dual feasibility: `lambda_j >= -eps`;
-/// * stationarity: `|grad f(p) + sum_j lambda_j a_j| <= 1e-8 * max(G, T)`,
-///
-/// with `eps = 1e-8 * G`, `G = max_i (h_i L + |g_i|)` the gradient scale over the cell's length scale `L`, and
-/// `T = max_i (|h_i p_i| + |g_i| + sum_j |lambda_j a_ji|)` the size of the terms the residual sums (its rounding
-/// scale). `T` exceeds `G` only where the multipliers are huge: at a vertex held by nearly parallel planes (the
-/// c-space obstacles of sheet-metal parts whose faces are a few micrometres out of line have faces 1e-7 rad from
-/// parallel) they are about `|grad f| / sin(angle)`, and the rounding of the 2 x 2 system that gives them leaves a
-/// residual near 1e-10 `T`, far above `1e-8 G` (the test `the_apex_of_a_thin_wedge_passes_the_kkt_check`). A wrong
-/// working set leaves a residual of the order of `G`, which ordinary multipliers (`T` about `G`) still reject.
-pub fn verify_kkt<const D: usize>(
-    cell: &Cell<D>,
-    cost: &impl SeparableQuadratic<D>,
-    sol: &QpSolution<D>,
-) -> Result<(), QpError> {
-    let tol = cell.tolerance().linear;
-    let hs = cell.halfspaces();
-    let mut worst = f64::NEG_INFINITY;
-    for h in hs {
-        worst = worst.max(h.excess(&sol.point));
-    }
-    if worst > tol {
-        return Err(QpError::Kkt { what: "primal feasibility", value: worst, allowed: tol });
-    }
-    let (h, g) = check_cost(cost)?;
-    verify_kkt_dual(cell, &h, &g, sol)
-}
-
-/// The conditions of [`verify_kkt`] other than primal feasibility.
-fn verify_kkt_dual<const D: usize>(
-    cell: &Cell<D>,
-    h: &[f64; D],
-    g: &[f64; D],
-    sol: &QpSolution<D>,
-) -> Result<(), QpError> {
-    let tol = cell.tolerance().linear;
-    let hs = cell.halfspaces();
-    let scale = cell.length_scale();
-    let gs = (0..D).map(|i| h[i] * scale + g[i].abs()).fold(f64::MIN_POSITIVE, f64::max);
-    let eps = 1e-8 * gs;
-    let mut residual = [0.0; D];
-    let mut terms = [0.0; D];
-    for i in 0..D {
-        residual[i] = h[i] * sol.point[i] + g[i];
-        terms[i] = (h[i] * sol.point[i]).abs() + g[i].abs();
-    }
-    for (&j, &l) in sol.active.iter().zip(&sol.multipliers) {
-        let e = hs[j].excess(&sol.point).abs();
-        if e > tol {
-            return Err(QpError::Kkt { what: "complementarity", value: e, allowed: tol });
-        }
-        if l < -eps {
-            return Err(QpError::Kkt { what: "dual feasibility", value: l, allowed: -eps });
-        }
-        for i in 0..D {
-            residual[i] += l * hs[j].normal[i];
-            terms[i] += (l * hs[j].normal[i]).abs();
-        }
-    }
-    let r = residual.iter().map(|x| x * x).sum::<f64>().sqrt();
-    let allowed = 1e-8 * terms.iter().copied().fold(gs, f64::max);
-    // (non-finite multipliers or residual never pass: `allowed` would be infinite too)
-    if !(r <= allowed && allowed.is_finite()) {
-        return Err(QpError::Kkt { what: "stationarity", value: r, allowed });
-    }
-    Ok(())
-}
-
 /// Minimum of `cost` over `cell` by clarabel (interior point). The general path and the tests' cross-check.
-pub fn minimize_clarabel<const D: usize>(
-    cell: &Cell<D>,
-    cost: &impl SeparableQuadratic<D>,
-) -> Result<QpSolution<D>, QpError> {
-    let (h, g) = check_cost(cost)?;
+pub fn minimize_clarabel<const D: usize>(cell: &Cell<D>, cost: &SeparableCost<D>) -> Result<QpSolution<D>, QpError> {
+    let (h, g) = (cost.hessian_diagonal(), cost.linear());
     if cell.is_empty() {
         return Err(QpError::EmptyCell);
     }
-    let x = clarabel_qp::<D>(&h, &g, cell.rows(), cell.offsets())?;
+    let x = clarabel_qp::<D>(&h, &g, cell.rows(), cell.offsets()).map_err(QpError::Clarabel)?;
     let mut p = [0.0; D];
     p.copy_from_slice(&x[..D]);
     let tight = tight_set(cell, &p);
@@ -624,74 +184,13 @@ pub fn minimize_clarabel<const D: usize>(
     })
 }
 
-/// `min 1/2 sum h_i x_i^2 + g . x  s.t.  rows_j . x <= b_j` with clarabel; `Solved` only.
-pub(crate) fn clarabel_qp<const D: usize>(
-    h: &[f64; D],
-    g: &[f64; D],
-    rows: &[[f64; MAX_N]],
-    b: &[f64],
-) -> Result<Vec<f64>, QpError> {
-    let m = rows.len();
-    // P: diagonal, upper triangle, explicit zeros dropped
-    let mut colptr = vec![0usize];
-    let mut rowval = Vec::new();
-    let mut nzval = Vec::new();
-    for i in 0..D {
-        if h[i] != 0.0 {
-            rowval.push(i);
-            nzval.push(h[i]);
-        }
-        colptr.push(rowval.len());
-    }
-    let p = CscMatrix::new(D, D, colptr, rowval, nzval);
-    let mut colptr = vec![0usize];
-    let mut rowval = Vec::new();
-    let mut nzval = Vec::new();
-    for i in 0..D {
-        for (j, r) in rows.iter().enumerate() {
-            if r[i] != 0.0 {
-                rowval.push(j);
-                nzval.push(r[i]);
-            }
-        }
-        colptr.push(rowval.len());
-    }
-    let a = CscMatrix::new(m, D, colptr, rowval, nzval);
-    let cones = [NonnegativeConeT(m)];
-    // with clarabel's equilibration first, then without: on some small, well-scaled QPs the equilibrated problem
-    // never converges (a 3-variable, 9-row cell of a 4096-case run, seed 2718: the gap stays at 0.47 relative for
-    // 200 iterations, at these tolerances and at the defaults) while the plain one solves in 10 iterations
-    // (upstream: oxfordcontrol/Clarabel.rs issue 217, "Fail to solve small QP problems", equilibration enabled)
-    let mut status = SolverStatus::Unsolved;
-    for equilibrate in [true, false] {
-        let settings = DefaultSettingsBuilder::default()
-            .verbose(false)
-            .tol_gap_abs(1e-11)
-            .tol_gap_rel(1e-11)
-            .tol_feas(1e-11)
-            .tol_ktratio(1e-9)
-            .max_iter(200)
-            .equilibrate_enable(equilibrate)
-            .build()
-            .map_err(|e| QpError::Clarabel(format!("settings: {e}")))?;
-        let mut solver =
-            DefaultSolver::new(&p, g, &a, b, &cones, settings).map_err(|e| QpError::Clarabel(format!("setup: {e}")))?;
-        solver.solve();
-        status = solver.solution.status;
-        if status == SolverStatus::Solved {
-            return Ok(solver.solution.x.clone());
-        }
-        tracing::debug!(?status, equilibrate, rows = m, "clarabel QP not solved");
-    }
-    Err(QpError::Clarabel(format!("{status:?}")))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::cell::CellShape;
-    use crate::cell::{Halfspace, Tag};
     use crate::cost::SeparableCost;
+    use crate::halfspace::{Halfspace, Tag};
+    use crate::kkt::verify_kkt;
     use stackplan_geom::Tolerance;
 
     fn unit_cube() -> Cell<3> {
@@ -853,7 +352,7 @@ mod tests {
             assert!(hs.excess(&s.point) <= 3.0 * tol, "{:?} violated by {}", hs, hs.excess(&s.point));
         }
         // verified on the grown, reduced cell: the lowest z there (the cost depends on z alone)
-        let (reduced, index) = cell.grown_without_near_duplicates().expect("reduced");
+        let (reduced, index) = grown_without_near_duplicates(&cell).expect("reduced");
         let local: Vec<usize> = s.active.iter().map(|j| index.iter().position(|k| k == j).expect("kept")).collect();
         verify_kkt(&reduced, &cost, &QpSolution { active: ShortList::from_slice(&local), ..s.clone() })
             .expect("KKT on the reduced cell");
@@ -917,7 +416,7 @@ mod tests {
             SeparableCost::new(std::array::from_fn(|i| 2.0 * h[i]), std::array::from_fn(|i| -2.0 * h[i] * c[i]), 0.0)
                 .expect("cost");
         assert!(minimize_exact(&cell, &cost).is_err());
-        let (reduced, index) = cell.grown_without_near_duplicates().expect("reduced");
+        let (reduced, index) = grown_without_near_duplicates(&cell).expect("reduced");
         assert_eq!(reduced.len(), 11);
         assert!(minimize_exact(&reduced, &cost).is_err());
         let enumerated = minimize_enumerated(&reduced, &cost).expect("enumerated");

@@ -139,7 +139,8 @@ impl Cell<2> {
 
 #[cfg(test)]
 mod tests {
-    use crate::cell::{Cell, Halfspace, Tag};
+    use crate::cell::Cell;
+    use crate::halfspace::{Halfspace, Tag};
     use stackplan_geom::Tolerance;
 
     #[test]

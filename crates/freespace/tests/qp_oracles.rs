@@ -21,10 +21,7 @@ use crate::common;
 use common::Rng;
 use proptest::prelude::*;
 use stackplan_freespace::qp::minimize_general;
-use stackplan_freespace::{
-    Cell, Halfspace, QpError, QpSolution, RotatedExtents, SeparableCost, SeparableQuadratic, Tag,
-    desired_position_cost, minimize, minimize_clarabel, stacking_cost,
-};
+use stackplan_freespace::{Cell, Halfspace, QpError, QpSolution, SeparableCost, Tag, minimize, minimize_clarabel};
 use stackplan_geom::{DVec3, Tolerance};
 
 fn dot<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
@@ -132,10 +129,10 @@ fn random_cost(rng: &mut Rng, kind: usize) -> SeparableCost<3> {
     let ext = common::random_extents(rng);
     let reference = DVec3::new(rng.range(-15.0, 15.0), rng.range(-15.0, 15.0), rng.range(-4.0, 8.0));
     match kind % 7 {
-        0 => stacking_cost(rng.range(0.02, 0.98), &ext, reference).expect("cost"),
-        1 => stacking_cost(0.0, &ext, reference).expect("cost"),
-        2 => stacking_cost(1.0, &ext, reference).expect("cost"),
-        3 => desired_position_cost(ext.center_of_gravity, reference).expect("cost"),
+        0 => common::stacking_cost(rng.range(0.02, 0.98), &ext, reference).expect("cost"),
+        1 => common::stacking_cost(0.0, &ext, reference).expect("cost"),
+        2 => common::stacking_cost(1.0, &ext, reference).expect("cost"),
+        3 => common::desired_position_cost(ext.center_of_gravity, reference).expect("cost"),
         4 => {
             let h = [0; 3].map(|_| 10f64.powf(rng.range(-2.0, 1.0)));
             let g = [0; 3].map(|_| rng.range(-30.0, 30.0));
@@ -442,11 +439,11 @@ proptest! {
         let mut rng = Rng(seed);
         let (hs, _, _) = random_cell(&mut rng, KINDS[kind], cuts);
         let w = if near_one { 1.0 - 10f64.powf(e) } else { 10f64.powf(e) };
-        let ext = RotatedExtents {
+        let ext = common::Extents {
             x_max: 2.0, x_min: -1.0, y_max: 1.5, y_min: -2.5, center_of_gravity: DVec3::new(0.1, -0.2, 0.7),
         };
         let reference = DVec3::new(rng.range(-15.0, 15.0), rng.range(-15.0, 15.0), rng.range(-4.0, 8.0));
-        let cost = stacking_cost(w, &ext, reference).expect("cost");
+        let cost = common::stacking_cost(w, &ext, reference).expect("cost");
         let cell = Cell::new(hs, Tolerance::for_scale(30.0)).map_err(|e| TestCaseError::fail(format!("{e}")))?;
         prop_assert_eq!(minimize(&cell, &cost), minimize_general(&cell, &cost));
     }

@@ -3,12 +3,10 @@
 use crate::common;
 
 use common::{Rng, Shape, bbox, random_cell};
+use common::{desired_position_cost, stacking_cost};
 use proptest::prelude::*;
-use stackplan_freespace::{
-    Cell, Halfspace, SeparableCost, SeparableQuadratic, desired_position_cost, minimize, minimize_clarabel, omega,
-    stacking_cost, verify_kkt,
-};
-use stackplan_geom::{Containment, DVec2, DVec3};
+use stackplan_freespace::{Cell, Halfspace, SeparableCost, Tag, minimize, minimize_clarabel, verify_kkt};
+use stackplan_geom::{Containment, DVec3, Tolerance};
 
 #[derive(Debug, Clone, Copy)]
 enum CostKind {
@@ -146,15 +144,21 @@ proptest! {
         check_case(seed, shape_of(shape), if w1 { CostKind::W1 } else { CostKind::W0 }, extra)?;
     }
 
-    /// Omega cut by random planes: unbounded directions of the cuts are closed by Omega.
+    /// A box (the permissible set of a part over a rectangular floor, \[A\] eq. 3) cut by random planes: unbounded
+    /// directions of the cuts are closed by the box.
     #[test]
-    fn qp_over_omega_cut_by_half_spaces(seed in any::<u64>(), kind in 0u8..5, cuts in 0usize..6) {
+    fn qp_over_a_box_cut_by_half_spaces(seed in any::<u64>(), kind in 0u8..5, cuts in 0usize..6) {
         let mut rng = Rng(seed);
-        let floor = stackplan_freespace::FloorVolume::rectangle(
-            DVec2::new(-10.0, -8.0), DVec2::new(rng.range(2.0, 12.0), rng.range(2.0, 10.0)), rng.range(3.0, 10.0),
-        ).expect("floor");
+        let (x1, y1, height) = (rng.range(2.0, 12.0), rng.range(2.0, 10.0), rng.range(3.0, 10.0));
         let part = common::random_points(&mut rng, DVec3::ZERO, 1.5, 10);
-        let om = omega(&floor, &part).expect("omega");
+        let (lo, hi) = part.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
+        // the part's vertices inside [-10, x1] x [-8, y1] x [0, height]: the floor's sides counter-clockwise from
+        // (-10, -8), then the floor and the ceiling, as the planner orders them
+        let sides = [([0.0, -1.0, 0.0], 8.0 + lo.y), ([1.0, 0.0, 0.0], x1 - hi.x), ([0.0, 1.0, 0.0], y1 - hi.y),
+            ([-1.0, 0.0, 0.0], 10.0 + lo.x), ([0.0, 0.0, -1.0], lo.z), ([0.0, 0.0, 1.0], height - hi.z)];
+        let walls = sides.iter().enumerate().map(|(k, &(n, d))| Halfspace::new(n, d, Tag::User(k as u64))).collect();
+        let scale = (x1 + 10.0).hypot(y1 + 8.0).max(height).max((hi - lo).length());
+        let om = Cell::new(walls, Tolerance::for_scale(scale)).expect("box");
         prop_assume!(!om.is_empty());
         let c = om.interior_point().expect("point");
         let cuts: Vec<Halfspace<3>> = (0..cuts).map(|i| {

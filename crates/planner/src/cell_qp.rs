@@ -3,14 +3,19 @@
 //! lexicographic tie-break "lowest z, then y, then x" when the Hessian is singular, e.g. `w = 0` or `w = 1` in
 //! cost (1)).
 //!
-//! The planner writes costs as `constant + sum_i h_i (p_i - c_i)^2`; freespace's form is
+//! The planner writes costs as `constant + sum_i h_i (p_i - c_i)^2` ([`Quadratic`]). For cost (1) of \[A\] with the
+//! extents `x_min, x_max` of the rotated vertices `R v`: `(p_x + x_max - x0)^2 + (p_x + x_min - x0)^2 =
+//! 2 (p_x - c_x)^2 + (x_max - x_min)^2 / 2` with `c_x = x0 - (x_max + x_min) / 2`, so `h_x = 2 w`, likewise `y`, and
+//! `h_z = 4 (1 - w)`, `c_z = z0 - z_c` (`z_c` the height of the rotated c.g.); for the target cost (\[A\] VII-A)
+//! `h = (1, 1, 1)` and `c = target - R g` ([`Quadratic::of_cost`]). freespace's form is
 //! `1/2 sum H_i p_i^2 + g . p + c0`, so `H_i = 2 h_i`, `g_i = -2 h_i c_i`, `c0 = constant + sum_i h_i c_i^2`.
 //! Should the exact solver report a failed KKT check (numerical trouble on a nearly degenerate cell), clarabel's
 //! interior-point solution is taken instead (some minimiser, no tie-break) and the event is logged.
 //! Cost: O(m) per active-set iteration, a handful of iterations in 2-3 variables.
 
-use stackplan_freespace::cell::Cell;
-use stackplan_freespace::{QpError, SeparableCost, minimize, minimize_clarabel};
+use crate::request::Cost;
+use glam::DVec3;
+use stackplan_freespace::{Cell, QpError, SeparableCost, minimize, minimize_clarabel};
 
 /// The optimum of the QP on a cell.
 #[derive(Debug, Clone, PartialEq)]
@@ -45,6 +50,24 @@ pub struct Quadratic<const D: usize> {
     pub c: [f64; D],
     /// Constant.
     pub constant: f64,
+}
+
+impl Quadratic<3> {
+    /// The cost `cost` (module documentation) for a part whose rotated vertices span `[lo, hi]` (relative to the
+    /// position) and whose rotated c.g. offset is `cg`. O(1).
+    pub fn of_cost(cost: &Cost, lo: DVec3, hi: DVec3, cg: DVec3) -> Self {
+        match *cost {
+            Cost::Stacking { w, origin } => {
+                let hz = 4.0 * (1.0 - w);
+                Self {
+                    h: [2.0 * w, 2.0 * w, hz],
+                    c: [origin.x - 0.5 * (hi.x + lo.x), origin.y - 0.5 * (hi.y + lo.y), origin.z - cg.z],
+                    constant: 0.5 * w * ((hi.x - lo.x).powi(2) + (hi.y - lo.y).powi(2)),
+                }
+            }
+            Cost::Target { target } => Self { h: [1.0; 3], c: (target - cg).to_array(), constant: 0.0 },
+        }
+    }
 }
 
 impl<const D: usize> Quadratic<D> {
@@ -193,7 +216,7 @@ pub fn minimise<const D: usize>(cell: &Cell<D>, q: &Quadratic<D>) -> Result<Opti
 #[cfg(test)]
 mod tests {
     use super::*;
-    use stackplan_freespace::cell::{Halfspace, Tag};
+    use stackplan_freespace::{Halfspace, Tag};
     use stackplan_geom::Tolerance;
 
     /// A deterministic generator of numbers in `[0, 1)` (xorshift64).

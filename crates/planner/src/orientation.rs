@@ -1,61 +1,22 @@
 //! One discrete orientation of the new part: rotation, the permissible set `Omega` (\[A\] eq. 3) and the cost as a
-//! separable quadratic (`docs/algorithms.md`, "Free space and the placement QP").
+//! separable quadratic ([`Quadratic::of_cost`]; `docs/algorithms.md`, "Free space and the placement QP").
 //!
 //! With `Sigma = {x : a_k . x <= b_k}` and the rotated vertices `R v`,
 //! `Omega(R) = {p : a_k . p <= b_k - max_v a_k . (R v)}`: one inequality per side of the floor polygon, the floor
 //! `p_z >= -min_v (R v)_z` and the ceiling `p_z <= H - max_v (R v)_z`. At a fixed `p_z` the floor and ceiling become
 //! a test of that value and the sides stay. O(V (S + 2)) for `V` vertices and `S` floor sides.
-//!
-//! Both costs are `f(p) = constant + sum_i h_i (p_i - c_i)^2` with `h_i >= 0`. For cost (1) with extents
-//! `x_min, x_max` of `R v`: `(p_x + x_max - x0)^2 + (p_x + x_min - x0)^2 = 2 (p_x - c_x)^2 + (x_max - x_min)^2 / 2`
-//! with `c_x = x0 - (x_max + x_min) / 2`, so `h_x = 2 w`, likewise `y`, and `h_z = 4 (1 - w)`, `c_z = z0 - z_c`.
-//! For the target cost `h = (1, 1, 1)` and `c = target - R g`.
 
+use crate::cell_qp::Quadratic;
 use crate::request::{Cost, FloorVolume, polygon_side_planes};
 use glam::{DMat3, DVec2, DVec3};
 use stackplan_cspace::PlacedConvex;
-use stackplan_freespace::cell::{Halfspace, Tag};
+use stackplan_freespace::{Halfspace, Tag};
 use stackplan_geom::Part;
 use std::sync::Arc;
 
 /// The components of `part` rotated by `rotation`, at position zero.
 pub fn rotated_components(part: &Part, rotation: DMat3) -> Arc<[PlacedConvex]> {
     part.components().iter().map(|c| PlacedConvex::new(c, rotation, DVec3::ZERO)).collect()
-}
-
-/// A separable convex quadratic `constant + sum_i h_i (p_i - c_i)^2` in three variables.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SeparableQuadratic {
-    /// Curvatures (>= 0).
-    pub h: [f64; 3],
-    /// Centres.
-    pub c: [f64; 3],
-    /// Constant term.
-    pub constant: f64,
-}
-
-impl SeparableQuadratic {
-    /// The value at `p`.
-    pub fn value(&self, p: DVec3) -> f64 {
-        let p = p.to_array();
-        self.constant + (0..3).map(|i| self.h[i] * (p[i] - self.c[i]) * (p[i] - self.c[i])).sum::<f64>()
-    }
-
-    /// The cost of `cost` for a part whose rotated vertices span `[lo, hi]` (relative to the position) and whose
-    /// rotated c.g. offset is `cg`.
-    pub fn of_cost(cost: &Cost, lo: DVec3, hi: DVec3, cg: DVec3) -> Self {
-        match *cost {
-            Cost::Stacking { w, origin } => {
-                let hz = 4.0 * (1.0 - w);
-                Self {
-                    h: [2.0 * w, 2.0 * w, hz],
-                    c: [origin.x - 0.5 * (hi.x + lo.x), origin.y - 0.5 * (hi.y + lo.y), origin.z - cg.z],
-                    constant: 0.5 * w * ((hi.x - lo.x).powi(2) + (hi.y - lo.y).powi(2)),
-                }
-            }
-            Cost::Target { target } => Self { h: [1.0; 3], c: (target - cg).to_array(), constant: 0.0 },
-        }
-    }
 }
 
 /// A discrete orientation with everything the search needs at it.
@@ -83,7 +44,7 @@ pub struct Orientation {
     /// The rotated vertices of every component, component by component (for `Omega`).
     vertices: Vec<DVec3>,
     /// The cost at this orientation.
-    pub quadratic: SeparableQuadratic,
+    pub quadratic: Quadratic<3>,
 }
 
 impl Orientation {
@@ -125,7 +86,7 @@ impl Orientation {
             hi = hi.max(*v);
         }
         let cg = rotation * part.mass().center_of_gravity;
-        let quadratic = SeparableQuadratic::of_cost(cost, lo, hi, cg);
+        let quadratic = Quadratic::of_cost(cost, lo, hi, cg);
         Self { index, rest, theta_index, theta, rotation, lo, hi, cg, components: Arc::new([]), vertices, quadratic }
     }
 

@@ -9,7 +9,7 @@
 //!   vertical path for insertion), reporting every violated condition.
 
 use crate::PlacedPart;
-use crate::cell_qp::{Quadratic, minimise};
+use crate::cell_qp::minimise;
 use crate::detect::StackScene;
 use crate::obstacles::DerivedObstacle;
 use crate::orientation::Orientation;
@@ -17,7 +17,7 @@ use crate::request::PlacementRequest;
 use glam::{DMat3, DVec3};
 use stackplan_cspace::ObstacleCache;
 use stackplan_cspace::interference::{PairContact, PlacedScene};
-use stackplan_freespace::cell::{Cell, Halfspace, Tag};
+use stackplan_freespace::{Cell, Halfspace, Tag};
 use stackplan_geom::{Part, Tolerance};
 
 /// The best cost over all orientations and all cells of the complete free space (3-D `Omega` only), with the
@@ -88,8 +88,7 @@ pub fn complete_optimum(request: &PlacementRequest<'_>) -> Result<Option<(f64, u
                 cells = next;
             }
         }
-        let q = &o.quadratic;
-        let quad = Quadratic { h: q.h, c: q.c, constant: q.constant };
+        let quad = o.quadratic;
         for cell in &cells {
             if let Some(opt) = minimise(&cell.clone(), &quad)? {
                 let p = DVec3::from_array(opt.point);

@@ -115,7 +115,7 @@ proptest! {
                             lo.y + (hi.y - lo.y) * j as f64 / n as f64,
                             lo.z + (hi.z - lo.z) * (k as f64 / 6.0).powi(2),
                         );
-                        let cost = o.quadratic.value(p);
+                        let cost = o.quadratic.value(&p.to_array());
                         if cost < best - 1e-6 * (1.0 + best.abs()) && free(&scene, &c.part, o.rotation, p, 1e-6) {
                             prop_assert!(false, "sample {p} at theta {theta} costs {cost} < optimum {best}");
                         }

@@ -6,6 +6,7 @@ mod carried_frontiers;
 mod common;
 mod exactness;
 mod extrapolation;
+mod omega;
 mod omega_2d;
 mod paper_scenarios;
 mod partitions;

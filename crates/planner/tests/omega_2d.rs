@@ -112,7 +112,7 @@ proptest! {
                         lo.y + (hi.y - lo.y) * j as f64 / n as f64,
                         c.fixed_z,
                     );
-                    let cost = o.quadratic.value(p);
+                    let cost = o.quadratic.value(&p.to_array());
                     if cost < best - 1e-6 * (1.0 + best.abs()) && free(&scene, &c.part, o.rotation, p, 1e-6) {
                         prop_assert!(
                             false,

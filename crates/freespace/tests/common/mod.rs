@@ -1,7 +1,7 @@
 //! Shared generators of the property tests: a seeded RNG and random cells, costs and obstacles.
 #![allow(dead_code)]
 
-use stackplan_freespace::{Cell, Halfspace, Tag};
+use stackplan_freespace::{Cell, CostError, Halfspace, SeparableCost, Tag};
 use stackplan_geom::{DVec3, Tolerance};
 
 /// SplitMix64: a tiny deterministic RNG driven by a proptest seed.
@@ -63,15 +63,46 @@ pub fn boxed(lo: [f64; 3], hi: [f64; 3]) -> Vec<Halfspace<3>> {
     hs
 }
 
+/// The part-dependent constants of cost (1) of \[A\] at one orientation: the rotated part's extents in x and y and
+/// its rotated centre of gravity (the height `zc` is its z).
+#[derive(Debug, Clone, Copy)]
+pub struct Extents {
+    pub x_max: f64,
+    pub x_min: f64,
+    pub y_max: f64,
+    pub y_min: f64,
+    pub center_of_gravity: DVec3,
+}
+
 /// Random rotated extents of a part for cost (1) (x and y spans around 0, a c.g. offset).
-pub fn random_extents(rng: &mut Rng) -> stackplan_freespace::RotatedExtents {
-    stackplan_freespace::RotatedExtents {
+pub fn random_extents(rng: &mut Rng) -> Extents {
+    Extents {
         x_max: rng.range(0.5, 3.0),
         x_min: rng.range(-3.0, -0.5),
         y_max: rng.range(0.5, 3.0),
         y_min: rng.range(-3.0, -0.5),
         center_of_gravity: DVec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(0.0, 2.0)),
     }
+}
+
+/// Cost (1) of \[A\] at a fixed orientation, `w [(p_x + xmax - x0)^2 + (p_x + xmin - x0)^2 + (p_y + ymax - y0)^2 +
+/// (p_y + ymin - y0)^2] + 4 (1 - w) (p_z + zc - z0)^2`, expanded into `1/2 h p^2 + g p + c` per axis (the tests'
+/// reference; the planner derives the same cost in its own form, `stackplan-planner`'s `qp::Quadratic::of_cost`).
+pub fn stacking_cost(w: f64, e: &Extents, reference: DVec3) -> Result<SeparableCost<3>, CostError> {
+    assert!((0.0..=1.0).contains(&w), "w = {w}");
+    let (ax, bx) = (e.x_max - reference.x, e.x_min - reference.x);
+    let (ay, by) = (e.y_max - reference.y, e.y_min - reference.y);
+    let z = e.center_of_gravity.z - reference.z;
+    let h = [4.0 * w, 4.0 * w, 8.0 * (1.0 - w)];
+    let g = [2.0 * w * (ax + bx), 2.0 * w * (ay + by), 8.0 * (1.0 - w) * z];
+    let c = w * (ax * ax + bx * bx + ay * ay + by * by) + 4.0 * (1.0 - w) * z * z;
+    SeparableCost::new(h, g, c)
+}
+
+/// The squared distance of the part's c.g. (at `p + R c`) to `desired` (\[A\] VII-A): `h = 2`, `g = 2 (R c - p_d)`.
+pub fn desired_position_cost(rotated_cg: DVec3, desired: DVec3) -> Result<SeparableCost<3>, CostError> {
+    let o = rotated_cg - desired;
+    SeparableCost::new([2.0; 3], [2.0 * o.x, 2.0 * o.y, 2.0 * o.z], o.length_squared())
 }
 
 pub fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {

@@ -9,8 +9,8 @@ use crate::obstacles::DerivedObstacle;
 use crate::orientation::rotated_components;
 use crate::request::PlacementError;
 use glam::DVec3;
-use stackplan_freespace::cell::{Cell, Halfspace, Tag};
-use stackplan_freespace::outer_box::{box_is_empty, box_misses_halfspace, tighten_box};
+use stackplan_freespace::outer_box::{box_is_empty, box_misses_halfspace, grown_outer_box_pruned, tighten_box};
+use stackplan_freespace::{Cell, Halfspace, Tag};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -275,7 +275,7 @@ impl Search<'_, '_> {
         // plane is finite: the phase 1 rejects the others with an error)
         let finite = buffers.outside.iter().all(|((n, d), _)| d.is_finite() && n.iter().all(|c| c.is_finite()));
         // (the children are built from the cell without the inequalities that box proves redundant)
-        let (reach, pruned) = node.cell.grown_outer_box_pruned();
+        let (reach, pruned) = grown_outer_box_pruned(&node.cell);
         let masked = self.obstacles[id as usize].planes.len() <= 128;
         let family_cuts =
             |kept: u128| if masked { InsideCuts::Kept(kept) } else { InsideCuts::Reach(finite.then_some(reach)) };

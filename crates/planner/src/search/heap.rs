@@ -3,7 +3,7 @@
 
 use super::dary_heap::DaryHeap;
 use crate::cell_qp::QpOptimum;
-use stackplan_freespace::cell::Cell;
+use stackplan_freespace::Cell;
 use std::sync::Arc;
 
 /// A solved node: an orientation, a cell, its optimum and the obstacles applied on its path.
@@ -43,7 +43,7 @@ pub(super) struct Family<const D: usize> {
 }
 
 /// The inside cuts `n_j . p <= d_j` that a family's children keep: those the box around the parent cell
-/// (`Cell::grown_outer_box_pruned`, when the obstacle's planes are finite) does not prove redundant. The test is
+/// (`outer_box::grown_outer_box_pruned`, when the obstacle's planes are finite) does not prove redundant. The test is
 /// the one that drops the empty outside child of the same face at the split (`box_misses_halfspace` with the same
 /// arguments), so the kept cuts are recorded there as a mask; an obstacle with more faces than the mask's bits keeps
 /// the box and repeats the test per child.

@@ -24,7 +24,7 @@
 //!    propagation, [`stackplan_freespace::outer_box`]) is computed at the split: a child whose outside half-space
 //!    misses it is empty and is not pushed (about 95 % of the empty children; its id is still taken, so the others'
 //!    ids and order are unchanged). The same box drops the inequalities it proves redundant from the cell the
-//!    children are built from (`Cell::grown_outer_box_pruned`: the same set; about 14 of 20 inequalities of a
+//!    children are built from (`outer_box::grown_outer_box_pruned`: the same set; about 14 of 20 inequalities of a
 //!    split cell in the 15-part Complex plan, inherited from cells cut before) and the inside cuts `n_j . p <= d_j`
 //!    it proves redundant from each child's list (the same test as the outside child's, recorded at the split as a
 //!    mask of the faces, `InsideCuts`). Each child's own box (the parent's tightened by its kept inside cuts and

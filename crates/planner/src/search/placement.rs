@@ -4,7 +4,7 @@ use super::*;
 use crate::cell_qp::QpOptimum;
 use crate::obstacles::PlaneOrigin;
 use glam::DVec3;
-use stackplan_freespace::cell::{Cell, Tag};
+use stackplan_freespace::{Cell, Tag};
 
 impl Search<'_, '_> {
     pub(super) fn placement<const D: usize>(
@@ -97,7 +97,7 @@ impl Search<'_, '_> {
             theta: o.theta,
             theta_deg: o.theta.to_degrees(),
             resting_pose: o.rest,
-            cost: o.quadratic.value(p),
+            cost: o.quadratic.value(&p.to_array()),
             contacts,
         }
     }

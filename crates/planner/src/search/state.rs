@@ -6,12 +6,12 @@ use crate::cell_qp::{QpOptimum, Quadratic, minimise};
 use crate::detect::{DetectScratch, StackScene, SweepAxes};
 use crate::interval_obstacles::IntervalObstacles;
 use crate::obstacles::DerivedObstacle;
-use crate::orientation::{Orientation, SeparableQuadratic};
+use crate::orientation::Orientation;
 use crate::request::{FloorVolume, PlacementError, PlacementRequest};
 use glam::DVec3;
 use rayon::prelude::*;
 use stackplan_cspace::ObstacleCache;
-use stackplan_freespace::cell::{Cell, Halfspace, Tag};
+use stackplan_freespace::{Cell, Halfspace, Tag};
 use stackplan_geom::Tolerance;
 use std::collections::{HashMap, VecDeque};
 use std::sync::Arc;
@@ -93,7 +93,7 @@ pub(super) fn restrict<const D: usize>(
     Ok((std::array::from_fn(|i| normal[i]), off))
 }
 
-pub(super) fn restrict_quadratic<const D: usize>(q: &SeparableQuadratic, fixed_z: f64) -> Quadratic<D> {
+pub(super) fn restrict_quadratic<const D: usize>(q: &Quadratic<3>, fixed_z: f64) -> Quadratic<D> {
     let mut constant = q.constant;
     if D == 2 {
         constant += q.h[2] * (fixed_z - q.c[2]).powi(2);
@@ -292,7 +292,7 @@ impl Search<'_, '_> {
         o: &Orientation,
         fixed_z: f64,
     ) -> Result<Option<Cell<D>>, PlacementError> {
-        let fs_err = |e: stackplan_freespace::cell::CellError| PlacementError::FreeSpace {
+        let fs_err = |e: stackplan_freespace::CellError| PlacementError::FreeSpace {
             orientation: o.index,
             reason: e.to_string(),
         };

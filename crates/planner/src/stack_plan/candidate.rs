@@ -126,7 +126,7 @@ impl Candidate<'_> {
                 .quadratic;
         let settled = Placement {
             position: s.position.to_array(),
-            cost: quadratic.value(s.position),
+            cost: quadratic.value(&s.position.to_array()),
             contacts,
             ..candidate.clone()
         };
