@@ -63,14 +63,16 @@ def test_place_equals_the_cli_place(cli, tmp_path):
 
 
 def test_contacts_equal_the_cli_contacts(cli):
-    bounds = dict(t_min=[-5, -5, 0, -9, -9, -9], t_max=[5, 5, 240, 9, 9, 9], offset=[-20, -20, -20])
+    # a unit cube on a unit cube, within 0.2 mm and 1 degree: 26 feasible states, about a second
     expected = json.loads(
         cli(
-            "contacts", "example:block", "example:l-corner", "--t-min=-5,-5,0,-9,-9,-9", "--t-max=5,5,240,9,9,9",
-            "--offset=-20,-20,-20", "--population", "8", "--generations", "2", "--json",
+            "contacts", "example:cube", "example:cube", "--t-min=-0.2,-0.2,0.9,-1,-1,-1", "--t-max=0.2,0.2,1.1,1,1,1",
+            "--population", "8", "--generations", "2", "--json",
         ).stdout
     )
+    cube = stackplan.Part.example("cube")
     got = stackplan.contacts(
-        stackplan.Part.example("block"), stackplan.Part.example("l-corner"), population=8, generations=2, **bounds
+        cube, cube, t_min=(-0.2, -0.2, 0.9, -1, -1, -1), t_max=[0.2, 0.2, 1.1, 1, 1, 1], population=8, generations=2
     )
     assert got == expected
+    assert sum(1 for state in got["states"] if state["feasible"]) == 26

@@ -195,7 +195,7 @@ pub fn search(args: &Args, part: &Part, stack_file: &StackFile) -> anyhow::Resul
     let floor = FloorVolume { polygon, height };
     let stack: Vec<StackPart<'_>> =
         stack_file.placements.iter().map(|pose| StackPart { part: &stack_file.part, pose: *pose }).collect();
-    let mut request = PlacementRequest::new(&part, stack, floor.clone());
+    let mut request = PlacementRequest::new(part, stack, floor.clone());
     request.thetas = thetas_with_step(args.dtheta_deg.to_radians()).context("--dtheta-deg")?;
     request.clearance = args.clearance;
     request.insertion = args.insertion;
