@@ -49,7 +49,7 @@ world = [[(pose[:3, :3] @ piece.T).T + pose[:3, 3] for piece in part.pieces] for
 print("lowest and highest vertex:", min(w[:, 2].min() for ws in world for w in ws),
       max(w[:, 2].max() for ws in world for w in ws), "mm")
 
-# %% Shown with trimesh (optional): each piece is convex, so its hull is the piece
+# %% Shown with trimesh (optional): one mesh per placed piece, from the piece's vertices and triangles
 try:
     import trimesh
 except ImportError:
@@ -60,8 +60,8 @@ if trimesh is not None:
     rng = np.random.default_rng(1)
     for k, pieces in enumerate(world):
         colour = np.append(rng.integers(60, 230, 3), 255)
-        for piece in pieces:
-            mesh = trimesh.convex.convex_hull(piece)
+        for piece, triangles in zip(pieces, part.triangles):
+            mesh = trimesh.Trimesh(vertices=piece, faces=triangles, process=False)
             mesh.visual.face_colors = colour
             scene.add_geometry(mesh, node_name=f"part {k + 1}")
     if args.no_show:

@@ -154,6 +154,14 @@ impl Part {
             .collect()
     }
 
+    /// The faces of each convex piece as triangles: a list of `(k, 3)` int arrays indexing that piece's vertices
+    /// (`pieces[i]`), each convex face fanned, counter-clockwise seen from outside; with `pieces` a mesh per piece for
+    /// trimesh or Open3D.
+    #[getter]
+    fn triangles<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyAny>>> {
+        self.inner.components.iter().map(|c| triangles_array(py, c)).collect()
+    }
+
     /// Volume of the union of the pieces (mm^3).
     #[getter]
     fn volume(&self) -> f64 {
@@ -519,6 +527,12 @@ fn cspace_obstacle<'py>(
         .map_err(|e| error(&e.into()))?;
     let polytope = obstacle.polytope();
     let vertices: Vec<[f64; 3]> = polytope.vertices().iter().map(|v| v.to_array()).collect();
+    Ok((numpy_array(py, vertices, "float64")?, triangles_array(py, polytope)?))
+}
+
+/// The faces of a convex polytope as a `(k, 3)` int array of triangles (each face fanned from its first corner,
+/// counter-clockwise seen from outside).
+fn triangles_array<'py>(py: Python<'py>, polytope: &stackplan::geom::ConvexPolytope) -> PyResult<Bound<'py, PyAny>> {
     let mut triangles: Vec<[usize; 3]> = Vec::new();
     for face in polytope.faces() {
         let cycle: Vec<usize> = face.vertices.iter().copied().collect();
@@ -527,10 +541,7 @@ fn cspace_obstacle<'py>(
         }
     }
     let n = triangles.len();
-    Ok((
-        numpy_array(py, vertices, "float64")?,
-        numpy_array(py, triangles, "int64")?.call_method1("reshape", ((n, 3),))?,
-    ))
+    numpy_array(py, triangles, "int64")?.call_method1("reshape", ((n, 3),))
 }
 
 /// `json.loads(text of value)`: a JSON value as Python objects.

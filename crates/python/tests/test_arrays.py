@@ -32,6 +32,9 @@ def test_from_arrays_keeps_the_pieces_and_their_volume():
         assert got.dtype == np.float64 and got.shape == (8, 3)
         np.testing.assert_array_equal(sorted_rows(got), sorted_rows(given))
     assert part.volume == pytest.approx(10 * 20 * 2 + 2 * 20 * 10, rel=1e-12)
+    # each piece's triangles close it up: the divergence theorem gives its volume
+    for piece, triangles, (lo, hi) in zip(part.pieces, part.triangles, [((0, 0, 0), (10, 20, 2)), ((0, 0, 2), (2, 20, 12))]):
+        assert mesh_volume(piece, triangles) == pytest.approx(np.prod(np.subtract(hi, lo)), rel=1e-12)
     lo, hi = part.bounds
     np.testing.assert_array_equal(lo, [0, 0, 0])
     np.testing.assert_array_equal(hi, [10, 20, 12])

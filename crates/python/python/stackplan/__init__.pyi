@@ -36,6 +36,9 @@ class Part:
     def pieces(self) -> list[npt.NDArray[np.float64]]:
         """The vertices of each convex piece, ``(n, 3)`` arrays (mm)."""
     @property
+    def triangles(self) -> list[npt.NDArray[np.int64]]:
+        """The faces of each piece as ``(k, 3)`` triangles indexing ``pieces[i]``, counter-clockwise from outside."""
+    @property
     def volume(self) -> float:
         """Volume (mm^3)."""
     @property
