@@ -60,10 +60,10 @@ if trimesh is not None:
     rng = np.random.default_rng(1)
     for k, pieces in enumerate(world):
         colour = np.append(rng.integers(60, 230, 3), 255)
-        for piece, triangles in zip(pieces, part.triangles):
+        for j, (piece, triangles) in enumerate(zip(pieces, part.triangles)):
             mesh = trimesh.Trimesh(vertices=piece, faces=triangles, process=False)
             mesh.visual.face_colors = colour
-            scene.add_geometry(mesh, node_name=f"part {k + 1}")
+            scene.add_geometry(mesh, node_name=f"part {k + 1} piece {j + 1}")
     if args.no_show:
         print(f"trimesh scene: {len(scene.geometry)} pieces, bounds {scene.bounds.tolist()}")
     else:
