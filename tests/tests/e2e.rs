@@ -2,6 +2,7 @@
 //! instead of one per file (each test binary links every dependency again). `cargo test -p PACKAGE NAME` still
 //! filters by module, e.g. `tightness::`.
 
+mod batch;
 mod commands;
 mod common;
 mod conventions;

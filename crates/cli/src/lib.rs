@@ -7,6 +7,7 @@
 pub mod cmd;
 pub mod input;
 pub mod logging;
+pub mod options;
 pub mod output;
 pub mod plan_files;
 pub mod render;
@@ -72,6 +73,8 @@ pub enum Command {
     Plan(cmd::plan::Args),
     /// Redraws the pictures, 3-D model and report of an existing plan file.
     Render(cmd::render::Args),
+    /// Many stacking plans from a JSON Lines file of jobs, in parallel, resumable, with a summary table.
+    Batch(cmd::batch::Args),
     /// Plans the same stack for several weights w and draws the stacks side by side (the seed's Fig. 2).
     Sweep(cmd::sweep::Args),
     /// The built-in example parts described and drawn under out/.
@@ -98,18 +101,20 @@ pub enum Command {
 /// single `f64` also takes values that start with a hyphen: `--theta-deg -1e-5` is a turn, and `--w -v` is an invalid
 /// number for `--w` rather than a missing value.
 pub fn command() -> clap::Command {
-    fn with_negatives(c: clap::Command) -> clap::Command {
-        c.allow_negative_numbers(true)
-            .mut_args(|a| {
-                if a.get_value_parser().type_id() == std::any::TypeId::of::<f64>() {
-                    a.allow_hyphen_values(true)
-                } else {
-                    a
-                }
-            })
-            .mut_subcommands(with_negatives)
-    }
     with_negatives(<Cli as clap::CommandFactory>::command())
+}
+
+/// `c` and its subcommands taking negative numbers as values ([`command`]).
+pub fn with_negatives(c: clap::Command) -> clap::Command {
+    c.allow_negative_numbers(true)
+        .mut_args(|a| {
+            if a.get_value_parser().type_id() == std::any::TypeId::of::<f64>() {
+                a.allow_hyphen_values(true)
+            } else {
+                a
+            }
+        })
+        .mut_subcommands(with_negatives)
 }
 
 pub fn main() -> ExitCode {
@@ -134,6 +139,7 @@ pub fn main() -> ExitCode {
     let result = input::set_read_settings(settings).and_then(|()| match &cli.command {
         Command::Part(c) => cmd::part::run(c),
         Command::Plan(a) => cmd::plan::run(a),
+        Command::Batch(a) => cmd::batch::run(a),
         Command::Render(a) => cmd::render::run(a),
         Command::Sweep(a) => cmd::sweep::run(a),
         Command::Demo(a) => cmd::demo::run(a),

@@ -114,6 +114,25 @@ pub fn plan_document_text(part: &Part, plan: &Plan, seconds: f64) -> anyhow::Res
     crate::output::json_text(&json!({ "part": inline, "placements": placements, "plan": summary }))
 }
 
+/// `plan` without its timings (`stats.seconds_search` and `stats.seconds_checks` 0): with `seconds` 0 in
+/// [`plan_document_text`], the plan file of a plan made twice with the same options is the same byte for byte
+/// (`stackplan batch`, and the Python package's `Plan.to_json(timings=False)`).
+pub fn untimed(plan: &Plan) -> Plan {
+    let mut plan = plan.clone();
+    plan.stats.seconds_search = 0.0;
+    plan.stats.seconds_checks = 0.0;
+    plan
+}
+
+/// Writes a plan's files into `dir` as `stackplan plan` does: `plan.json` ([`plan_document_text`]) and every picture
+/// drawn from that very text, exactly as `stackplan render` draws them. Every output is prepared first, then written
+/// atomically: a failure leaves no partial set behind.
+pub fn write_plan_files(dir: &Path, part: &Part, plan: &Plan, seconds: f64) -> anyhow::Result<()> {
+    let plan_text = plan_document_text(part, plan, seconds)?;
+    let file = parse_plan_file(plan_text.as_bytes(), &dir.join("plan.json"))?;
+    plan_pictures(&file)?.write_all(dir, plan_text.as_bytes())
+}
+
 /// The planner's options in radians, with their names in plan files: `PlanOptions` names them without the unit.
 const RADIAN_OPTIONS: [(&str, &str); 2] = [("dtheta", "dtheta_rad"), ("grasp_tilt", "grasp_tilt_rad")];
 

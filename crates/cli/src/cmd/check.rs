@@ -9,6 +9,7 @@ use crate::output;
 use crate::plan_files::{plan_floor, plan_option, plan_summary};
 use anyhow::Context;
 use serde::Serialize;
+use stackplan::geom::io::stack::StackFile;
 use stackplan::planner::FloorVolume;
 use stackplan::stability::check::{CheckOptions, StackCheck, check_stack};
 use stackplan::stability::grasp::GraspOptions;
@@ -143,6 +144,64 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let file =
         stackplan::geom::io::stack::read_stack_with(&args.stack, &crate::input::read_options(Default::default()))
             .with_context(|| format!("reading the stack {}", args.stack.display()))?;
+    let checked = check_stack_file(&file, args)?;
+    let ok = checked.report.ok;
+    if args.json {
+        output::print_json(&check_json_value(checked)?)?;
+    } else {
+        let CheckJson { options, floor, report, .. } = checked;
+        let mut text = format!(
+            "stack {}: {} parts (numbered from 1 in placing order), {}\n  part  interference_mm  clearance_met  \
+             stable  margin  stack_stable  grasp_radius_mm  insertable  removable  ok\n",
+            args.stack.display(),
+            report.parts.len(),
+            if ok { "all checks pass" } else { "CHECKS FAILED" }
+        );
+        for p in &report.parts {
+            text.push_str(&format!(
+                "  {:>4}  {:>15.6}  {:>13}  {:>6}  {:>6}  {:>12}  {:>15.3}  {:>10}  {:>9}  {}\n",
+                p.index + 1,
+                p.interference,
+                p.clearance_met,
+                p.stable.is_stable(),
+                p.margin.map_or("-".to_string(), |m| format!("{m:.3}")),
+                p.stack_stable.is_stable(),
+                p.grasp_radius,
+                p.insertable,
+                p.removable,
+                p.ok
+            ));
+        }
+        text.push_str(&format!(
+            "  whole stack: {:?}, margin {}\n  (interference: penetration depth; margin: the largest sideways push, as \
+             a fraction of the weight, that the part resists on its supports, up to 10; clearance {} mm, cup {} mm, \
+             mu {})\n",
+            report.stack.verdict,
+            report.stack.margin.map_or("-".to_string(), |m| format!("{m:.3}")),
+            crate::input::short_number(options.clearance),
+            crate::input::short_number(options.grasp.cup_diameter),
+            crate::input::short_number(options.mu),
+        ));
+        if let Some(f) = &floor {
+            if f.ok {
+                text.push_str("  floor volume: every part inside\n");
+            }
+            for v in &f.outside {
+                text.push_str(&format!(
+                    "  floor volume: part {} lies {:.6} mm beyond the floor polygon and {:.6} mm above the maximum height\n",
+                    v.index + 1, v.beyond_sides, v.above_height
+                ));
+            }
+        }
+        output::print_summary(&text)?;
+    }
+    Ok(if ok { Outcome::Success } else { Outcome::ChecksFailed })
+}
+
+/// Checks a stack file read from `args.stack` (which names it in errors) with the options of `args` and, for a plan
+/// file, its own friction, clearance, cup and floor volume: what `stackplan check` prints (shared with the Python
+/// package's `check`).
+pub fn check_stack_file(file: &StackFile, args: &Args) -> anyhow::Result<CheckJson> {
     let stack: Vec<PlacedPart<'_>> =
         file.placements.iter().map(|pose| PlacedPart { part: &file.part, pose: *pose }).collect();
     // a plan file is checked with the planner's own friction, clearance and cup unless the command line says otherwise;
@@ -198,57 +257,12 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         }
         report.ok &= f.ok;
     }
-    let ok = report.ok;
-    if args.json {
-        let mut json =
-            serde_json::to_value(CheckJson { stack_file: args.stack.display().to_string(), options, floor, report })?;
-        output::rename_key(&mut json, &["options", "grasp", "max_tilt"], "max_tilt_rad");
-        output::print_json(&json)?;
-    } else {
-        let mut text = format!(
-            "stack {}: {} parts (numbered from 1 in placing order), {}\n  part  interference_mm  clearance_met  \
-             stable  margin  stack_stable  grasp_radius_mm  insertable  removable  ok\n",
-            args.stack.display(),
-            report.parts.len(),
-            if ok { "all checks pass" } else { "CHECKS FAILED" }
-        );
-        for p in &report.parts {
-            text.push_str(&format!(
-                "  {:>4}  {:>15.6}  {:>13}  {:>6}  {:>6}  {:>12}  {:>15.3}  {:>10}  {:>9}  {}\n",
-                p.index + 1,
-                p.interference,
-                p.clearance_met,
-                p.stable.is_stable(),
-                p.margin.map_or("-".to_string(), |m| format!("{m:.3}")),
-                p.stack_stable.is_stable(),
-                p.grasp_radius,
-                p.insertable,
-                p.removable,
-                p.ok
-            ));
-        }
-        text.push_str(&format!(
-            "  whole stack: {:?}, margin {}\n  (interference: penetration depth; margin: the largest sideways push, as \
-             a fraction of the weight, that the part resists on its supports, up to 10; clearance {} mm, cup {} mm, \
-             mu {})\n",
-            report.stack.verdict,
-            report.stack.margin.map_or("-".to_string(), |m| format!("{m:.3}")),
-            crate::input::short_number(options.clearance),
-            crate::input::short_number(options.grasp.cup_diameter),
-            crate::input::short_number(options.mu),
-        ));
-        if let Some(f) = &floor {
-            if f.ok {
-                text.push_str("  floor volume: every part inside\n");
-            }
-            for v in &f.outside {
-                text.push_str(&format!(
-                    "  floor volume: part {} lies {:.6} mm beyond the floor polygon and {:.6} mm above the maximum height\n",
-                    v.index + 1, v.beyond_sides, v.above_height
-                ));
-            }
-        }
-        output::print_summary(&text)?;
-    }
-    Ok(if ok { Outcome::Success } else { Outcome::ChecksFailed })
+    Ok(CheckJson { stack_file: args.stack.display().to_string(), options, floor, report })
+}
+
+/// The JSON of `check --json` (radians named `_rad`).
+pub fn check_json_value(json: CheckJson) -> anyhow::Result<serde_json::Value> {
+    let mut value = serde_json::to_value(json)?;
+    output::rename_key(&mut value, &["options", "grasp", "max_tilt"], "max_tilt_rad");
+    Ok(value)
 }

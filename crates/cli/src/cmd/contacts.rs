@@ -7,7 +7,7 @@ use crate::Outcome;
 use crate::input::{PartPair, load_pair};
 use crate::output;
 use anyhow::Context;
-use stackplan::contact_states::acsg::{AcsgSettings, generate};
+use stackplan::contact_states::acsg::{Acsg, AcsgSettings, generate};
 use stackplan::contact_states::criteria::ContactPart;
 use stackplan::contact_states::ga::{GaSettings, MAX_GA_SIZE};
 use stackplan::contact_states::pose::ConfigBox;
@@ -79,6 +79,23 @@ fn config(s: &str, what: &str) -> anyhow::Result<[f64; 6]> {
 
 /// Runs the command.
 pub fn run(args: &Args) -> anyhow::Result<Outcome> {
+    let PartPair { moving, fixed, .. } = load_pair(&args.moving, &args.fixed, args.triangulate, None, None)?;
+    let graph = contact_graph(args, &moving, fixed)?;
+    if let Some(path) = &args.dot {
+        output::write_atomic(path, graph.to_dot().as_bytes())?;
+        output::print_wrote(&[path], args.json)?;
+    }
+    if args.json {
+        output::print_json(&graph)?;
+    } else {
+        output::print_text(&contacts_text(&graph))?;
+    }
+    Ok(Outcome::Success)
+}
+
+/// The assembly contact state graph of `moving` against `fixed` with the options of `args` (its part names name
+/// them in messages): shared with the Python package's `contacts`.
+pub fn contact_graph(args: &Args, moving: &Part, mut fixed: Part) -> anyhow::Result<Acsg> {
     anyhow::ensure!(
         (4..=MAX_GA_SIZE).contains(&args.population),
         "--population must lie in 4..={MAX_GA_SIZE}, got {}",
@@ -91,7 +108,6 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     );
     let bounds = ConfigBox::new(config(&args.t_min, "--t-min")?, config(&args.t_max, "--t-max")?)
         .context("--t-min / --t-max")?;
-    let PartPair { moving, mut fixed, .. } = load_pair(&args.moving, &args.fixed, args.triangulate, None, None)?;
     if let Some(o) = &args.offset {
         let v = parse_list(o, 3, "--offset")?;
         crate::input::check_lengths("--offset", &v)?;
@@ -99,7 +115,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         let components = fixed.components().iter().map(|c| c.transformed(DMat3::IDENTITY, shift)).collect();
         fixed = Part::from_components(fixed.name.clone(), components, fixed.density(), PartOrigin::ConvexPieces)?;
     }
-    let moving = ContactPart::from_part(&moving).with_context(|| format!("surface of {}", args.moving))?;
+    let moving = ContactPart::from_part(moving).with_context(|| format!("surface of {}", args.moving))?;
     let fixed = ContactPart::from_part(&fixed).with_context(|| format!("surface of {}", args.fixed))?;
     let settings = AcsgSettings {
         ga: GaSettings {
@@ -112,17 +128,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     };
     // the GA's effort per search and per graph is bounded; a request beyond it names these options
     settings.ga.check().context("--population / --generations")?;
-    let graph = generate(&fixed, &moving, bounds, settings).context("--population / --generations")?;
-    if let Some(path) = &args.dot {
-        output::write_atomic(path, graph.to_dot().as_bytes())?;
-        output::print_wrote(&[path], args.json)?;
-    }
-    if args.json {
-        output::print_json(&graph)?;
-    } else {
-        output::print_text(&contacts_text(&graph))?;
-    }
-    Ok(Outcome::Success)
+    generate(&fixed, &moving, bounds, settings).context("--population / --generations")
 }
 
 /// The text output of `contacts`: the counts, then a table of the states that were searched (the library's

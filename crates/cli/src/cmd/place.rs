@@ -9,8 +9,9 @@ use crate::input::{PartArgs, load_part};
 use crate::output;
 use anyhow::{Context, bail};
 use serde::Serialize;
-use stackplan::planner::{Cost, FloorVolume, PlacedPart, PlacementRequest, place, thetas_with_step};
-use stackplan_geom::io::stack::read_stack_with;
+use stackplan::planner::{Cost, FloorVolume, PlacedPart, PlacementRequest, PlacementResult, place, thetas_with_step};
+use stackplan_geom::Part;
+use stackplan_geom::io::stack::{StackFile, read_stack_with};
 use stackplan_geom::{DVec2, DVec3};
 use std::path::PathBuf;
 
@@ -98,6 +99,45 @@ struct Output<'a> {
 pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let part = load_part(&args.part)?;
     let stack_file = read_stack_with(&args.stack, &crate::input::read_options(args.part.decomposition()))?;
+    let result = search(args, &part, &stack_file)?;
+    if args.json {
+        output::print_json(&placements_json(&result)?)?;
+    } else {
+        let unit = if args.target.is_some() { "mm^2 (squared distance to the target)" } else { "mm^2" };
+        let mut text = String::new();
+        for (i, p) in result.placements.iter().enumerate() {
+            text.push_str(&format!(
+                "placement {}: position ({:.3}, {:.3}, {:.3}) mm, turn {:.1} deg, cost {:.6} {unit}, {} contacts\n",
+                i + 1,
+                p.position[0],
+                p.position[1],
+                p.position[2],
+                p.theta_deg,
+                p.cost,
+                p.contacts.len()
+            ));
+        }
+        if let Some(reason) = result.exhausted {
+            text.push_str(&format!("found {} of {} placement(s): {reason:?}\n", result.placements.len(), args.k));
+        }
+        let s = &result.stats;
+        text.push_str(&format!(
+            "orientations {} (searched {}), component pairs evaluated {} of {}, search nodes {}, {:.1} ms\n",
+            s.orientations_requested,
+            s.orientations_searched,
+            s.pairs_evaluated,
+            s.total_pairs,
+            s.nodes_expanded,
+            s.time_total_ms
+        ));
+        output::print_text(&text)?;
+    }
+    Ok(if result.placements.is_empty() { Outcome::ChecksFailed } else { Outcome::Success })
+}
+
+/// The placement search of `place` for `part` in the stack of `stack_file` with the options of `args` (its part and
+/// stack name them in messages): shared with the Python package's `place`.
+pub fn search(args: &Args, part: &Part, stack_file: &StackFile) -> anyhow::Result<PlacementResult> {
     crate::input::check_dtheta_deg(args.dtheta_deg)?;
     let check_lengths = crate::input::check_lengths;
     if let Some(floor) = &args.floor {
@@ -155,7 +195,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     let floor = FloorVolume { polygon, height };
     let stack: Vec<PlacedPart<'_>> =
         stack_file.placements.iter().map(|pose| PlacedPart { part: &stack_file.part, pose: *pose }).collect();
-    let mut request = PlacementRequest::new(&part, stack, floor.clone());
+    let mut request = PlacementRequest::new(part, stack, floor.clone());
     request.thetas = thetas_with_step(args.dtheta_deg.to_radians()).context("--dtheta-deg")?;
     request.clearance = args.clearance;
     request.insertion = args.insertion;
@@ -173,44 +213,16 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
         (None, Some(_)) => "--floor".to_string(),
         (None, None) => "the default floor".to_string(),
     };
-    let result = place(&request).with_context(|| format!("placing {} on {floor_source}", args.part.part))?;
-    if args.json {
-        let mut json = serde_json::to_value(Output {
-            placements: &result.placements,
-            exhausted: result.exhausted,
-            stats: &result.stats,
-        })?;
-        output::rename_key(&mut json, &["placements", "*", "theta"], "theta_rad");
-        output::print_json(&json)?;
-    } else {
-        let unit = if args.target.is_some() { "mm^2 (squared distance to the target)" } else { "mm^2" };
-        let mut text = String::new();
-        for (i, p) in result.placements.iter().enumerate() {
-            text.push_str(&format!(
-                "placement {}: position ({:.3}, {:.3}, {:.3}) mm, turn {:.1} deg, cost {:.6} {unit}, {} contacts\n",
-                i + 1,
-                p.position[0],
-                p.position[1],
-                p.position[2],
-                p.theta_deg,
-                p.cost,
-                p.contacts.len()
-            ));
-        }
-        if let Some(reason) = result.exhausted {
-            text.push_str(&format!("found {} of {} placement(s): {reason:?}\n", result.placements.len(), args.k));
-        }
-        let s = &result.stats;
-        text.push_str(&format!(
-            "orientations {} (searched {}), component pairs evaluated {} of {}, search nodes {}, {:.1} ms\n",
-            s.orientations_requested,
-            s.orientations_searched,
-            s.pairs_evaluated,
-            s.total_pairs,
-            s.nodes_expanded,
-            s.time_total_ms
-        ));
-        output::print_text(&text)?;
-    }
-    Ok(if result.placements.is_empty() { Outcome::ChecksFailed } else { Outcome::Success })
+    place(&request).with_context(|| format!("placing {} on {floor_source}", args.part.part))
+}
+
+/// The JSON of `place --json` (radians named `_rad`).
+pub fn placements_json(result: &PlacementResult) -> anyhow::Result<serde_json::Value> {
+    let mut json = serde_json::to_value(Output {
+        placements: &result.placements,
+        exhausted: result.exhausted,
+        stats: &result.stats,
+    })?;
+    output::rename_key(&mut json, &["placements", "*", "theta"], "theta_rad");
+    Ok(json)
 }

@@ -7,7 +7,7 @@
 
 use crate::Outcome;
 use crate::input::load_part_spec;
-use crate::plan_files::{parse_plan_file, plan_document_text, plan_pictures};
+use crate::plan_files::write_plan_files;
 use anyhow::{Context, bail};
 use stackplan::planner::{FloorVolume, Plan, PlanOptions, stack_plan::plan_stack_with_progress};
 use stackplan_geom::Part;
@@ -112,6 +112,12 @@ pub fn check_w(option: &str, w: f64) -> anyhow::Result<()> {
 impl PlannerArgs {
     /// Checks the options that do not depend on the part, then reads the part.
     pub fn load_part(&self, spec: &str) -> anyhow::Result<Part> {
+        self.check()?;
+        load_part_spec(spec, crate::input::decomposition(self.triangulate))
+    }
+
+    /// Checks the options that do not depend on the part (the messages name the command-line options).
+    pub fn check(&self) -> anyhow::Result<()> {
         if self.count == 0 {
             bail!("--count must be at least 1");
         }
@@ -133,7 +139,7 @@ impl PlannerArgs {
         }
         anyhow::ensure!(self.node_budget > 0, "--node-budget must be at least 1");
         crate::input::check_grasp_tilt(self.grasp_tilt_deg)?;
-        load_part_spec(spec, crate::input::decomposition(self.triangulate))
+        Ok(())
     }
 
     /// The planner's options for `part` and weight `w` (the floor and height defaults scale with the part).
@@ -201,11 +207,7 @@ pub fn run(args: &Args) -> anyhow::Result<Outcome> {
     bar.finish_and_clear();
     let (plan, seconds) = planned.with_context(|| format!("planning {}", args.part))?;
 
-    // the pictures are drawn from the plan file's text, exactly as `stackplan render` draws them; every output is
-    // prepared first, then written atomically: a failure leaves no partial set behind
-    let plan_text = plan_document_text(&part, &plan, seconds)?;
-    let file = parse_plan_file(plan_text.as_bytes(), &args.out.join("plan.json"))?;
-    plan_pictures(&file)?.write_all(&args.out, plan_text.as_bytes())?;
+    write_plan_files(&args.out, &part, &plan, seconds)?;
     let [[x0, y0], [x1, y1]] = plan.footprint;
     crate::output::print_summary(&format!(
         "{} of {} parts placed ({}): height {:.1} mm, footprint {:.1} x {:.1} mm, total cost {:.1} mm^2, {:.1} s\n\
