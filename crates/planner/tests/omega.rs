@@ -26,7 +26,7 @@ proptest! {
         let (a, b, height) = axes;
         let mut angles = angles[..sides].to_vec();
         angles.sort_by(f64::total_cmp);
-        prop_assume!(angles.windows(2).all(|w| w[1] - w[0] > 1e-3) && angles[sides - 1] - angles[0] < 6.28);
+        prop_assume!(angles.windows(2).all(|w| w[1] - w[0] > 1e-3) && angles[sides - 1] - angles[0] < std::f64::consts::TAU - 3e-3);
         let polygon: Vec<DVec2> = angles.iter().map(|t| DVec2::new(1.0 + a * t.cos(), -2.0 + b * t.sin())).collect();
         let floor = FloorVolume { polygon, height };
         // a convex part: the hull of random points in a ball

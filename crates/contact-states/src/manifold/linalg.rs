@@ -115,8 +115,6 @@ pub(super) fn null_space_projection(goal: &[f64; 6], rows: &[[f64; 6]], fixed: &
     d
 }
 
-/// A direction (scaled variables, unit length) that improves the objective `sign t_k` (decreases it) while keeping
-
 #[cfg(test)]
 mod tests {
     use super::*;
