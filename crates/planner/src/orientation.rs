@@ -1,5 +1,5 @@
 //! One discrete orientation of the new part: rotation, the permissible set `Omega` (\[A\] eq. 3) and the cost as a
-//! separable quadratic ([`Quadratic::of_cost`]; `docs/algorithms.md`, "Free space and the placement QP").
+//! separable quadratic (`cell_qp::Quadratic::of_cost`; `docs/algorithms.md`, "Free space and the placement QP").
 //!
 //! With `Sigma = {x : a_k . x <= b_k}` and the rotated vertices `R v`,
 //! `Omega(R) = {p : a_k . p <= b_k - max_v a_k . (R v)}`: one inequality per side of the floor polygon, the floor

@@ -19,7 +19,7 @@
 //! [`crate::criteria`]) at most `hold`; the penetration term `L d_G` at most `hold`; and the PPCs in contact are
 //! exactly the state: with Euclidean distances between the elements (point to planar face
 //! `sqrt(height^2 + in-plane distance^2)`, segment to segment in 3-D), the PPCs at distance `<= hold` map to the state
-//! by [`ContactState::canonical`], and no PPC lies in the ambiguous band `(hold, clear]`. `hold = 1e-7 L`,
+//! by [`crate::ContactState::canonical`], and no PPC lies in the ambiguous band `(hold, clear]`. `hold = 1e-7 L`,
 //! `clear = 1e-5 L` by default. Cost O(number of reachable PPCs) distance evaluations.
 //!
 //! **Interior witness.** A GA witness of eq. 8 can sit where further contacts also hold (closure semantics). The

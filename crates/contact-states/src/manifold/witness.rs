@@ -66,7 +66,7 @@ impl Manifolds<'_> {
     /// [`Self::interior_witness`]; with `perturb_when_apart` false the perturbations are skipped when the first
     /// projected start is rejected as `NotInContact` or `Penetrating` (for neighbours' configurations, which a GA
     /// run follows: such starts rarely lead to a witness). Configurations rejected as another state
-    /// ([`Rejection::OtherState`]) are appended to `other_states` (at most [`MAX_OTHER_STATES`]): they are candidate
+    /// ([`Rejection::OtherState`]) are appended to `other_states` (at most `MAX_OTHER_STATES`): they are candidate
     /// witnesses of the state that holds there.
     pub fn interior_witness_with(
         &self,
