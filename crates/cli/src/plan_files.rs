@@ -499,11 +499,11 @@ pub fn placement_reason(p: &Map<String, Value>) -> String {
         k => format!("{k} cheaper candidates of its stage failed a check"),
     };
     let reasons = [
-        ("not_stable", "not stable on its supports"),
+        ("not_stable", "not stable on their supports"),
         ("stack_not_stable", "the stack would not be stable"),
         ("not_graspable", "no face for the cup"),
         ("not_insertable", "not insertable from above"),
-        ("clearance", "too close to a part"),
+        ("clearance", "too close to another part"),
     ];
     let counts = p.get("rejections").and_then(Value::as_object);
     let failed: Vec<String> = reasons
@@ -514,7 +514,7 @@ pub fn placement_reason(p: &Map<String, Value>) -> String {
         })
         .collect();
     let failed =
-        if failed.is_empty() { String::new() } else { format!(" (rejected while placing it: {})", failed.join(", ")) };
+        if failed.is_empty() { String::new() } else { format!("; rejected in all its stages: {}", failed.join(", ")) };
     let drop = p.get("release_drop").and_then(Value::as_f64).unwrap_or(0.0);
     let drop =
         if drop > 0.0 { format!("; released {drop:.1} mm above its rest and drops into place") } else { String::new() };
@@ -689,9 +689,9 @@ mod tests {
         })));
         assert_eq!(
             rejected,
-            "stage 2 (the whole floor): 3 cheaper candidates of its stage failed a check (rejected while placing it: 2 \
-             not stable on its supports, 1 not insertable from above); released 0.3 mm above its rest and drops into \
-             place"
+            "stage 2 (the whole floor): 3 cheaper candidates of its stage failed a check; rejected in all its stages: \
+             2 not stable on their supports, 1 not insertable from above; released 0.3 mm above its rest and drops \
+             into place"
         );
     }
 

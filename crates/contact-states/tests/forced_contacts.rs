@@ -17,25 +17,12 @@ use stackplan_contact_states::acsg::{AcsgSettings, generate};
 use stackplan_contact_states::criteria::ContactPart;
 use stackplan_contact_states::ga::GaSettings;
 use stackplan_contact_states::pose::ConfigBox;
-use stackplan_geom::{DMat3, DVec3, Part, PartOrigin, convex_hull};
+use stackplan_geom::{ConvexPolytope, DMat3, DVec3, Part, PartOrigin};
 
 use crate::common;
 
-fn cuboid(lo: DVec3, hi: DVec3) -> stackplan_geom::ConvexPolytope {
-    let pts: Vec<DVec3> = (0..8)
-        .map(|i| {
-            DVec3::new(
-                if i & 1 == 0 { lo.x } else { hi.x },
-                if i & 2 == 0 { lo.y } else { hi.y },
-                if i & 4 == 0 { lo.z } else { hi.z },
-            )
-        })
-        .collect();
-    convex_hull(&pts).expect("box").polytope
-}
-
 fn part(name: &str, boxes: &[(DVec3, DVec3)]) -> Part {
-    let components = boxes.iter().map(|&(lo, hi)| cuboid(lo, hi)).collect();
+    let components = boxes.iter().map(|&(lo, hi)| ConvexPolytope::cuboid(lo, hi).expect("box")).collect();
     Part::from_components(name, components, 1.0, PartOrigin::ConvexPieces).expect("part")
 }
 
